@@ -1,0 +1,53 @@
+"""dvqp: QP-based redundancy resolution of hyper-redundant manipulators in a pipe's developed view.
+
+The pieces, in the order a step uses them:
+
+- :class:`Robot` — Pinocchio model, body-point and tool frames, joint limits;
+- :class:`KinematicState` — one kinematics update per step, in Cartesian and DV coordinates;
+- :class:`Objective` — the paper's ``w(Q)`` with its gradient, :class:`Obstacle` circles;
+- resolvers — :class:`PseudoinverseResolver` (paper eq. 18) and the per-step QP;
+- :func:`simulate` — JOG / path integration into a :class:`Trajectory`.
+"""
+
+from dvqp.errors import (
+    BackendError,
+    DvqpError,
+    ParameterError,
+    SceneError,
+    ShapeError,
+    SingularConfigurationError,
+    UnreachableTargetError,
+)
+from dvqp.objective import Objective, Term
+from dvqp.obstacles import Obstacle
+from dvqp.pinv import PseudoinverseResolver
+from dvqp.resolver import Resolver, Step
+from dvqp.robot import Robot
+from dvqp.simulate import JogSegment, jog_commands, simulate
+from dvqp.state import KinematicState
+from dvqp.trajectory import Trajectory
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "BackendError",
+    "DvqpError",
+    "JogSegment",
+    "KinematicState",
+    "Objective",
+    "Obstacle",
+    "ParameterError",
+    "PseudoinverseResolver",
+    "Resolver",
+    "Robot",
+    "SceneError",
+    "ShapeError",
+    "SingularConfigurationError",
+    "Step",
+    "Term",
+    "Trajectory",
+    "UnreachableTargetError",
+    "__version__",
+    "jog_commands",
+    "simulate",
+]

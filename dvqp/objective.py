@@ -1,0 +1,136 @@
+"""The objective ``w(Q)`` of the paper (eq. 10–17) and its analytic gradient.
+
+``w`` is maximised: its gradient pulls the body points to the orbital height ``h*`` and pushes
+points and links out of the obstacle circles. With ``k`` body points ``p_i = [l, z, h]``::
+
+    ¹w   = −Σ_i ½ k²_i (h_i − h*)²
+    ²w_j =  Σ_i ½ w_j k̂_i (‖S_j − p_i‖² − R_j²),   k̂_i = k¹_i inside the circle, else 0
+    ³w_j =  Σ_i ½ w_j k̂_i (D_ij² − R_j²),          k̂_i = k¹_i if the closest point of link i
+                                                    is interior and inside the circle
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from dvqp import _validate
+from dvqp.errors import ParameterError, ShapeError
+from dvqp.obstacles import Obstacle, offsets, segment_offsets, stack
+from dvqp.state import KinematicState
+
+
+@dataclass(frozen=True)
+class Term:
+    """A value of ``w`` (or of one of its terms) and its gradient ``∂w/∂Q``, shape (n,)."""
+
+    value: float
+    gradient: NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Objective:
+    """The paper's objective, configured for a robot with ``n_points`` body points.
+
+    Parameters
+    ----------
+    n_points
+        Number of body points k.
+    orbital_level
+        ``h*``, m.
+    k_height
+        ``k²``, scalar or shape (k,), >= 0, 1/m² scaling of the orbital term.
+    k_obstacle
+        ``k¹``, scalar or shape (k,), >= 0; ``k¹_i`` also weights link i (points i, i+1).
+    obstacles
+        Circles in the (l, z) plane.
+    gain
+        ``λ`` that scales ``∇w`` in the resolution step (>= 0).
+    """
+
+    n_points: int
+    orbital_level: float
+    k_height: NDArray[np.float64] | float = 1.0
+    k_obstacle: NDArray[np.float64] | float = 1.0
+    obstacles: tuple[Obstacle, ...] = ()
+    gain: float = 1.0
+    _packed: tuple[NDArray[np.float64], ...] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        k = int(self.n_points)
+        if k < 2:
+            raise ParameterError("n_points", "must be >= 2")
+        for name in ("k_height", "k_obstacle"):
+            arr = _validate.broadcast(name, getattr(self, name), k)
+            if np.any(arr < 0):
+                raise ParameterError(name, "must be >= 0")
+            object.__setattr__(self, name, _validate.readonly(arr))
+        level = float(self.orbital_level)
+        if not np.isfinite(level):
+            raise ParameterError("orbital_level", "must be finite")
+        object.__setattr__(self, "orbital_level", level)
+        object.__setattr__(self, "gain", _validate.positive("gain", self.gain, strict=False))
+        obstacles = tuple(self.obstacles)
+        for i, o in enumerate(obstacles):
+            if not isinstance(o, Obstacle):
+                raise ParameterError(f"obstacles[{i}]", "must be an Obstacle")
+        object.__setattr__(self, "obstacles", obstacles)
+        object.__setattr__(self, "_packed", stack(obstacles))
+
+    def _check(self, state: KinematicState) -> None:
+        if state.points.shape[0] != self.n_points:
+            raise ShapeError("state.points", (self.n_points, 3), state.points.shape)
+
+    def orbital(self, state: KinematicState) -> Term:
+        """``¹w``: attraction of the body points to the orbital height."""
+        self._check(state)
+        dh = state.points[:, 2] - self.orbital_level
+        kh = np.asarray(self.k_height)
+        value = -0.5 * float(np.sum(kh * dh * dh))
+        grad = -(kh * dh) @ state.point_jacobians[:, 2, :]
+        return Term(value, grad)
+
+    def obstacle_points(self, state: KinematicState) -> Term:
+        """``Σ_j ²w_j``: repulsion of the body points from the obstacles."""
+        self._check(state)
+        centers, radii, weights = self._packed
+        n = state.n
+        if centers.shape[0] == 0:
+            return Term(0.0, np.zeros(n))
+        s = offsets(state.points[:, :2], centers, state.radius)  # (J, k, 2)
+        excess = np.einsum("jkc,jkc->jk", s, s) - radii[:, None] ** 2
+        coef = weights[:, None] * np.asarray(self.k_obstacle)[None, :] * (excess < 0)
+        value = 0.5 * float(np.sum(coef * excess))
+        # ∂/∂Q: −Σ w k̂ (S − p)ᵀ ∂p/∂Q   (point Jacobian rows l, z)
+        v = np.einsum("jk,jkc->kc", coef, s)  # (k, 2)
+        grad = -np.einsum("kc,kcn->n", v, state.point_jacobians[:, :2, :])
+        return Term(value, grad)
+
+    def obstacle_links(self, state: KinematicState) -> Term:
+        """``Σ_j ³w_j``: repulsion of the links (closest interior point) from the obstacles."""
+        self._check(state)
+        centers, radii, weights = self._packed
+        n = state.n
+        if centers.shape[0] == 0:
+            return Term(0.0, np.zeros(n))
+        t, r = segment_offsets(state.points[:, :2], centers, state.radius, clamp=False)
+        excess = np.einsum("jic,jic->ji", r, r) - radii[:, None] ** 2
+        active = (excess < 0) & (t >= 0.0) & (t <= 1.0)
+        coef = weights[:, None] * np.asarray(self.k_obstacle)[None, :-1] * active  # (J, k-1)
+        value = 0.5 * float(np.sum(coef * excess))
+        # ∂³w/∂Q = −Σ w k̂ (S − p̄)ᵀ ((1−t) ∂p_i + t ∂p_{i+1}); the ∂t term vanishes (r ⟂ link)
+        a = coef[..., None] * r  # (J, k-1, 2)
+        per_point = np.zeros((self.n_points, 2))
+        per_point[:-1] += np.einsum("jic,ji->ic", a, 1.0 - t)
+        per_point[1:] += np.einsum("jic,ji->ic", a, t)
+        grad = -np.einsum("kc,kcn->n", per_point, state.point_jacobians[:, :2, :])
+        return Term(value, grad)
+
+    def evaluate(self, state: KinematicState) -> Term:
+        """``w(Q)`` and ``∂w/∂Q`` (all three terms), shape (n,)."""
+        terms = (self.orbital(state), self.obstacle_points(state), self.obstacle_links(state))
+        return Term(
+            sum(t.value for t in terms), terms[0].gradient + terms[1].gradient + terms[2].gradient
+        )

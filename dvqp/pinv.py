@@ -1,0 +1,119 @@
+"""The paper's baseline (eq. 18): pseudoinverse plus null-space projection of ``∇w``.
+
+Weighted least-norm form with a positive diagonal ``W`` (``W = I`` gives eq. 18)::
+
+    J̄_W⁺ = W⁻¹ J̄ᵀ (J̄ W⁻¹ J̄ᵀ + μ² I)⁻¹
+    Q̇    = J̄_W⁺ ẋ + (I − J̄_W⁺ J̄) W⁻¹ g,        g = λ ∂w/∂Q
+
+which is ``W⁻¹ g + J̄_W⁺ (ẋ − J̄ W⁻¹ g)``. With ``μ = 0`` this is exactly the minimiser of
+``½ Q̇ᵀ W Q̇ − gᵀ Q̇`` subject to ``J̄ Q̇ = ẋ``. ``μ > 0`` is the damped (singularity-robust)
+inverse: finite everywhere, at the price of a task error near singularities.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from dvqp import _validate
+from dvqp.errors import ParameterError, SingularConfigurationError
+from dvqp.resolver import Step
+from dvqp.state import KinematicState
+
+SINGULAR_RCOND = 1e-10
+"""Reciprocal condition of ``J̄ W⁻¹ J̄ᵀ`` below which the undamped inverse is refused."""
+
+
+def weighted_pinv_step(
+    jacobian: NDArray[np.float64],
+    xdot: NDArray[np.float64],
+    gradient: NDArray[np.float64],
+    inv_weights: NDArray[np.float64],
+    damping: float = 0.0,
+) -> NDArray[np.float64]:
+    """``Q̇ = W⁻¹g + J̄_W⁺ (ẋ − J̄ W⁻¹ g)`` for a (m, n) Jacobian.
+
+    Parameters
+    ----------
+    jacobian
+        ``J̄``, shape (m, n).
+    xdot
+        Task velocity, shape (m,).
+    gradient
+        ``g``, shape (n,).
+    inv_weights
+        Diagonal of ``W⁻¹``, shape (n,), > 0.
+    damping
+        ``μ`` (units of the task), >= 0.
+
+    Raises
+    ------
+    SingularConfigurationError
+        ``μ = 0`` and ``J̄ W⁻¹ J̄ᵀ`` is singular (rank-deficient task).
+    """
+    jw = jacobian * inv_weights  # J W⁻¹, (m, n)
+    gram = jw @ jacobian.T
+    m = gram.shape[0]
+    if damping > 0.0:
+        gram = gram + damping * damping * np.eye(m)
+    else:
+        eig = np.linalg.eigvalsh(gram)
+        if eig[0] <= SINGULAR_RCOND * max(eig[-1], 1e-300):
+            raise SingularConfigurationError(
+                f"task Jacobian is rank deficient (eigenvalues of J W^-1 J^T from {eig[0]:.3g} "
+                f"to {eig[-1]:.3g}); use a damped inverse"
+            )
+    free = inv_weights * gradient
+    lam = np.linalg.solve(gram, xdot - jacobian @ free)
+    return free + jw.T @ lam
+
+
+class PseudoinverseResolver:
+    """The paper's baseline resolver (name ``"pinv"``).
+
+    Parameters
+    ----------
+    weights
+        Diagonal of ``W`` (> 0), scalar or shape (n,). Default: identity.
+    damping
+        ``μ >= 0`` of the damped inverse; 0 reproduces eq. 18 and raises at singularities.
+    """
+
+    name = "pinv"
+
+    def __init__(self, weights: ArrayLike | None = None, damping: float = 0.0) -> None:
+        self._weights = None if weights is None else np.asarray(weights, dtype=float)
+        if self._weights is not None and (
+            not np.all(np.isfinite(self._weights)) or np.any(self._weights <= 0)
+        ):
+            raise ParameterError("weights", "must be finite and > 0")
+        self.damping = _validate.positive("damping", damping, strict=False)
+
+    def inverse_weights(self, n: int) -> NDArray[np.float64]:
+        """Diagonal of ``W⁻¹`` for n joints, shape (n,)."""
+        if self._weights is None:
+            return np.ones(n)
+        return 1.0 / _validate.broadcast("weights", self._weights, n)
+
+    def resolve(
+        self,
+        state: KinematicState,
+        gradient: NDArray[np.float64],
+        xdot: NDArray[np.float64],
+        dt: float,
+    ) -> Step:
+        """One baseline step (``dt`` is unused: the baseline holds no limits)."""
+        start = time.perf_counter()
+        n = state.n
+        g = _validate.vector("gradient", gradient, n)
+        jac = state.tool_jacobian
+        xd = _validate.vector("xdot", xdot, jac.shape[0])
+        qdot = weighted_pinv_step(jac, xd, g, self.inverse_weights(n), self.damping)
+        elapsed = time.perf_counter() - start
+        error = float(np.max(np.abs(jac @ qdot - xd)))
+        return Step(qdot=qdot, success=True, status="optimal", task_error=error, solve_time=elapsed)
+
+    def reset(self) -> None:
+        """Nothing to forget: the baseline is stateless."""

@@ -1,0 +1,241 @@
+"""The manipulator: a Pinocchio model with named body-point frames, a tool frame and limits.
+
+A :class:`Robot` is built from a DH table (:meth:`Robot.from_dh`), from the paper's 13-DOF
+arm (:meth:`Robot.ndt13`) or from a URDF file (:meth:`Robot.from_urdf`). The method is not
+limited to 13 DOF: any serial chain with ``n`` revolute joints, ``k`` point frames and a tool
+frame works.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike, NDArray
+
+from dvqp import _validate
+from dvqp.dh import DHRow, check_transform, fixed_part, ndt13_table
+from dvqp.errors import DvqpError, ParameterError
+
+NDT13_POINT_JOINTS = (4, 6, 8, 10, 13)
+"""Joints (1-based) whose output frames are the paper's five body points."""
+
+DEFAULT_QD_MAX = 1.5
+"""Default joint velocity limit, rad/s."""
+
+
+class Robot:
+    """A serial manipulator with body points, a tool frame and joint limits.
+
+    Parameters
+    ----------
+    model
+        Pinocchio model with ``nq == nv == n`` (revolute joints).
+    point_frames
+        Names of the body-point frames, in order along the chain (k >= 2).
+    tool_frame
+        Name of the tool frame (its z axis is the probe axis).
+    q_min, q_max
+        Joint position limits, rad, scalar or shape (n,); ``±inf`` for none.
+        Default: the model's own limits.
+    qd_max
+        Joint velocity limits, rad/s, scalar or shape (n,), > 0.
+    name
+        A label for reports.
+    """
+
+    def __init__(
+        self,
+        model: pin.Model,
+        point_frames: Sequence[str],
+        tool_frame: str,
+        *,
+        q_min: ArrayLike | None = None,
+        q_max: ArrayLike | None = None,
+        qd_max: ArrayLike = DEFAULT_QD_MAX,
+        name: str = "robot",
+    ) -> None:
+        if model.nq != model.nv:
+            raise ParameterError("model", "only joints with nq == nv (revolute, prismatic)")
+        self.model = model
+        self.name = name
+        n = model.nq
+        if len(point_frames) < 2:
+            raise ParameterError("points", "need at least two body-point frames")
+        names = [*point_frames, tool_frame]
+        ids = []
+        for fname in names:
+            if not model.existFrame(fname):
+                known = ", ".join(f.name for f in model.frames)
+                raise ParameterError("frames", f"no frame named {fname!r} (model has: {known})")
+            ids.append(model.getFrameId(fname))
+        self.point_frames = tuple(point_frames)
+        self.tool_frame = tool_frame
+        self.frame_ids: tuple[int, ...] = tuple(ids)
+        lo = model.lowerPositionLimit if q_min is None else q_min
+        hi = model.upperPositionLimit if q_max is None else q_max
+        self.q_min = _validate.readonly(_broadcast_limit("q_min", lo, n))
+        self.q_max = _validate.readonly(_broadcast_limit("q_max", hi, n))
+        if np.any(self.q_min > self.q_max):
+            raise ParameterError("q_min", "must be <= q_max for every joint")
+        qd = _validate.broadcast("qd_max", qd_max, n)
+        if np.any(qd <= 0):
+            raise ParameterError("qd_max", "must be > 0 for every joint")
+        self.qd_max = _validate.readonly(qd)
+        self.data = model.createData()
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return int(self.model.nq)
+
+    @property
+    def n_points(self) -> int:
+        """Number of body points."""
+        return len(self.point_frames)
+
+    def check_q(self, q: ArrayLike, name: str = "q") -> NDArray[np.float64]:
+        """Return ``q`` as a finite float vector of length :attr:`n`, or raise."""
+        return _validate.vector(name, q, self.n)
+
+    def within_limits(self, q: ArrayLike, tol: float = 1e-9) -> bool:
+        """True if ``q`` lies within the joint position limits (with tolerance, rad)."""
+        qv = self.check_q(q)
+        return bool(np.all(qv >= self.q_min - tol) and np.all(qv <= self.q_max + tol))
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def from_dh(
+        cls,
+        table: Sequence[DHRow],
+        tool: ArrayLike,
+        point_joints: Sequence[int],
+        *,
+        q_min: ArrayLike = -np.pi,
+        q_max: ArrayLike = np.pi,
+        qd_max: ArrayLike = DEFAULT_QD_MAX,
+        name: str = "dh-robot",
+    ) -> Robot:
+        """Build a revolute chain from a standard DH table.
+
+        Joint i is a revolute joint about its local z, placed after joint i−1's fixed part
+        ``Tz(d)·Tx(a)·Rx(α)``. Frame ``"point{j}"`` sits at the output of the j-th joint in
+        ``point_joints`` (1-based), frame ``"tool"`` at ``T_n^0 · tool``.
+
+        Parameters
+        ----------
+        table
+            DH rows, one per joint.
+        tool
+            ``T_e^n``, shape (4, 4).
+        point_joints
+            1-based joint indices whose output frames are the body points.
+        q_min, q_max, qd_max
+            Limits, see :class:`Robot`.
+        """
+        if len(table) < 1:
+            raise ParameterError("table", "needs at least one DH row")
+        n = len(table)
+        tool_t = check_transform("tool", tool)
+        for j in point_joints:
+            if not 1 <= int(j) <= n:
+                raise ParameterError("point_joints", f"joint {j} is not in 1..{n}")
+        lo = _broadcast_limit("q_min", q_min, n)
+        hi = _broadcast_limit("q_max", q_max, n)
+        model = pin.Model()
+        model.name = name
+        parent = 0
+        placement = pin.SE3.Identity()
+        inf = np.array([np.inf])
+        for i, row in enumerate(table):
+            if row.theta_offset != 0.0:
+                rz = pin.SE3(pin.rpy.rpyToMatrix(0.0, 0.0, row.theta_offset), np.zeros(3))
+                placement = placement * rz
+            parent = model.addJoint(
+                parent,
+                pin.JointModelRZ(),
+                placement,
+                f"joint{i + 1}",
+                inf,
+                inf,
+                lo[i : i + 1],
+                hi[i : i + 1],
+            )
+            model.addJointFrame(parent, -1)
+            placement = pin.SE3(fixed_part(row))
+            for k, j in enumerate(point_joints):
+                if int(j) == i + 1:
+                    model.addFrame(pin.Frame(f"point{k + 1}", parent, placement, pin.OP_FRAME))
+        tool_placement = pin.SE3(fixed_part(table[-1]) @ tool_t)
+        model.addFrame(pin.Frame("tool", parent, tool_placement, pin.OP_FRAME))
+        points = [f"point{k + 1}" for k in range(len(point_joints))]
+        return cls(model, points, "tool", q_min=lo, q_max=hi, qd_max=qd_max, name=name)
+
+    @classmethod
+    def ndt13(
+        cls,
+        link_lengths: ArrayLike,
+        *,
+        q_min: ArrayLike | None = None,
+        q_max: ArrayLike | None = None,
+        qd_max: ArrayLike = DEFAULT_QD_MAX,
+    ) -> Robot:
+        """The paper's 13-DOF NDT manipulator (Table I) with body points at joints 4–13.
+
+        Parameters
+        ----------
+        link_lengths
+            ``[L1, …, L7]``, m.
+        q_min, q_max
+            Limits, rad. Default: the carriage (joint 1) is unlimited, the arm joints ±π.
+        qd_max
+            Velocity limits, rad/s.
+        """
+        table, tool = ndt13_table(link_lengths)
+        default_lo = np.full(13, -np.pi)
+        default_lo[0] = -np.inf
+        lo = default_lo if q_min is None else q_min
+        hi = -default_lo if q_max is None else q_max
+        return cls.from_dh(
+            table, tool, NDT13_POINT_JOINTS, q_min=lo, q_max=hi, qd_max=qd_max, name="ndt13"
+        )
+
+    @classmethod
+    def from_urdf(
+        cls,
+        path: str | Path,
+        points: Sequence[str],
+        tool: str,
+        *,
+        q_min: ArrayLike | None = None,
+        q_max: ArrayLike | None = None,
+        qd_max: ArrayLike | None = None,
+    ) -> Robot:
+        """Load a serial arm from a URDF file; ``points`` and ``tool`` are frame (link) names.
+
+        Velocity limits default to the URDF's, or :data:`DEFAULT_QD_MAX` where it gives none.
+        """
+        try:
+            model = pin.buildModelFromUrdf(str(path))
+        except (RuntimeError, ValueError) as exc:
+            raise DvqpError(f"{path}: cannot load URDF: {exc}") from exc
+        if qd_max is None:
+            vel = np.asarray(model.velocityLimit, dtype=float)
+            qd_max = np.where(np.isfinite(vel) & (vel > 0), vel, DEFAULT_QD_MAX)
+        return cls(model, points, tool, q_min=q_min, q_max=q_max, qd_max=qd_max, name=model.name)
+
+
+def _broadcast_limit(name: str, value: ArrayLike, n: int) -> NDArray[np.float64]:
+    """Scalar or (n,) limit vector; ±inf allowed, NaN not."""
+    arr = np.asarray(value, dtype=np.float64)
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,):
+        from dvqp.errors import ShapeError
+
+        raise ShapeError(name, (n,), arr.shape)
+    if np.any(np.isnan(arr)):
+        raise ParameterError(name, "must not be NaN")
+    return arr.copy()

@@ -1,0 +1,193 @@
+"""A planned trajectory, its per-step diagnostics, and its export (.npz, .csv)."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from dvqp.developed_view import unwrap
+from dvqp.errors import DvqpError, ParameterError
+
+ARRAYS = (
+    "t",
+    "q",
+    "qdot",
+    "dv",
+    "points",
+    "w",
+    "min_clearance",
+    "solve_time",
+    "task_error",
+    "iterations",
+    "success",
+    "status",
+)
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Samples ``k = 0..N`` of a run and the ``N`` steps between them.
+
+    Attributes
+    ----------
+    t : ndarray, shape (N+1,)
+        Time, s.
+    q : ndarray, shape (N+1, n)
+        Joint configuration, rad.
+    qdot : ndarray, shape (N, n)
+        Joint velocity applied during step k, rad/s.
+    dv : ndarray, shape (N+1, 4)
+        Tool ``[l, z, h, α]`` with l (m) and α (rad) unwrapped along the run.
+    points : ndarray, shape (N+1, k, 3)
+        Body points ``[l, z, h]`` (m), l unwrapped per point.
+    w : ndarray, shape (N+1,)
+        Objective value.
+    min_clearance : ndarray, shape (N+1,)
+        Smallest clearance of body points and links to the obstacles, m (inf: no obstacle).
+    solve_time : ndarray, shape (N,)
+        Resolver time per step, s.
+    task_error : ndarray, shape (N,)
+        ``‖J̄Q̇ − ẋ‖∞`` per step.
+    iterations : ndarray of int, shape (N,)
+        Solver iterations (−1: not reported).
+    success : ndarray of bool, shape (N,)
+        The step was solved and checked.
+    status : ndarray of str, shape (N,)
+        Resolver status per step.
+    backend : str
+        Name of the resolver.
+    pipe_radius : float
+        m.
+    scene_text : str
+        The scene file's text, if the run came from one.
+    """
+
+    t: NDArray[np.float64]
+    q: NDArray[np.float64]
+    qdot: NDArray[np.float64]
+    dv: NDArray[np.float64]
+    points: NDArray[np.float64]
+    w: NDArray[np.float64]
+    min_clearance: NDArray[np.float64]
+    solve_time: NDArray[np.float64]
+    task_error: NDArray[np.float64]
+    iterations: NDArray[np.int64]
+    success: NDArray[np.bool_]
+    status: NDArray[np.str_]
+    backend: str = ""
+    pipe_radius: float = 0.0
+    scene_text: str = field(default="", repr=False)
+
+    @classmethod
+    def from_samples(
+        cls,
+        *,
+        dt: float,
+        q: NDArray[np.float64],
+        qdot: NDArray[np.float64],
+        tool: NDArray[np.float64],
+        points: NDArray[np.float64],
+        pipe_radius: float,
+        w: NDArray[np.float64],
+        min_clearance: NDArray[np.float64],
+        solve_time: NDArray[np.float64],
+        task_error: NDArray[np.float64],
+        iterations: NDArray[np.int64],
+        success: NDArray[np.bool_],
+        status: Sequence[str],
+        backend: str,
+    ) -> Trajectory:
+        """Build from raw samples, unwrapping l (period 2πR) and α (period 2π)."""
+        period = 2.0 * np.pi * pipe_radius
+        dv = tool.copy()
+        dv[:, 0] = unwrap(tool[:, 0], period)
+        dv[:, 3] = unwrap(tool[:, 3], 2.0 * np.pi)
+        pts = points.copy()
+        pts[:, :, 0] = unwrap(points[:, :, 0], period, axis=0)
+        return cls(
+            t=dt * np.arange(q.shape[0]),
+            q=q,
+            qdot=qdot,
+            dv=dv,
+            points=pts,
+            w=w,
+            min_clearance=min_clearance,
+            solve_time=solve_time,
+            task_error=task_error,
+            iterations=iterations,
+            success=success,
+            status=np.asarray(list(status), dtype=np.str_),
+            backend=backend,
+            pipe_radius=float(pipe_radius),
+        )
+
+    @property
+    def n_steps(self) -> int:
+        """Number of steps N."""
+        return int(self.qdot.shape[0])
+
+    @property
+    def ok(self) -> bool:
+        """Every step succeeded."""
+        return bool(np.all(self.success))
+
+    def save(self, path: str | Path) -> Path:
+        """Write ``.npz`` (all arrays, metadata, scene text) or ``.csv`` (t, q, dv) atomically.
+
+        The file appears complete or not at all: it is written to a temporary file in the
+        same folder and renamed.
+        """
+        target = Path(path)
+        suffix = target.suffix.lower()
+        if suffix not in (".npz", ".csv"):
+            raise ParameterError(
+                "output", f"{target}: unknown format {suffix!r} (use .npz or .csv)"
+            )
+        if not target.parent.exists():
+            raise ParameterError("output", f"{target.parent}: no such directory")
+        fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=suffix)
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                if suffix == ".npz":
+                    arrays = {name: getattr(self, name) for name in ARRAYS}
+                    np.savez_compressed(
+                        fh,
+                        **arrays,
+                        backend=np.str_(self.backend),
+                        pipe_radius=np.float64(self.pipe_radius),
+                        scene=np.str_(self.scene_text),
+                    )
+                else:
+                    self._write_csv(fh)
+            os.replace(tmp, target)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        return target
+
+    def _write_csv(self, fh: object) -> None:
+        n = self.q.shape[1]
+        header = ["t"] + [f"q{i + 1}" for i in range(n)] + ["l", "z", "h", "alpha"]
+        table = np.column_stack([self.t, self.q, self.dv])
+        np.savetxt(fh, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")  # type: ignore[arg-type]
+
+    @classmethod
+    def load(cls, path: str | Path) -> Trajectory:
+        """Read a trajectory written by :meth:`save` (``.npz``)."""
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                arrays = {name: data[name] for name in ARRAYS}
+                return cls(
+                    **arrays,
+                    backend=str(data["backend"]),
+                    pipe_radius=float(data["pipe_radius"]),
+                    scene_text=str(data["scene"]),
+                )
+        except (OSError, KeyError, ValueError) as exc:
+            raise DvqpError(f"{path}: not a dvqp trajectory ({exc})") from exc

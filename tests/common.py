@@ -1,0 +1,53 @@
+"""Constants and small builders shared by the tests (robot fixtures are built in code)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dvqp import Objective, Obstacle
+
+PIPE_RADIUS = 0.254
+ORBITAL_LEVEL = 0.08
+LINK_LENGTHS = [0.334, 0.10, 0.15, 0.15, 0.15, 0.15, 0.06]
+Q0 = [
+    1.5708,
+    -0.048,
+    0.068,
+    0.026,
+    0.08,
+    0.032,
+    0.088,
+    -0.078,
+    -0.088,
+    0.003,
+    -0.434,
+    0.116,
+    -0.278,
+]
+
+
+def random_configurations(count: int, seed: int = 0, spread: float = 0.6) -> np.ndarray:
+    """Configurations around the start configuration (rad), shape (count, 13)."""
+    rng = np.random.default_rng(seed)
+    return np.array(Q0) + rng.uniform(-spread, spread, size=(count, 13))
+
+
+def objective_with(obstacles: list[Obstacle], **kw: object) -> Objective:
+    """The paper's objective (5 points, h* = 0.08 m) with the given obstacles."""
+    return Objective(n_points=5, orbital_level=ORBITAL_LEVEL, obstacles=tuple(obstacles), **kw)  # type: ignore[arg-type]
+
+
+def central_difference(f, x: np.ndarray, eps: float = 1e-6, wrap=None) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """Central finite-difference Jacobian of ``f`` at ``x``, shape f(x).shape + (len(x),).
+
+    ``wrap`` (optional) is applied to each difference ``f(x+) − f(x−)`` (for l and α).
+    """
+    cols = []
+    for i in range(x.shape[0]):
+        e = np.zeros_like(x)
+        e[i] = eps
+        d = np.asarray(f(x + e)) - np.asarray(f(x - e))
+        if wrap is not None:
+            d = wrap(d)
+        cols.append(d / (2 * eps))
+    return np.stack(cols, axis=-1)

@@ -1,0 +1,69 @@
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from dvqp import KinematicState, PseudoinverseResolver, Robot
+from dvqp.errors import ParameterError, ShapeError, SingularConfigurationError
+from dvqp.pinv import weighted_pinv_step
+from tests.common import PIPE_RADIUS, random_configurations
+
+
+def kkt_solution(jac: np.ndarray, xdot: np.ndarray, g: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Minimiser of ½ Q̇ᵀWQ̇ − gᵀQ̇ s.t. J̄Q̇ = ẋ from the KKT system (independent of the formula)."""
+    n, m = jac.shape[1], jac.shape[0]
+    kkt = np.block([[np.diag(w), jac.T], [jac, np.zeros((m, m))]])
+    return np.linalg.solve(kkt, np.concatenate([g, xdot]))[:n]
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10_000), st.booleans())
+def test_step_tracks_the_command_and_equals_the_qp_minimiser(seed: int, weighted: bool) -> None:
+    rng = np.random.default_rng(seed)
+    jac = rng.normal(size=(4, 13))
+    xdot, g = rng.normal(size=4), rng.normal(size=13)
+    w = rng.uniform(0.2, 5.0, 13) if weighted else np.ones(13)
+    qdot = weighted_pinv_step(jac, xdot, g, 1.0 / w)
+    np.testing.assert_allclose(jac @ qdot, xdot, atol=1e-10)
+    np.testing.assert_allclose(qdot, kkt_solution(jac, xdot, g, w), atol=1e-9)
+
+
+def test_paper_formula_eq18_is_the_unweighted_case(robot: Robot) -> None:
+    rng = np.random.default_rng(2)
+    for q in random_configurations(5, seed=3):
+        jac = KinematicState.compute(robot, q, PIPE_RADIUS).tool_jacobian
+        xdot, g = rng.normal(size=4), rng.normal(size=13)
+        jp = jac.T @ np.linalg.inv(jac @ jac.T)
+        eq18 = jp @ xdot + (np.eye(13) - jp @ jac) @ g
+        np.testing.assert_allclose(weighted_pinv_step(jac, xdot, g, np.ones(13)), eq18, atol=1e-10)
+
+
+def test_null_space_part_does_not_disturb_the_task(robot: Robot, state0: KinematicState) -> None:
+    rng = np.random.default_rng(4)
+    xdot = rng.normal(size=4)
+    resolver = PseudoinverseResolver(weights=rng.uniform(0.5, 2.0, 13))
+    with_g = resolver.resolve(state0, rng.normal(size=13), xdot, 0.005)
+    without = resolver.resolve(state0, np.zeros(13), xdot, 0.005)
+    jac = state0.tool_jacobian
+    np.testing.assert_allclose(jac @ (with_g.qdot - without.qdot), 0.0, atol=1e-10)
+    assert with_g.task_error < 1e-10 and np.abs(with_g.qdot - without.qdot).max() > 1e-3
+
+
+def test_rank_deficient_task_raises_unless_damped() -> None:
+    jac = np.zeros((4, 13))
+    jac[:3, :3] = np.eye(3)  # fourth task row is zero: singular
+    with pytest.raises(SingularConfigurationError, match="rank deficient"):
+        weighted_pinv_step(jac, np.ones(4), np.zeros(13), np.ones(13))
+    qdot = weighted_pinv_step(jac, np.ones(4), np.zeros(13), np.ones(13), damping=1e-2)
+    assert np.all(np.isfinite(qdot))
+
+
+def test_bad_inputs_raise_typed_errors(state0: KinematicState) -> None:
+    with pytest.raises(ShapeError, match="xdot"):
+        PseudoinverseResolver().resolve(state0, np.zeros(13), np.zeros(3), 0.005)
+    with pytest.raises(ShapeError, match="gradient"):
+        PseudoinverseResolver().resolve(state0, np.zeros(12), np.zeros(4), 0.005)
+    with pytest.raises(ParameterError, match="weights"):
+        PseudoinverseResolver(weights=[0.0] * 13)
+    with pytest.raises(ParameterError, match="damping"):
+        PseudoinverseResolver(damping=-1.0)

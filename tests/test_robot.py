@@ -1,0 +1,68 @@
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dvqp import KinematicState, Robot
+from dvqp.errors import DvqpError, ParameterError, ShapeError
+from tests.common import LINK_LENGTHS
+
+URDF = """<?xml version="1.0"?>
+<robot name="arm3">
+  <link name="base"/>
+  <link name="l1"/><link name="l2"/><link name="l3"/><link name="probe"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/>
+    <origin xyz="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="2.0"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/>
+    <origin xyz="0.4 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1.0"/></joint>
+  <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/>
+    <origin xyz="0 0 0.1"/><axis xyz="1 0 0"/>
+    <limit lower="-2" upper="2" effort="1" velocity="0.5"/></joint>
+  <joint name="tool" type="fixed"><parent link="l3"/><child link="probe"/>
+    <origin xyz="0 0.1 0" rpy="-1.5707963 0 0"/></joint>
+</robot>
+"""
+
+
+def test_ndt13_has_thirteen_joints_five_points_and_default_limits(robot: Robot) -> None:
+    assert robot.n == 13 and robot.n_points == 5
+    assert robot.q_min[0] == -np.inf and robot.q_max[1] == pytest.approx(np.pi)
+    assert np.all(robot.qd_max == 1.5)
+
+
+def test_urdf_robot_reads_limits_and_named_frames(tmp_path: Path) -> None:
+    path = tmp_path / "arm3.urdf"
+    path.write_text(URDF)
+    robot = Robot.from_urdf(path, points=["l2", "l3"], tool="probe")
+    assert robot.n == 3
+    np.testing.assert_allclose(robot.q_max, [3, 1, 2])
+    np.testing.assert_allclose(robot.qd_max, [2.0, 1.0, 0.5])
+    state = KinematicState.compute(robot, np.zeros(3), 0.3)
+    assert state.tool_jacobian.shape == (4, 3) and state.points.shape == (2, 3)
+    np.testing.assert_allclose(state.origins[-1], [0.4, 0.1, 0.1], atol=1e-12)
+
+
+def test_urdf_errors_name_the_file_and_the_missing_frame(tmp_path: Path) -> None:
+    with pytest.raises(DvqpError, match=r"missing\.urdf"):
+        Robot.from_urdf(tmp_path / "missing.urdf", points=["a", "b"], tool="c")
+    path = tmp_path / "arm3.urdf"
+    path.write_text(URDF)
+    with pytest.raises(ParameterError, match="'nope'"):
+        Robot.from_urdf(path, points=["l1", "nope"], tool="probe")
+
+
+def test_limits_are_validated() -> None:
+    with pytest.raises(ShapeError, match="q_min"):
+        Robot.ndt13(LINK_LENGTHS, q_min=np.zeros(12))
+    with pytest.raises(ParameterError, match="q_min"):
+        Robot.ndt13(LINK_LENGTHS, q_min=1.0, q_max=0.0)
+    with pytest.raises(ParameterError, match="qd_max"):
+        Robot.ndt13(LINK_LENGTHS, qd_max=0.0)
+
+
+def test_within_limits(robot: Robot, q0: np.ndarray) -> None:
+    assert robot.within_limits(q0)
+    q0[3] = 4.0
+    assert not robot.within_limits(q0)
