@@ -13,7 +13,7 @@ def vector(name: str, value: ArrayLike, n: int | None = None) -> NDArray[np.floa
     arr = np.asarray(value, dtype=np.float64)
     if arr.ndim != 1 or (n is not None and arr.shape[0] != n):
         raise ShapeError(name, (-1 if n is None else n,), arr.shape)
-    if not np.all(np.isfinite(arr)):
+    if not np.isfinite(arr).all():
         raise ParameterError(name, "must be finite (no NaN or inf)")
     return arr
 

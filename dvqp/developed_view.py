@@ -15,6 +15,8 @@ on the pipe axis raises :class:`~dvqp.errors.SingularConfigurationError`; an und
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -30,9 +32,8 @@ more than about 1 mrad away from radial, bounded and finite closer to it."""
 
 def wrap(dl: ArrayLike, radius: float) -> NDArray[np.float64]:
     """Wrap arc-length differences into ``[−πR, πR)``, m, same shape as ``dl``."""
-    d = np.asarray(dl, dtype=np.float64)
     period = 2.0 * np.pi * radius
-    return d - period * np.floor((d + 0.5 * period) / period)
+    return np.remainder(np.asarray(dl, dtype=np.float64) + 0.5 * period, period) - 0.5 * period
 
 
 def wrap_angle(da: ArrayLike) -> NDArray[np.float64]:
@@ -94,34 +95,41 @@ def position_jacobian(origins: ArrayLike, radius: float) -> NDArray[np.float64]:
     return out
 
 
+def heading_terms(
+    ox: float, oy: float, zx: float, zy: float, zz: float
+) -> tuple[float, tuple[float, float, float, float, float]]:
+    """Heading ``α`` (rad) and its nonzero partials, in plain floats (the per-step fast path).
+
+    Returns
+    -------
+    alpha : float
+    partials : tuple of float
+        ``(∂α/∂Ox, ∂α/∂Oy, ∂α/∂zx, ∂α/∂zy, ∂α/∂zz)``; ``∂α/∂Oz = 0``.
+    """
+    rho = math.hypot(ox, oy)
+    if rho < RHO_MIN:
+        raise SingularConfigurationError(f"frame lies on the pipe axis (rho = {rho:.3g} m)")
+    c = (ox * zy - oy * zx) / rho
+    s = zz
+    k = 1.0 / max(c * c + s * s, HEADING_FLOOR)
+    # ∂α = (c ∂s − s ∂c) / (c² + s²); s depends on zz only.
+    dc_ox = zy / rho - c * ox / (rho * rho)
+    dc_oy = -zx / rho - c * oy / (rho * rho)
+    partials = (-s * dc_ox * k, -s * dc_oy * k, s * oy / rho * k, -s * ox / rho * k, c * k)
+    return math.atan2(s, c), partials
+
+
 def heading(origin: ArrayLike, axis: ArrayLike) -> float:
     """Heading ``α`` (rad) of the unit ``axis`` at ``origin`` (m) projected on the surface."""
-    o = np.asarray(origin, dtype=np.float64)
-    z = np.asarray(axis, dtype=np.float64)
-    rho = float(_rho(o[None, :])[0])
-    c = (o[0] * z[1] - o[1] * z[0]) / rho
-    return float(np.arctan2(z[2], c))
+    (ox, oy, _), (zx, zy, zz) = np.asarray(origin, float).tolist(), np.asarray(axis, float).tolist()
+    return heading_terms(ox, oy, zx, zy, zz)[0]
 
 
 def heading_gradient(origin: ArrayLike, axis: ArrayLike) -> NDArray[np.float64]:
-    """``∂α/∂[O; z]``, shape (6,), damped near the undefined heading (axis radial)."""
-    o = np.asarray(origin, dtype=np.float64)
-    z = np.asarray(axis, dtype=np.float64)
-    rho = float(_rho(o[None, :])[0])
-    c = (o[0] * z[1] - o[1] * z[0]) / rho
-    s = z[2]
-    dc = np.array(
-        [
-            z[1] / rho - c * o[0] / rho**2,
-            -z[0] / rho - c * o[1] / rho**2,
-            0.0,
-            -o[1] / rho,
-            o[0] / rho,
-            0.0,
-        ]
-    )
-    ds = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 1.0])
-    return (c * ds - s * dc) / max(c * c + s * s, HEADING_FLOOR)
+    """``∂α/∂[O; z]``, shape (6,), bounded near the undefined heading (axis radial)."""
+    (ox, oy, _), (zx, zy, zz) = np.asarray(origin, float).tolist(), np.asarray(axis, float).tolist()
+    d = heading_terms(ox, oy, zx, zy, zz)[1]
+    return np.array([d[0], d[1], 0.0, d[2], d[3], d[4]])
 
 
 def coordinates(origin: ArrayLike, axis: ArrayLike, radius: float) -> NDArray[np.float64]:

@@ -11,14 +11,15 @@ points and links out of the obstacle circles. With ``k`` body points ``p_i = [l,
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
-from dvqp.obstacles import Obstacle, offsets, segment_offsets, stack
+from dvqp.obstacles import Obstacle
+from dvqp.proximity import ObstacleSet, proximity
 from dvqp.state import KinematicState
 
 
@@ -45,7 +46,7 @@ class Objective:
     k_obstacle
         ``k¹``, scalar or shape (k,), >= 0; ``k¹_i`` also weights link i (points i, i+1).
     obstacles
-        Circles in the (l, z) plane.
+        Circles in the (l, z) plane (kept as an :class:`~dvqp.proximity.ObstacleSet`).
     gain
         ``λ`` that scales ``∇w`` in the resolution step (>= 0).
     """
@@ -54,9 +55,8 @@ class Objective:
     orbital_level: float
     k_height: NDArray[np.float64] | float = 1.0
     k_obstacle: NDArray[np.float64] | float = 1.0
-    obstacles: tuple[Obstacle, ...] = ()
+    obstacles: ObstacleSet | tuple[Obstacle, ...] = ()
     gain: float = 1.0
-    _packed: tuple[NDArray[np.float64], ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         k = int(self.n_points)
@@ -72,12 +72,8 @@ class Objective:
             raise ParameterError("orbital_level", "must be finite")
         object.__setattr__(self, "orbital_level", level)
         object.__setattr__(self, "gain", _validate.positive("gain", self.gain, strict=False))
-        obstacles = tuple(self.obstacles)
-        for i, o in enumerate(obstacles):
-            if not isinstance(o, Obstacle):
-                raise ParameterError(f"obstacles[{i}]", "must be an Obstacle")
-        object.__setattr__(self, "obstacles", obstacles)
-        object.__setattr__(self, "_packed", stack(obstacles))
+        if not isinstance(self.obstacles, ObstacleSet):
+            object.__setattr__(self, "obstacles", ObstacleSet(self.obstacles))
 
     def _check(self, state: KinematicState) -> None:
         if state.points.shape[0] != self.n_points:
@@ -88,43 +84,47 @@ class Objective:
         self._check(state)
         dh = state.points[:, 2] - self.orbital_level
         kh = np.asarray(self.k_height)
-        value = -0.5 * float(np.sum(kh * dh * dh))
+        value = -0.5 * float(kh @ (dh * dh))
         grad = -(kh * dh) @ state.point_jacobians[:, 2, :]
         return Term(value, grad)
 
     def obstacle_points(self, state: KinematicState) -> Term:
         """``Σ_j ²w_j``: repulsion of the body points from the obstacles."""
         self._check(state)
-        centers, radii, weights = self._packed
-        n = state.n
-        if centers.shape[0] == 0:
-            return Term(0.0, np.zeros(n))
-        s = offsets(state.points[:, :2], centers, state.radius)  # (J, k, 2)
-        excess = np.einsum("jkc,jkc->jk", s, s) - radii[:, None] ** 2
-        coef = weights[:, None] * np.asarray(self.k_obstacle)[None, :] * (excess < 0)
+        obstacles = self.obstacles
+        if not len(obstacles):
+            return Term(0.0, np.zeros(state.n))
+        near = proximity(state, obstacles)
+        excess = near.point_distance**2 - obstacles.radii[:, None] ** 2  # (J, k)
+        inside = excess < 0.0
+        if not inside.any():
+            return Term(0.0, np.zeros(state.n))
+        coef = obstacles.weights[:, None] * np.asarray(self.k_obstacle)[None, :] * inside
         value = 0.5 * float(np.sum(coef * excess))
         # ∂/∂Q: −Σ w k̂ (S − p)ᵀ ∂p/∂Q   (point Jacobian rows l, z)
-        v = np.einsum("jk,jkc->kc", coef, s)  # (k, 2)
+        v = (coef[..., None] * near.point_offsets).sum(axis=0)  # (k, 2)
         grad = -np.einsum("kc,kcn->n", v, state.point_jacobians[:, :2, :])
         return Term(value, grad)
 
     def obstacle_links(self, state: KinematicState) -> Term:
         """``Σ_j ³w_j``: repulsion of the links (closest interior point) from the obstacles."""
         self._check(state)
-        centers, radii, weights = self._packed
-        n = state.n
-        if centers.shape[0] == 0:
-            return Term(0.0, np.zeros(n))
-        t, r = segment_offsets(state.points[:, :2], centers, state.radius, clamp=False)
-        excess = np.einsum("jic,jic->ji", r, r) - radii[:, None] ** 2
-        active = (excess < 0) & (t >= 0.0) & (t <= 1.0)
-        coef = weights[:, None] * np.asarray(self.k_obstacle)[None, :-1] * active  # (J, k-1)
+        obstacles = self.obstacles
+        if not len(obstacles):
+            return Term(0.0, np.zeros(state.n))
+        near = proximity(state, obstacles)
+        t = near.link_t
+        excess = near.link_distance**2 - obstacles.radii[:, None] ** 2  # (J, k-1)
+        active = (excess < 0.0) & (t > 0.0) & (t < 1.0)
+        if not active.any():
+            return Term(0.0, np.zeros(state.n))
+        coef = obstacles.weights[:, None] * np.asarray(self.k_obstacle)[None, :-1] * active
         value = 0.5 * float(np.sum(coef * excess))
         # ∂³w/∂Q = −Σ w k̂ (S − p̄)ᵀ ((1−t) ∂p_i + t ∂p_{i+1}); the ∂t term vanishes (r ⟂ link)
-        a = coef[..., None] * r  # (J, k-1, 2)
+        a = coef[..., None] * near.link_offsets  # (J, k-1, 2)
         per_point = np.zeros((self.n_points, 2))
-        per_point[:-1] += np.einsum("jic,ji->ic", a, 1.0 - t)
-        per_point[1:] += np.einsum("jic,ji->ic", a, t)
+        per_point[:-1] += (a * (1.0 - t)[..., None]).sum(axis=0)
+        per_point[1:] += (a * t[..., None]).sum(axis=0)
         grad = -np.einsum("kc,kcn->n", per_point, state.point_jacobians[:, :2, :])
         return Term(value, grad)
 

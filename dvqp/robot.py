@@ -87,6 +87,11 @@ class Robot:
         self.data = model.createData()
 
     @property
+    def frame_names(self) -> tuple[str, ...]:
+        """Names of the body-point frames then the tool frame."""
+        return (*self.point_frames, self.tool_frame)
+
+    @property
     def n(self) -> int:
         """Number of joints."""
         return int(self.model.nq)

@@ -7,6 +7,7 @@ toward a DV reference: ``ẋ = ẋ_d + K·(x_d − x)`` with l and α difference
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -17,7 +18,7 @@ from dvqp import _validate
 from dvqp.developed_view import wrap, wrap_angle
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.objective import Objective
-from dvqp.obstacles import offsets, segment_offsets, stack
+from dvqp.proximity import proximity
 from dvqp.resolver import Resolver
 from dvqp.robot import Robot
 from dvqp.state import KinematicState
@@ -63,18 +64,11 @@ def dv_error(
 
 
 def min_clearance(state: KinematicState, objective: Objective) -> float:
-    """Smallest signed clearance (m) of any body point or link to any obstacle circle.
+    """Smallest signed clearance (m) of any body point or link to the objective's obstacles.
 
     Negative inside an obstacle; ``inf`` with no obstacles.
     """
-    centers, radii, _ = stack(objective.obstacles)
-    if centers.shape[0] == 0:
-        return float("inf")
-    lz = state.points[:, :2]
-    dp = np.linalg.norm(offsets(lz, centers, state.radius), axis=-1) - radii[:, None]
-    _, r = segment_offsets(lz, centers, state.radius, clamp=True)
-    dl = np.linalg.norm(r, axis=-1) - radii[:, None]
-    return float(min(dp.min(), dl.min()))
+    return proximity(state, objective.obstacles).min_clearance()  # type: ignore[arg-type]
 
 
 def simulate(
@@ -138,22 +132,26 @@ def simulate(
     w = np.empty(n_steps + 1)
     clearance = np.empty(n_steps + 1)
     times = np.zeros(n_steps)
+    step_times = np.zeros(n_steps)
     errors = np.zeros(n_steps)
     iterations = np.full(n_steps, -1, dtype=np.int64)
     ok = np.zeros(n_steps, dtype=bool)
     status: list[str] = []
     for i in range(n_steps + 1):
+        started = time.perf_counter()
         state = KinematicState.compute(robot, q, radius)
         term = objective.evaluate(state)
+        if i < n_steps:
+            xdot = cmd[i]
+            if ref is not None and gain > 0.0:
+                xdot = xdot + gain * dv_error(ref[i], state.tool, radius)
+            result = resolver.resolve(state, objective.gain * term.gradient, xdot, step)
+            step_times[i] = time.perf_counter() - started
         qs[i], tool[i], points[i] = q, state.tool, state.points
         w[i] = term.value
         clearance[i] = min_clearance(state, objective)
         if i == n_steps:
             break
-        xdot = cmd[i]
-        if ref is not None and gain > 0.0:
-            xdot = xdot + gain * dv_error(ref[i], state.tool, radius)
-        result = resolver.resolve(state, objective.gain * term.gradient, xdot, step)
         times[i], errors[i], ok[i] = result.solve_time, result.task_error, result.success
         iterations[i] = -1 if result.iterations is None else result.iterations
         status.append(result.status)
@@ -172,6 +170,7 @@ def simulate(
         w=w,
         min_clearance=clearance,
         solve_time=times,
+        step_time=step_times,
         task_error=errors,
         iterations=iterations,
         success=ok,

@@ -7,7 +7,8 @@ for the body points and the tool, maps them to the developed view, and freezes t
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -15,6 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
 from dvqp import developed_view as dv
+from dvqp.errors import SingularConfigurationError
 from dvqp.robot import Robot
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -42,6 +44,8 @@ class KinematicState:
         Tool DV coordinates ``[l, z, h, α]`` (m, m, m, rad).
     tool_jacobian : ndarray, shape (4, n)
         The DV task Jacobian ``J̄(Q)``.
+    cache : dict
+        Quantities derived from this state once and shared (e.g. :func:`dvqp.proximity.proximity`).
     """
 
     q: NDArray[np.float64]
@@ -52,6 +56,7 @@ class KinematicState:
     point_jacobians: NDArray[np.float64]
     tool: NDArray[np.float64]
     tool_jacobian: NDArray[np.float64]
+    cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def n(self) -> int:
@@ -83,32 +88,51 @@ class KinematicState:
         pin.computeJointJacobians(model, data, qv)
         pin.updateFramePlacements(model, data)
         ids = robot.frame_ids
-        m = len(ids)
-        origins = np.empty((m, 3))
-        axes = np.empty((m, 3))
-        jac = np.empty((m, 6, qv.shape[0]))
-        for i, fid in enumerate(ids):
-            placement = data.oMf[fid]
-            origins[i] = placement.translation
-            axes[i] = placement.rotation[:, 2]
-            jac[i] = pin.getFrameJacobian(model, data, fid, _LWA)
-        pos = dv.position(origins, radius)
-        dpos = dv.position_jacobian(origins, radius)
-        lin = dpos @ jac[:, :3, :]  # (m, 3, n)
-        tool_o, tool_z = origins[-1], axes[-1]
-        # ż = ω × z = −S(z)·ω: heading row is ∂α/∂O·Jv + ∂α/∂z·(−S(z)·Jω)
-        dalpha = dv.heading_gradient(tool_o, tool_z)
-        heading_row = dalpha[:3] @ jac[-1, :3] - dalpha[3:] @ dv.skew(tool_z) @ jac[-1, 3:]
-        tool = np.append(pos[-1], dv.heading(tool_o, tool_z))
-        tool_jac = np.vstack([lin[-1], heading_row[None, :]])
+        frames = np.array([data.oMf[i].homogeneous for i in ids])  # (m, 4, 4)
+        jac = np.array([pin.getFrameJacobian(model, data, i, _LWA) for i in ids])  # (m, 6, n)
+        origins = frames[:, :3, 3]
+        axes = frames[:, :3, 2]
+        x, y = origins[:, 0], origins[:, 1]
+        rho2 = x * x + y * y
+        rho = np.sqrt(rho2)
+        if not (rho >= dv.RHO_MIN).all():
+            i = int(np.argmin(rho))
+            raise SingularConfigurationError(
+                f"frame {robot.frame_names[i]!r} lies on the pipe axis (rho = {rho[i]:.3g} m)"
+            )
+        r = float(radius)
+        m, n = jac.shape[0], jac.shape[2]
+        pos = np.empty((m, 3))
+        pos[:, 0] = r * np.arctan2(y, x)
+        pos[:, 1] = origins[:, 2]
+        pos[:, 2] = rho - r
+        # Rows of ∂[l, z, h]/∂O · Jv, combined without forming the 3×3 blocks.
+        jx, jy = jac[:, 0, :], jac[:, 1, :]
+        lin = np.empty((m, 3, n))
+        lin[:, 0] = (r / rho2)[:, None] * (x[:, None] * jy - y[:, None] * jx)
+        lin[:, 1] = jac[:, 2, :]
+        lin[:, 2] = (x / rho)[:, None] * jx + (y / rho)[:, None] * jy
+        # Heading row: ∂α/∂O·Jv + ∂α/∂z·(−S(z)·Jω) = ∂α/∂O·Jv + (z × ∂α/∂z)·Jω  (ż = ω × z)
+        ox, oy, _ = origins[-1].tolist()
+        zx, zy, zz = axes[-1].tolist()
+        alpha, (dox, doy, dzx, dzy, dzz) = dv.heading_terms(ox, oy, zx, zy, zz)
+        weights = np.array(
+            [dox, doy, 0.0, zy * dzz - zz * dzy, zz * dzx - zx * dzz, zx * dzy - zy * dzx]
+        )
+        tool = np.empty(4)
+        tool[:3] = pos[-1]
+        tool[3] = alpha
+        tool_jac = np.empty((4, n))
+        tool_jac[:3] = lin[-1]
+        tool_jac[3] = weights @ jac[-1]
         ro = _validate.readonly
         return cls(
             q=ro(qv),
             radius=float(radius),
             origins=ro(origins),
             axes=ro(axes),
-            points=ro(pos[:-1].copy()),
-            point_jacobians=ro(lin[:-1].copy()),
+            points=ro(pos[:-1]),
+            point_jacobians=ro(lin[:-1]),
             tool=ro(tool),
             tool_jacobian=ro(tool_jac),
         )

@@ -23,6 +23,7 @@ ARRAYS = (
     "w",
     "min_clearance",
     "solve_time",
+    "step_time",
     "task_error",
     "iterations",
     "success",
@@ -51,7 +52,9 @@ class Trajectory:
     min_clearance : ndarray, shape (N+1,)
         Smallest clearance of body points and links to the obstacles, m (inf: no obstacle).
     solve_time : ndarray, shape (N,)
-        Resolver time per step, s.
+        Resolver time per step (QP assembly + solve + check, or the pseudoinverse), s.
+    step_time : ndarray, shape (N,)
+        Full step time: kinematics + objective + resolver, s.
     task_error : ndarray, shape (N,)
         ``‖J̄Q̇ − ẋ‖∞`` per step.
     iterations : ndarray of int, shape (N,)
@@ -66,6 +69,9 @@ class Trajectory:
         m.
     scene_text : str
         The scene file's text, if the run came from one.
+    tracking_error : ndarray, shape (N+1, 4) or (0, 4)
+        ``x_d − x`` of the tool per sample (m, m, m, rad; l and α wrapped) against the planned
+        reference (a path, or the integrated JOG commands); empty if there was none.
     """
 
     t: NDArray[np.float64]
@@ -76,6 +82,7 @@ class Trajectory:
     w: NDArray[np.float64]
     min_clearance: NDArray[np.float64]
     solve_time: NDArray[np.float64]
+    step_time: NDArray[np.float64]
     task_error: NDArray[np.float64]
     iterations: NDArray[np.int64]
     success: NDArray[np.bool_]
@@ -83,6 +90,7 @@ class Trajectory:
     backend: str = ""
     pipe_radius: float = 0.0
     scene_text: str = field(default="", repr=False)
+    tracking_error: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 4)))
 
     @classmethod
     def from_samples(
@@ -97,6 +105,7 @@ class Trajectory:
         w: NDArray[np.float64],
         min_clearance: NDArray[np.float64],
         solve_time: NDArray[np.float64],
+        step_time: NDArray[np.float64],
         task_error: NDArray[np.float64],
         iterations: NDArray[np.int64],
         success: NDArray[np.bool_],
@@ -119,6 +128,7 @@ class Trajectory:
             w=w,
             min_clearance=min_clearance,
             solve_time=solve_time,
+            step_time=step_time,
             task_error=task_error,
             iterations=iterations,
             success=success,
@@ -138,7 +148,10 @@ class Trajectory:
         return bool(np.all(self.success))
 
     def save(self, path: str | Path) -> Path:
-        """Write ``.npz`` (all arrays, metadata, scene text) or ``.csv`` (t, q, dv) atomically.
+        """Write ``.npz`` (all arrays, metadata, scene text) or ``.csv`` atomically.
+
+        The CSV has the columns ``t, q1..qn, l, z, h, alpha`` and, if the trajectory has a
+        tracking error, ``e_l, e_z, e_h, e_alpha``.
 
         The file appears complete or not at all: it is written to a temporary file in the
         same folder and renamed.
@@ -162,6 +175,7 @@ class Trajectory:
                         backend=np.str_(self.backend),
                         pipe_radius=np.float64(self.pipe_radius),
                         scene=np.str_(self.scene_text),
+                        tracking_error=self.tracking_error,
                     )
                 else:
                     self._write_csv(fh)
@@ -174,7 +188,11 @@ class Trajectory:
     def _write_csv(self, fh: object) -> None:
         n = self.q.shape[1]
         header = ["t"] + [f"q{i + 1}" for i in range(n)] + ["l", "z", "h", "alpha"]
-        table = np.column_stack([self.t, self.q, self.dv])
+        columns = [self.t, self.q, self.dv]
+        if self.tracking_error.shape[0] == self.t.shape[0]:
+            header += ["e_l", "e_z", "e_h", "e_alpha"]
+            columns.append(self.tracking_error)
+        table = np.column_stack(columns)
         np.savetxt(fh, table, delimiter=",", header=",".join(header), comments="", fmt="%.10g")  # type: ignore[arg-type]
 
     @classmethod
@@ -188,6 +206,9 @@ class Trajectory:
                     backend=str(data["backend"]),
                     pipe_radius=float(data["pipe_radius"]),
                     scene_text=str(data["scene"]),
+                    tracking_error=(
+                        data["tracking_error"] if "tracking_error" in data else np.zeros((0, 4))
+                    ),
                 )
         except (OSError, KeyError, ValueError) as exc:
             raise DvqpError(f"{path}: not a dvqp trajectory ({exc})") from exc

@@ -1,0 +1,167 @@
+"""Shared machinery of the direct (stateful, warm-started) adapters.
+
+Not part of the public API: a backend only has to satisfy
+:class:`solvers.Backend`; this base class merely gives the four direct
+adapters the same setup / update / retry-cold policy.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Hashable
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from .exceptions import ProblemShapeError, SolverError
+from .problem import Problem
+from .protocol import Backend
+from .solution import Solution
+
+#: Exceptions that reveal a bug in an adapter rather than a failed solve.
+PROGRAMMING_ERRORS = (TypeError, AttributeError, NameError, ImportError, NotImplementedError)
+
+
+@dataclass
+class RawResult:
+    """What a solver returned, multipliers already in the package sign convention."""
+
+    x: np.ndarray | None
+    status: str
+    iterations: int | None = None
+    y: np.ndarray | None = None
+    z: np.ndarray | None = None
+    z_box: np.ndarray | None = None
+
+
+def check_initvals(problem: Problem, initvals: np.ndarray | None) -> np.ndarray | None:
+    """Return ``initvals`` as a float64 array of shape (n,), or None."""
+    if initvals is None:
+        return None
+    guess = np.array(initvals, dtype=np.float64)
+    if guess.shape != (problem.n,):
+        raise ProblemShapeError(f"initvals: expected shape ({problem.n},), got {guess.shape}")
+    return guess
+
+
+def solve_guarded(backend: Backend, problem: Problem, run: Callable[[], RawResult]) -> Solution:
+    """Call ``run()`` and check its result; a solver exception becomes a failed Solution.
+
+    Exceptions in :data:`PROGRAMMING_ERRORS` are adapter bugs and raise
+    :class:`SolverError` instead.
+    """
+    try:
+        raw = run()
+    except SolverError:
+        raise
+    except PROGRAMMING_ERRORS as exc:
+        raise SolverError(f"{backend.name}: adapter error: {type(exc).__name__}: {exc}") from exc
+    except Exception as exc:  # the solver library failed on this problem
+        return Solution.failure(
+            problem,
+            backend=backend.name,
+            tolerance=backend.tolerance,
+            status="exception",
+            message=f"{backend.name} raised {type(exc).__name__}: {exc}",
+        )
+    return Solution.checked(
+        problem,
+        raw.x,
+        backend=backend.name,
+        tolerance=backend.tolerance,
+        status=raw.status,
+        iterations=raw.iterations,
+        y=raw.y,
+        z=raw.z,
+        z_box=raw.z_box,
+    )
+
+
+class StatefulBackend:
+    """Set up once, then update data and warm-start while the structure holds.
+
+    Subclasses define ``name``, ``default_tolerance``, ``default_settings`` and
+    implement :meth:`_structure_of`, :meth:`_setup` (cold: build the solver
+    from scratch) and :meth:`_update` (warm: push new data into the existing
+    solver). If a warm answer fails :meth:`Solution.checked`, the problem is
+    solved once more cold and the solution is flagged ``retried``.
+    """
+
+    name: str
+    default_tolerance: ClassVar[float]
+    default_settings: ClassVar[dict[str, Any]]
+
+    def __init__(self, *, tolerance: float | None = None, **settings: Any) -> None:
+        unknown = sorted(set(settings) - self.known_settings())
+        if unknown:
+            raise SolverError(f"{self.name}: unknown settings {unknown}")
+        self.tolerance = self.default_tolerance if tolerance is None else float(tolerance)
+        self.settings: dict[str, Any] = {**self.default_settings, **settings}
+        self._structure: Hashable | None = None
+
+    @classmethod
+    def known_settings(cls) -> set[str]:
+        """Setting names the solver accepts (checked at construction)."""
+        return set(cls.default_settings)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(tolerance={self.tolerance:g})"
+
+    def reset(self) -> None:
+        """Forget the solver state; the next solve sets up from scratch."""
+        self._structure = None
+        self._release()
+
+    def solve(self, problem: Problem, initvals: np.ndarray | None = None) -> Solution:
+        """Solve ``problem``, warm-starting when its structure is unchanged.
+
+        Parameters
+        ----------
+        problem : Problem
+            The QP.
+        initvals : ndarray, shape (n,), optional
+            Primal guess, used where the solver supports it (otherwise the
+            previous solution is the warm start).
+
+        Returns
+        -------
+        Solution
+            ``retried`` is True when the warm answer was rejected and redone cold.
+        """
+        start = time.perf_counter()
+        guess = check_initvals(problem, initvals)
+        structure = self._structure_of(problem)
+        warm = structure == self._structure
+        solution = self._attempt(problem, guess, warm, structure)
+        if warm and not solution.found:
+            solution = self._attempt(problem, guess, False, structure)
+            solution.retried = True
+        if not solution.found:
+            self.reset()
+        solution.solve_time = time.perf_counter() - start
+        return solution
+
+    def _attempt(
+        self, problem: Problem, guess: np.ndarray | None, warm: bool, structure: Hashable
+    ) -> Solution:
+        if warm:
+            return solve_guarded(self, problem, lambda: self._update(problem, guess))
+        self._structure = None
+        self._release()
+        solution = solve_guarded(self, problem, lambda: self._setup(problem, guess))
+        self._structure = structure
+        return solution
+
+    def _structure_of(self, problem: Problem) -> Hashable:
+        """Key that must be equal between two problems for a data update."""
+        return (problem.n, problem.n_eq, problem.n_in, problem.has_bounds)
+
+    def _setup(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
+        raise NotImplementedError
+
+    def _update(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
+        raise NotImplementedError
+
+    def _release(self) -> None:
+        """Drop the solver object (called before a cold set-up and on reset)."""

@@ -1,0 +1,131 @@
+"""Backend names -> factories, built from whatever solver packages import here.
+
+Plain names are the best adapter for a solver: the direct stateful adapters
+for ``osqp``, ``clarabel``, ``daqp`` and ``proxqp``, the generic ``qpsolvers``
+path for every other solver ``qpsolvers`` finds (``quadprog``, ``piqp``,
+``highs``, ...). ``qpsolvers:NAME`` forces the generic path for any solver
+``qpsolvers`` has installed.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib
+from collections.abc import Callable
+from importlib import metadata
+from typing import Any
+
+from .exceptions import UnknownBackendError
+from .protocol import Backend
+
+QPSOLVERS_PREFIX = "qpsolvers:"
+
+#: Direct adapters: backend name -> (module, class name).
+DIRECT: dict[str, tuple[str, str]] = {
+    "clarabel": ("clarabel_", "ClarabelBackend"),
+    "daqp": ("daqp_", "DaqpBackend"),
+    "osqp": ("osqp_", "OsqpBackend"),
+    "proxqp": ("proxqp_", "ProxqpBackend"),
+}
+
+#: Distribution name of a solver when it differs from the solver name.
+DISTRIBUTIONS: dict[str, str] = {
+    "highs": "highspy",
+    "proxqp": "proxsuite",
+    "gurobi": "gurobipy",
+    "hpipm": "hpipm_python",
+    "jaxopt_osqp": "jaxopt",
+    "qpswift": "qpSWIFT",
+    "qpoases": "qpoases",
+}
+
+Factory = Callable[..., Backend]
+
+
+def _qpsolvers_names() -> list[str]:
+    try:
+        qpsolvers = importlib.import_module("qpsolvers")
+    except ImportError:
+        return []
+    return sorted(qpsolvers.available_solvers)
+
+
+def _generic(solver: str, name: str) -> Factory:
+    def factory(**options: Any) -> Backend:
+        from .qpsolvers_ import QpsolversBackend
+
+        return QpsolversBackend(solver, name=name, **options)
+
+    return factory
+
+
+@functools.cache
+def _factories() -> dict[str, Factory]:
+    factories: dict[str, Factory] = {}
+    for name, (module_name, class_name) in DIRECT.items():
+        try:
+            module = importlib.import_module(f".{module_name}", __package__)
+        except ImportError:
+            continue
+        factories[name] = getattr(module, class_name)
+    for solver in _qpsolvers_names():
+        factories.setdefault(solver, _generic(solver, solver))
+        factories[QPSOLVERS_PREFIX + solver] = _generic(solver, QPSOLVERS_PREFIX + solver)
+    return factories
+
+
+def available_backends() -> list[str]:
+    """Names :func:`make_backend` accepts here: plain names first, then ``qpsolvers:*``.
+
+    Returns
+    -------
+    list of str
+        Sorted, e.g. ``['clarabel', 'daqp', ..., 'qpsolvers:clarabel', ...]``.
+    """
+    names = list(_factories())
+    return sorted(names, key=lambda name: (name.startswith(QPSOLVERS_PREFIX), name))
+
+
+def make_backend(name: str, **options: Any) -> Backend:
+    """Create a fresh backend instance (no state shared with earlier instances).
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`available_backends`.
+    **options
+        ``tolerance=`` and solver settings, forwarded to the adapter.
+
+    Returns
+    -------
+    Backend
+        A new adapter.
+
+    Raises
+    ------
+    UnknownBackendError
+        If ``name`` is not installed; carries ``.name`` and ``.installed``.
+    """
+    factory = _factories().get(name)
+    if factory is None:
+        raise UnknownBackendError(name, available_backends())
+    return factory(**options)
+
+
+def backend_versions() -> dict[str, str]:
+    """Installed versions of ``qpsolvers`` and every solver package in use.
+
+    Returns
+    -------
+    dict of str to str
+        Distribution name -> version, e.g. ``{'osqp': '1.1.3', ...}``.
+    """
+    solvers = {name.removeprefix(QPSOLVERS_PREFIX) for name in _factories()}
+    distributions = {"qpsolvers", *(DISTRIBUTIONS.get(s, s) for s in solvers)}
+    versions: dict[str, str] = {}
+    for dist in sorted(distributions):
+        try:
+            versions[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            continue
+    return versions

@@ -1,0 +1,161 @@
+r"""KKT residuals of a candidate QP solution, computed from the problem data only.
+
+Multiplier sign convention (the one of ``qpsolvers``), used by every backend:
+
+.. math::
+
+    P x + q + A^T y + G^T z + z_{box} = 0, \qquad z \ge 0,
+
+with ``z_box[i] <= 0`` when the lower bound of ``x[i]`` is active and
+``z_box[i] >= 0`` when its upper bound is active.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from .exceptions import ProblemShapeError
+from .problem import Problem
+
+
+@dataclass(frozen=True)
+class Residuals:
+    """Violation of each optimality condition, all in the infinity norm.
+
+    Attributes
+    ----------
+    equality : float
+        ``max |A x - b|`` (0 without equalities).
+    inequality : float
+        ``max(G x - h, 0)`` (0 without inequalities).
+    bounds : float
+        ``max(lb - x, x - ub, 0)`` (0 without bounds).
+    stationarity : float or None
+        ``||P x + q + A^T y + G^T z + z_box||_inf``; None when a needed
+        multiplier is missing.
+    complementarity : float or None
+        Largest ``|multiplier| * slack`` over inequality and bound rows, or
+        wrong-signed multiplier ``max(-z, 0)``; a non-zero multiplier on a row
+        with infinite slack counts as its own size. None without multipliers.
+    """
+
+    equality: float
+    inequality: float
+    bounds: float
+    stationarity: float | None = None
+    complementarity: float | None = None
+
+    @property
+    def max_primal(self) -> float:
+        """Largest primal violation (equality, inequality or bounds)."""
+        return max(self.equality, self.inequality, self.bounds)
+
+
+def _multiplier(name: str, value: npt.ArrayLike | None, size: int) -> np.ndarray | None:
+    if value is None:
+        return None
+    array = np.asarray(value, dtype=np.float64)
+    if array.shape != (size,):
+        raise ProblemShapeError(f"{name}: expected shape ({size},), got {array.shape}")
+    return array
+
+
+def _slack_product(multiplier: np.ndarray, slack: np.ndarray, finite: bool) -> float:
+    """Largest ``max(m, 0) * |slack|``; an infinite slack counts as 1."""
+    if not multiplier.size:
+        return 0.0
+    if not finite:
+        slack = np.where(np.isfinite(slack), slack, 1.0)
+    return float((np.maximum(multiplier, 0.0) * np.abs(slack)).max())
+
+
+def kkt_residuals(
+    problem: Problem,
+    x: np.ndarray,
+    y: npt.ArrayLike | None = None,
+    z: npt.ArrayLike | None = None,
+    z_box: npt.ArrayLike | None = None,
+) -> tuple[Residuals, float]:
+    """:func:`residuals` plus the gradient scale ``max(||P x||_inf, ||q||_inf)``."""
+    p = problem
+    h_finite, lb_finite, ub_finite = p._finite
+    equality = inequality = bounds = 0.0
+    if p.A is not None and p.b is not None:
+        equality = float(np.abs(p.A @ x - p.b).max())
+    slack_in = p.h - p.G @ x if p.G is not None and p.h is not None else None
+    if slack_in is not None:
+        inequality = max(0.0, -float(slack_in.min()))
+    if p.lb is not None:
+        bounds = max(bounds, float((p.lb - x).max()))
+    if p.ub is not None:
+        bounds = max(bounds, float((x - p.ub).max()))
+    Px = p.P @ x
+    scale = max(float(np.abs(Px).max()), float(np.abs(p.q).max())) if p.n else 0.0
+
+    y = _multiplier("y", y, p.n_eq) if p.n_eq else None
+    z = _multiplier("z", z, p.n_in) if p.n_in else None
+    z_box = _multiplier("z_box", z_box, p.n) if p.has_bounds else None
+    if (p.n_eq and y is None) or (p.n_in and z is None) or (p.has_bounds and z_box is None):
+        return Residuals(equality, inequality, bounds), scale
+
+    gradient = Px + p.q
+    complementarity = 0.0
+    if p.A is not None and y is not None:
+        gradient += y @ p.A
+    if p.G is not None and z is not None and slack_in is not None:
+        gradient += z @ p.G
+        complementarity = max(-float(z.min()), _slack_product(z, slack_in, h_finite))
+    if z_box is not None:
+        gradient += z_box
+        if p.ub is not None:
+            complementarity = max(complementarity, _slack_product(z_box, p.ub - x, ub_finite))
+        else:
+            complementarity = max(complementarity, float(z_box.max()))
+        if p.lb is not None:
+            complementarity = max(complementarity, _slack_product(-z_box, x - p.lb, lb_finite))
+        else:
+            complementarity = max(complementarity, -float(z_box.min()))
+    stationarity = float(np.abs(gradient).max()) if p.n else 0.0
+    return Residuals(equality, inequality, bounds, stationarity, max(complementarity, 0.0)), scale
+
+
+def residuals(
+    problem: Problem,
+    x: npt.ArrayLike,
+    y: npt.ArrayLike | None = None,
+    z: npt.ArrayLike | None = None,
+    z_box: npt.ArrayLike | None = None,
+) -> Residuals:
+    """Compute the KKT residuals of ``x`` (and multipliers) for ``problem``.
+
+    Parameters
+    ----------
+    problem : Problem
+        The QP the candidate solves.
+    x : ndarray, shape (n,)
+        Primal candidate.
+    y : ndarray, shape (m,), optional
+        Equality multipliers; needed for stationarity when ``m > 0``.
+    z : ndarray, shape (p,), optional
+        Inequality multipliers; needed for stationarity when ``p > 0``.
+    z_box : ndarray, shape (n,), optional
+        Bound multipliers; needed for stationarity when bounds are given.
+
+    Returns
+    -------
+    Residuals
+        Primal residuals always; ``stationarity`` and ``complementarity`` only
+        when every multiplier the problem needs is given.
+
+    Raises
+    ------
+    ProblemShapeError
+        If ``x`` or a needed multiplier has the wrong shape.
+    """
+    point = np.asarray(x, dtype=np.float64)
+    if point.shape != (problem.n,):
+        raise ProblemShapeError(f"x: expected shape ({problem.n},), got {point.shape}")
+    return kkt_residuals(problem, point, y, z, z_box)[0]

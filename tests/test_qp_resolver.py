@@ -1,0 +1,148 @@
+import numpy as np
+import pytest
+
+import solvers
+from dvqp import JogSegment, KinematicState, Obstacle, PseudoinverseResolver, Robot, jog_commands
+from dvqp import simulate as run
+from dvqp.errors import BackendError
+from dvqp.limits import DamperParameters
+from dvqp.pinv import weighted_pinv_step
+from dvqp.qp_resolver import QPResolver
+from dvqp.qp_step import StepConfig
+from tests.common import LINK_LENGTHS, PIPE_RADIUS, objective_with, random_configurations
+
+DT = 0.005
+
+# Accuracy on Q̇ (rad/s) each backend reaches on the step QP with its dvqp settings.
+AGREEMENT_TOLERANCE = {
+    "daqp": 1e-9,
+    "quadprog": 1e-9,
+    "proxqp": 1e-6,
+    "osqp": 1e-6,
+    "clarabel": 1e-6,
+    "piqp": 1e-6,
+    "highs": 1e-5,
+}
+BACKENDS = [
+    name
+    for name in solvers.available_backends()
+    if name.removeprefix("qpsolvers:") in AGREEMENT_TOLERANCE
+]
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("weighted", [False, True])
+def test_qp_equals_the_pseudoinverse_step_when_no_inequality_is_active(
+    robot: Robot, backend: str, weighted: bool
+) -> None:
+    rng = np.random.default_rng(17)
+    weights = rng.uniform(0.5, 3.0, 13) if weighted else np.ones(13)
+    # Loose limits, no obstacle, a floor far below: nothing is active.
+    config = StepConfig(robot, (), DamperParameters(min_height=-1.0), weights=weights)
+    resolver = QPResolver(config, backend)
+    tol = AGREEMENT_TOLERANCE[backend.removeprefix("qpsolvers:")]
+    for q in random_configurations(5, seed=23, spread=0.3):
+        state = KinematicState.compute(robot, q, PIPE_RADIUS)
+        g, xdot = 0.1 * rng.normal(size=13), 0.02 * rng.normal(size=4)
+        step = resolver.resolve(state, g, xdot, DT)
+        assert step.success and step.status == "optimal", step.status
+        expected = weighted_pinv_step(state.tool_jacobian, xdot, g, 1.0 / weights)
+        np.testing.assert_allclose(step.qdot, expected, atol=tol, rtol=0)
+
+
+def limited_robot() -> Robot:
+    lim = np.r_[np.inf, np.full(12, 1.2)]
+    return Robot.ndt13(LINK_LENGTHS, q_min=-lim, q_max=lim, qd_max=1.0)
+
+
+def clearance_history(traj, obstacles) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """Clearance of every point to every obstacle along the run, shape (N+1, J, k)."""
+    centers = np.array([o.center for o in obstacles])
+    radii = np.array([o.radius for o in obstacles])
+    d = traj.points[:, None, :, :2] - centers[None, :, None, :]
+    return np.linalg.norm(d, axis=-1) - radii[None, :, None]
+
+
+def test_limits_hold_along_a_jog_that_breaks_them_with_the_pseudoinverse(q0: np.ndarray) -> None:
+    robot = limited_robot()
+    obstacles = [
+        Obstacle(np.array([0.19, 0.43]), 0.04, 10.0),
+        Obstacle(np.array([0.08, 0.30]), 0.03, 10.0),
+    ]
+    objective = objective_with(obstacles)
+    params = DamperParameters(min_height=0.06, margin=0.005, influence=0.05, gain=0.5)
+    config = StepConfig(robot, objective.obstacles, params)
+    cmd = jog_commands(
+        [
+            JogSegment(1.0, np.array([0.0, 0.06, 0, 0])),
+            JogSegment(1.0, np.array([0.06, 0.0, -0.02, 0.3])),
+        ],
+        DT,
+    )
+    runs = {
+        name: run(robot, PIPE_RADIUS, objective, resolver, q0, cmd, DT)
+        for name, resolver in (
+            ("pinv", PseudoinverseResolver()),
+            ("qp", QPResolver(config, "daqp")),
+        )
+    }
+    qp, pinv = runs["qp"], runs["pinv"]
+    assert qp.ok and qp.task_error.max() < 1e-9
+    assert np.all(qp.q <= robot.q_max + 1e-9) and np.all(qp.q >= robot.q_min - 1e-9)
+    assert np.all(np.abs(qp.qdot) <= robot.qd_max + 1e-9)
+    # Height and clearance are linearised one step ahead: allow second-order overshoot only.
+    assert qp.points[:, :, 2].min() >= 0.06 - 1e-4
+    assert qp.min_clearance.min() > 0.0
+    start_outside = clearance_history(qp, obstacles)[0] > 0
+    assert np.all(clearance_history(qp, obstacles)[:, start_outside] > 0)
+    # The baseline, same commands: it enters an obstacle.
+    assert pinv.min_clearance.min() < -0.01
+
+
+@pytest.mark.parametrize(
+    "backend", [b for b in ("daqp", "osqp", "clarabel", "proxqp") if b in BACKENDS]
+)
+def test_an_infeasible_command_is_relaxed_with_a_reported_task_error(
+    q0: np.ndarray, backend: str
+) -> None:
+    robot = limited_robot()
+    config = StepConfig(robot, (), DamperParameters(min_height=0.0))
+    cmd = jog_commands([JogSegment(0.1, np.array([2.0, 0.0, 0.0, 0.0]))], DT)  # 2 m/s: too fast
+    traj = run(robot, PIPE_RADIUS, objective_with([]), QPResolver(config, backend), q0, cmd, DT)
+    assert traj.ok and set(traj.status) == {"relaxed"}
+    assert traj.task_error.min() > 0.1
+    assert np.all(np.abs(traj.qdot) <= robot.qd_max + 1e-9)
+
+
+class CorruptingBackend:
+    """Wraps a real backend and shifts its answer: the residual check must catch it."""
+
+    def __init__(self) -> None:
+        self._inner = solvers.make_backend("daqp")
+        self.name, self.tolerance = "corrupt", self._inner.tolerance
+
+    def solve(
+        self, problem: solvers.Problem, initvals: np.ndarray | None = None
+    ) -> solvers.Solution:
+        good = self._inner.solve(problem, initvals)
+        x = None if good.x is None else good.x + 1e-3
+        return solvers.Solution.checked(
+            problem, x, status="solved", backend=self.name, tolerance=self.tolerance
+        )
+
+    def reset(self) -> None:
+        self._inner.reset()
+
+
+def test_a_wrong_answer_reported_as_solved_fails_the_step(
+    state0: KinematicState, robot: Robot
+) -> None:
+    resolver = QPResolver(StepConfig(robot), CorruptingBackend)
+    step = resolver.resolve(state0, np.zeros(13), np.array([0.01, 0, 0, 0]), DT)
+    assert not step.success and step.status.startswith("failed")
+    assert np.all(step.qdot == 0.0)
+
+
+def test_unknown_backend_lists_the_installed_ones(robot: Robot) -> None:
+    with pytest.raises(BackendError, match=r"installed: .*daqp"):
+        QPResolver(StepConfig(robot), "nosuchsolver")
