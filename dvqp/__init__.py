@@ -6,7 +6,8 @@ The pieces, in the order a step uses them:
 - :class:`KinematicState` — one kinematics update per step, in Cartesian and DV coordinates;
 - :class:`Objective` — the paper's ``w(Q)`` with its gradient, :class:`Obstacle` circles;
 - resolvers — :class:`PseudoinverseResolver` (paper eq. 18) and the per-step QP;
-- :func:`simulate` — JOG / path integration into a :class:`Trajectory`.
+- :func:`simulate` — JOG / path integration into a :class:`Trajectory`;
+- :func:`load_scene` and :func:`plan` — a scene file run with a named backend.
 """
 
 from dvqp.errors import (
@@ -21,8 +22,10 @@ from dvqp.errors import (
 from dvqp.objective import Objective, Term
 from dvqp.obstacles import Obstacle
 from dvqp.pinv import PseudoinverseResolver
+from dvqp.planning import plan
 from dvqp.resolver import Resolver, Step
 from dvqp.robot import Robot
+from dvqp.scene import Scene, load_scene
 from dvqp.simulate import JogSegment, jog_commands, simulate
 from dvqp.state import KinematicState
 from dvqp.trajectory import Trajectory
@@ -40,6 +43,7 @@ __all__ = [
     "PseudoinverseResolver",
     "Resolver",
     "Robot",
+    "Scene",
     "SceneError",
     "ShapeError",
     "SingularConfigurationError",
@@ -49,5 +53,7 @@ __all__ = [
     "UnreachableTargetError",
     "__version__",
     "jog_commands",
+    "load_scene",
+    "plan",
     "simulate",
 ]

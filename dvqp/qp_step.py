@@ -73,6 +73,15 @@ class StepConfig:
             object.__setattr__(self, "obstacles", ObstacleSet(self.obstacles))
         object.__setattr__(self, "task_weight", _validate.positive("task_weight", self.task_weight))
 
+    @property
+    def hessian(self) -> NDArray[np.float64]:
+        """``W = diag(weights)``, shape (n, n), built once."""
+        cached = self.__dict__.get("_hessian")
+        if cached is None:
+            cached = _validate.readonly(np.diag(np.asarray(self.weights)))
+            object.__setattr__(self, "_hessian", cached)
+        return cached  # type: ignore[no-any-return]
+
     def inequalities(self, state: KinematicState, dt: float) -> Constraint:
         """Obstacle dampers then surface-height rows at this state."""
         dampers = obstacle_dampers(state, self.obstacles, self.dampers, dt)  # type: ignore[arg-type]
@@ -92,15 +101,20 @@ class StepProblem:
     ----------
     problem : solvers.Problem
         The QP handed to a backend.
-    labels : tuple of str
-        One label per inequality row of ``problem.G``.
+    inequalities : Constraint
+        The rows of ``problem.G`` over ``Q̇`` (their labels say what each holds).
     relaxed : bool
         The task carries a slack (the last 4 variables).
     """
 
     problem: Problem
-    labels: tuple[str, ...]
+    inequalities: Constraint
     relaxed: bool
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """One label per inequality row, e.g. ``"link2/obstacle1"``."""
+        return self.inequalities.labels
 
 
 def build_step_qp(
@@ -133,17 +147,16 @@ def build_step_qp(
     m = jac.shape[0]
     ineq = config.inequalities(state, dt)
     box = config.bounds(state, dt)
-    weights = np.asarray(config.weights)
     if not relax_task:
         problem = Problem(
-            P=np.diag(weights), q=-gradient, A=jac, b=xdot,
+            P=config.hessian, q=-gradient, A=jac, b=xdot,
             G=ineq.G if ineq.rows else None, h=ineq.h if ineq.rows else None,
             lb=box.lb, ub=box.ub,
         )  # fmt: skip
-        return StepProblem(problem, ineq.labels, relaxed=False)
+        return StepProblem(problem, ineq, relaxed=False)
     inf = np.full(m, np.inf)
     problem = Problem(
-        P=np.diag(np.concatenate([weights, np.full(m, config.task_weight)])),
+        P=np.diag(np.concatenate([config.weights, np.full(m, config.task_weight)])),
         q=np.concatenate([-gradient, np.zeros(m)]),
         A=np.hstack([jac, -np.eye(m)]),
         b=xdot,
@@ -152,4 +165,4 @@ def build_step_qp(
         lb=np.concatenate([box.lb, -inf]),
         ub=np.concatenate([box.ub, inf]),
     )
-    return StepProblem(problem, ineq.labels, relaxed=True)
+    return StepProblem(problem, ineq, relaxed=True)

@@ -1,0 +1,170 @@
+"""Typed readers of parsed TOML tables for :mod:`dvqp.scene` (private).
+
+Every reader takes the table, the key and the dotted path of the table (``"robot"``,
+``"obstacles[1]"``) and raises :class:`~dvqp.errors.SceneError` naming the full field on a
+missing, mistyped or unknown entry.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
+from typing import Any, NoReturn
+
+import numpy as np
+from numpy.typing import NDArray
+
+from dvqp.errors import ParameterError, SceneError, ShapeError
+
+REQUIRED: Any = object()
+"""Sentinel default: the field must be present."""
+
+
+def join(prefix: str, key: str | int) -> str:
+    """The dotted path of ``key`` in the table at ``prefix`` (``"a.b"``, ``"a[0]"``)."""
+    if isinstance(key, int):
+        return f"{prefix}[{key}]"
+    return f"{prefix}.{key}" if prefix else key
+
+
+def kind(value: object) -> str:
+    """The TOML type of a parsed value, with an article (``"a string"``)."""
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, (int, float)):
+        return "a number"
+    if isinstance(value, str):
+        return "a string"
+    if isinstance(value, list):
+        return "an array"
+    if isinstance(value, dict):
+        return "a table"
+    return "a date/time"
+
+
+def is_number(value: object) -> bool:
+    """True for TOML integers and floats (not booleans)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+class Fields:
+    """Readers bound to one scene source (the file name used in every message).
+
+    Parameters
+    ----------
+    source
+        The file name, or ``"<string>"``.
+    """
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, field: str, reason: str) -> NoReturn:
+        """Raise ``SceneError(source, field, reason)``."""
+        raise SceneError(self.source, field, reason)
+
+    @contextmanager
+    def mapped(self, prefix: str) -> Iterator[None]:
+        """Re-raise constructor errors (ShapeError, ParameterError) as SceneError at prefix."""
+        try:
+            yield
+        except ShapeError as exc:
+            expected = "×".join("n" if e < 0 else str(e) for e in exc.expected)
+            self.fail(join(prefix, exc.name), f"expected shape ({expected}), got {exc.actual}")
+        except ParameterError as exc:
+            self.fail(join(prefix, exc.name), exc.reason)
+
+    def check_keys(self, table: dict[str, Any], prefix: str, allowed: Iterable[str]) -> None:
+        """Reject keys of ``table`` not in ``allowed`` (typos), suggesting the closest one."""
+        names = list(allowed)
+        for key in table:
+            if key not in names:
+                close = difflib.get_close_matches(key, names, n=1)
+                hint = f"did you mean {close[0]!r}?" if close else "allowed: " + ", ".join(names)
+                self.fail(join(prefix, key), f"unknown key ({hint})")
+
+    def get(self, table: dict[str, Any], key: str, prefix: str, default: Any = REQUIRED) -> Any:
+        """The raw value, the default, or a 'required field is missing' error."""
+        if key in table:
+            return table[key]
+        if default is REQUIRED:
+            self.fail(join(prefix, key), "required field is missing")
+        return default
+
+    def table(
+        self, parent: dict[str, Any], key: str, prefix: str, allowed: Iterable[str], *,
+        required: bool = True,
+    ) -> dict[str, Any]:  # fmt: skip
+        """A sub-table with only ``allowed`` keys (``{}`` if optional and absent)."""
+        value = self.get(parent, key, prefix, REQUIRED if required else {})
+        if not isinstance(value, dict):
+            self.fail(join(prefix, key), f"expected a table, got {kind(value)}")
+        self.check_keys(value, join(prefix, key), allowed)
+        return value
+
+    def tables(
+        self, parent: dict[str, Any], key: str, prefix: str, allowed: Iterable[str]
+    ) -> list[dict[str, Any]]:
+        """An array of tables (``[[key]]``), each with only ``allowed`` keys; ``[]`` if absent."""
+        value = self.get(parent, key, prefix, [])
+        field = join(prefix, key)
+        if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+            self.fail(field, f"expected an array of tables ([[{field}]]), got {kind(value)}")
+        names = list(allowed)
+        for i, item in enumerate(value):
+            self.check_keys(item, join(field, i), names)
+        return value
+
+    def number(
+        self, table: dict[str, Any], key: str, prefix: str, default: Any = REQUIRED
+    ) -> float:
+        """A finite number (int or float), m / s / rad as documented per field."""
+        value = self.get(table, key, prefix, default)
+        return self._finite(join(prefix, key), value)
+
+    def string(self, table: dict[str, Any], key: str, prefix: str, default: Any = REQUIRED) -> str:
+        """A string."""
+        value = self.get(table, key, prefix, default)
+        if not isinstance(value, str):
+            self.fail(join(prefix, key), f"expected a string, got {kind(value)}")
+        return value
+
+    def strings(self, table: dict[str, Any], key: str, prefix: str) -> list[str]:
+        """A non-empty array of strings."""
+        value = self.get(table, key, prefix)
+        if not isinstance(value, list) or not value or not all(isinstance(v, str) for v in value):
+            self.fail(join(prefix, key), f"expected an array of strings, got {kind(value)}")
+        return value
+
+    def vector(
+        self, table: dict[str, Any], key: str, prefix: str, n: int, *,
+        scalar: bool = False, default: Any = REQUIRED, infinite: bool = False,
+    ) -> NDArray[np.float64]:  # fmt: skip
+        """``n`` numbers (or one number broadcast to ``n`` if ``scalar``), shape (n,).
+
+        They must be finite unless ``infinite`` (then ``±inf`` pass, ``nan`` does not).
+        """
+        value = self.get(table, key, prefix, default)
+        return self.vector_value(join(prefix, key), value, n, scalar=scalar, infinite=infinite)
+
+    def vector_value(
+        self, field: str, value: Any, n: int, *, scalar: bool = False, infinite: bool = False
+    ) -> NDArray[np.float64]:
+        """Check an already fetched value as in :meth:`vector`."""
+        if scalar and is_number(value):
+            return np.full(n, self._finite(field, value, infinite))
+        want = f"a number or an array of {n} numbers" if scalar else f"an array of {n} numbers"
+        if not isinstance(value, list):
+            self.fail(field, f"expected {want}, got {kind(value)}")
+        if len(value) != n:
+            self.fail(field, f"expected {want}, got {len(value)} values")
+        return np.array([self._finite(join(field, i), v, infinite) for i, v in enumerate(value)])
+
+    def _finite(self, field: str, value: Any, infinite: bool = False) -> float:
+        if not is_number(value):
+            self.fail(field, f"expected a number, got {kind(value)}")
+        if math.isnan(value) or (not infinite and math.isinf(value)):
+            self.fail(field, f"must be finite, got {value!r}")
+        return float(value)

@@ -1,0 +1,169 @@
+"""Run scenes with several backends on the same commands and gather comparable figures.
+
+Each scene is loaded once per worker and run with every backend in turn, so the ratio of a
+backend's step time to ``pinv``'s compares runs made in the same process, one after the
+other. :func:`compare` runs scenes in parallel processes when ``jobs > 1`` (timings are then
+noisier: the processes share the machine).
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from typing import Any
+
+import numpy as np
+
+import solvers
+from dvqp.errors import DvqpError
+from dvqp.planning import PINV, failure, final_errors, plan
+from dvqp.scene import Scene, load_scene
+from dvqp.trajectory import Trajectory
+
+FIELDS = (
+    "scene", "file", "backend", "success", "steps", "failures", "median_step_us", "p95_step_us",
+    "ratio_to_pinv", "max_task_error", "min_clearance", "max_joint_limit_violation",
+    "max_velocity_limit_violation", "final_tracking_error", "error",
+)  # fmt: skip
+"""Keys of a result row, in table / CSV order."""
+
+Row = dict[str, Any]
+
+
+def _finite(value: float) -> float | None:
+    """``value`` as a float, or None if it is NaN or infinite (JSON has no NaN)."""
+    v = float(value)
+    return v if np.isfinite(v) else None
+
+
+def summarize(scene: Scene, traj: Trajectory) -> Row:
+    """The figures of one run.
+
+    Returns
+    -------
+    dict
+        ``steps``; ``failures`` (steps not succeeded); ``success`` (no failure and, for a
+        path, its end reached); median and 95th-percentile full step time (µs); the largest
+        task error ``‖J̄Q̇ − ẋ‖∞`` of the succeeded steps; the smallest obstacle clearance (m);
+        the largest joint-limit violation (rad) of ``q`` and velocity-limit violation
+        (rad/s) of ``Q̇``; the final tracking error (m, path mode); and ``final_tool``
+        ``[l, z, h, α]``; ``error``, why the run failed. Undefined figures are None.
+    """
+    robot = scene.robot
+    ok = traj.success
+    why = failure(scene, traj)
+    steps_us = traj.step_time * 1e6
+    q_out = np.maximum(robot.q_min - traj.q, traj.q - robot.q_max)
+    qd_out = np.abs(traj.qdot) - robot.qd_max
+    tracking = (
+        final_errors(traj)[0] if scene.path is not None and traj.tracking_error.size else None
+    )
+    return {
+        "scene": scene.name,
+        "file": scene.source,
+        "backend": traj.backend,
+        "success": why is None,
+        "steps": traj.n_steps,
+        "failures": int(np.sum(~ok)),
+        "median_step_us": _finite(np.median(steps_us)) if traj.n_steps else None,
+        "p95_step_us": _finite(np.percentile(steps_us, 95)) if traj.n_steps else None,
+        "ratio_to_pinv": None,
+        "max_task_error": _finite(np.max(traj.task_error[ok])) if np.any(ok) else None,
+        "min_clearance": _finite(np.min(traj.min_clearance)),
+        "max_joint_limit_violation": float(max(0.0, np.max(q_out))),
+        "max_velocity_limit_violation": float(max(0.0, np.max(qd_out, initial=0.0))),
+        "final_tracking_error": tracking,
+        "final_tool": [float(v) for v in traj.dv[-1]],
+        "error": None if why is None else str(why),
+    }
+
+
+def run_scene(
+    path: str, backends: Sequence[str], progress: Callable[[str], None] | None = None
+) -> list[Row]:
+    """Load a scene and run it with every backend; the rows in ``backends`` order.
+
+    A run that raises a :class:`~dvqp.errors.DvqpError` (a singular configuration, a solver
+    that gave up) gives a row with ``success`` False and the message in ``error``.
+    ``progress(backend)`` is called after each run.
+    """
+    scene = load_scene(path)
+    rows = []
+    for backend in backends:
+        try:
+            row = summarize(scene, plan(scene, backend))
+        except DvqpError as exc:
+            row = {key: None for key in (*FIELDS, "final_tool")}
+            row.update(scene=scene.name, file=scene.source, backend=backend, success=False,
+                       error=str(exc))  # fmt: skip
+        rows.append(row)
+        if progress is not None:
+            progress(backend)
+    base = next((r["median_step_us"] for r in rows if r["backend"] == PINV), None)
+    for row in rows:
+        if base and row["median_step_us"] is not None:
+            row["ratio_to_pinv"] = row["median_step_us"] / base
+    return rows
+
+
+def compare(
+    paths: Sequence[str],
+    backends: Sequence[str],
+    jobs: int = 1,
+    progress: Callable[[int, int, str], None] | None = None,
+) -> list[Row]:
+    """Run every scene with every backend; rows grouped by scene in ``paths`` order.
+
+    Parameters
+    ----------
+    paths
+        Scene files (already validated by the caller, or errors surface here).
+    backends
+        Backend names.
+    jobs
+        Worker processes (one scene per task); 1 runs in this process.
+    progress
+        Called as ``progress(done, total, label)``, counting runs (scene × backend).
+    """
+    total, done = len(paths) * len(backends), 0
+    results: dict[str, list[Row]] = {}
+
+    def tick(count: int, label: str) -> None:
+        nonlocal done
+        done += count
+        if progress is not None:
+            progress(done, total, label)
+
+    if jobs <= 1 or len(paths) <= 1:
+        for path in paths:
+            results[path] = run_scene(path, backends, lambda b, p=path: tick(1, f"{p} {b}"))
+    else:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            futures = {pool.submit(run_scene, path, list(backends)): path for path in paths}
+            for future in as_completed(futures):
+                results[futures[future]] = future.result()
+                tick(len(backends), futures[future])
+    return [row for path in paths for row in results[path]]
+
+
+def machine() -> dict[str, Any]:
+    """Platform, processor, CPU count and Python version of this machine."""
+    return {
+        "platform": platform.platform(),
+        "processor": platform.processor() or platform.machine(),
+        "cpu_count": os.cpu_count(),
+        "python": platform.python_version(),
+    }
+
+
+def versions() -> dict[str, str]:
+    """Versions of dvqp, numpy, pinocchio and the QP solver packages."""
+    import pinocchio
+
+    from dvqp import __version__
+
+    out = {"dvqp": __version__, "numpy": np.__version__, "pinocchio": str(pinocchio.__version__)}
+    out.update(solvers.backend_versions())
+    return out

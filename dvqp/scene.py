@@ -1,0 +1,179 @@
+"""Scene files: a pipe, an arm, the objective, obstacles, limits and a motion, in TOML.
+
+:func:`load_scene` reads a ``.toml`` file with the standard library (``tomllib``, or ``tomli``
+on Python 3.10) and validates it into a :class:`Scene` of typed objects. Anything wrong — a
+missing or mistyped field, a wrong length, an unknown key, a value a constructor rejects, an
+obstacle over the tool's start point — raises :class:`~dvqp.errors.SceneError` with the
+one-line message ``<file>: <field>: <reason>``; fields are dotted TOML paths with 0-based
+array indices (``obstacles[1].radius``). The format is documented in ``docs/scenes.md``.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from dvqp import _scene_sections as sec
+from dvqp._fields import Fields
+from dvqp._scene_sections import PathMotion
+from dvqp.errors import SceneError
+from dvqp.limits import DamperParameters
+from dvqp.objective import Objective
+from dvqp.obstacles import Obstacle
+from dvqp.robot import Robot
+from dvqp.simulate import JogSegment
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+__all__ = ["Environment", "PathMotion", "Scene", "environment", "load_scene", "loads"]
+
+TOP_KEYS = ("name", "description", "pipe", "robot", "objective", "obstacles", "constraints",
+            "motion")  # fmt: skip
+"""The keys a scene file may have at its top level."""
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene (see ``docs/scenes.md`` for the file format).
+
+    Attributes
+    ----------
+    name, description : str
+        Labels (``name`` defaults to the file's stem).
+    source : str
+        The file it came from, or ``"<string>"``.
+    text : str
+        The TOML text (stored in planned trajectories).
+    pipe_radius : float
+        ``R``, m.
+    weld : float or None
+        z of the circumferential weld, m (for plots).
+    robot : Robot
+        The arm with its limits.
+    q0 : ndarray, shape (n,)
+        Start configuration, rad.
+    weights : ndarray, shape (n,)
+        Diagonal of ``W``.
+    objective : Objective
+        ``w(Q)``, with the obstacles.
+    dampers : DamperParameters
+        The QP's inequality parameters.
+    dt : float
+        Step, s.
+    jog : tuple of JogSegment
+        JOG segments (empty in path mode).
+    path : PathMotion or None
+        The path to follow (None in JOG mode).
+    """
+
+    name: str
+    description: str
+    source: str
+    text: str = field(repr=False)
+    pipe_radius: float
+    weld: float | None
+    robot: Robot = field(repr=False)
+    q0: NDArray[np.float64] = field(repr=False)
+    weights: NDArray[np.float64] = field(repr=False)
+    objective: Objective = field(repr=False)
+    dampers: DamperParameters
+    dt: float
+    jog: tuple[JogSegment, ...] = field(repr=False)
+    path: PathMotion | None = field(repr=False)
+
+    @property
+    def obstacles(self) -> tuple[Obstacle, ...]:
+        """The obstacle circles."""
+        return tuple(self.objective.obstacles)
+
+    @property
+    def mode(self) -> str:
+        """``"jog"`` or ``"path"``."""
+        return "jog" if self.path is None else "path"
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a scene file; relative URDF paths resolve from its folder.
+
+    Raises
+    ------
+    SceneError
+        ``<path>: <field>: <reason>`` for an unreadable or invalid file.
+    """
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise SceneError(str(path), "", f"cannot read: {reason}") from exc
+    return loads(text, source=str(path), base_dir=Path(path).parent)
+
+
+def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = None) -> Scene:
+    """Parse and validate scene TOML text.
+
+    Parameters
+    ----------
+    text
+        The TOML document.
+    source
+        Name used in error messages.
+    base_dir
+        Folder relative URDF paths resolve from. Default: ``source``'s folder if it names a
+        file, else the working directory.
+    """
+    f = Fields(source)
+    doc = _parse(f, text)
+    if base_dir is None:
+        base_dir = Path.cwd() if source.startswith("<") else Path(source).parent
+    radius, weld = sec.pipe(f, doc)
+    robot, q0, weights = sec.robot(f, doc, Path(base_dir))
+    objective = sec.objective(f, doc, robot.n_points, sec.obstacles(f, doc))
+    dampers = sec.dampers(f, doc)
+    dt, jog, path = sec.motion(f, doc)
+    sec.check_start(f, robot, q0, radius, objective.obstacles)
+    stem = "scene" if source.startswith("<") else Path(source).stem
+    return Scene(
+        name=f.string(doc, "name", "", stem), description=f.string(doc, "description", "", ""),
+        source=source, text=text, pipe_radius=radius, weld=weld, robot=robot, q0=q0,
+        weights=weights, objective=objective, dampers=dampers, dt=dt, jog=jog, path=path,
+    )  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Environment:
+    """What a plot needs of a scene: the pipe, the orbital level, the weld and the obstacles."""
+
+    pipe_radius: float
+    orbital_level: float
+    weld: float | None
+    obstacles: tuple[Obstacle, ...]
+
+
+def environment(text: str, source: str = "<string>") -> Environment:
+    """Read only the pipe, objective and obstacles of scene text (no robot is built).
+
+    For a trajectory's stored scene, whose URDF may no longer be where it was.
+    """
+    f = Fields(source)
+    doc = _parse(f, text)
+    radius, weld = sec.pipe(f, doc)
+    objective_t = f.table(doc, "objective", "", sec.OBJECTIVE_KEYS)
+    level = f.number(objective_t, "orbital_level", "objective")
+    return Environment(radius, level, weld, sec.obstacles(f, doc))
+
+
+def _parse(f: Fields, text: str) -> dict[str, Any]:
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        f.fail("", f"invalid TOML: {exc}")
+    f.check_keys(doc, "", TOP_KEYS)
+    return doc

@@ -1,0 +1,131 @@
+"""Each bundled scene shows what ``scenes/README.md`` says it shows.
+
+The QP claims run on DAQP (the fastest backend here); the baseline claims on ``pinv``.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dvqp import KinematicState, Scene, Trajectory, load_scene, plan
+from dvqp.planning import failure, motion
+from dvqp.qp_step import StepConfig
+from dvqp.scene import loads
+
+SCENES = Path(__file__).resolve().parent.parent / "scenes"
+
+
+@functools.cache
+def scene(name: str) -> Scene:
+    return load_scene(SCENES / f"{name}.toml")
+
+
+@functools.cache
+def run(name: str, backend: str) -> Trajectory:
+    if backend != "pinv":
+        pytest.importorskip(backend)
+    return plan(scene(name), backend)
+
+
+def tight_rows(s: Scene, traj: Trajectory, tol: float = 1e-6) -> Counter[str]:
+    """How many steps each QP inequality row (obstacle damper, height) held with equality.
+
+    Also checks that no row was broken by more than ``tol`` (m/s).
+    """
+    config = StepConfig(s.robot, s.objective.obstacles, s.dampers, s.weights)
+    tight: Counter[str] = Counter()
+    for k in range(traj.n_steps):
+        state = KinematicState.compute(s.robot, traj.q[k], s.pipe_radius)
+        rows = config.inequalities(state, s.dt)
+        slack = rows.h - rows.G @ traj.qdot[k]
+        assert slack.min(initial=0.0) > -tol, f"step {k} breaks a row"
+        tight.update(label for label, value in zip(rows.labels, slack, strict=True) if value < tol)
+    return tight
+
+
+def body_heights(traj: Trajectory) -> np.ndarray:
+    return traj.points[:, :, 2]
+
+
+def test_paper_scene_hovers_at_the_orbital_level_and_keeps_out_of_the_inlets() -> None:
+    s, qp, base = (
+        scene("paper-two-inlets"),
+        run("paper-two-inlets", "daqp"),
+        run("paper-two-inlets", "pinv"),
+    )
+    level, margin = s.objective.orbital_level, s.dampers.margin
+    m = motion(s)
+    assert {len(s.jog), len(s.obstacles)} == {4, 2}
+    assert np.count_nonzero(m.commands[:, [0, 1, 3]].any(axis=0)) == 3  # JOG in l, z and α
+    for traj in (qp, base):
+        assert traj.ok and traj.task_error.max() < 1e-9  # the probe follows the JOG exactly
+        np.testing.assert_allclose(traj.dv[-1], m.reference[-1], atol=5e-4)
+        assert np.abs(body_heights(traj) - level).max() < 0.012  # hovering at h*
+    assert margin - 1e-4 < qp.min_clearance.min() < margin + 1e-4  # held at the margin
+    assert base.min_clearance.min() < -0.002  # the soft baseline enters an inlet
+    # without the orbital term the body drifts off h* further
+    flat = plan(loads(s.text.replace("k_height = 100.0", "k_height = 0.0")), "pinv")
+    drift = np.abs(body_heights(flat) - level).max()
+    assert drift > 1.5 * np.abs(body_heights(base) - level).max()
+
+
+def test_circumference_scene_goes_once_round_across_the_seam() -> None:
+    s, traj = scene("weld-circumference"), run("weld-circumference", "pinv")
+    turn = 2 * np.pi * s.pipe_radius
+    assert s.path is not None and s.path.waypoints[-1, 0] > np.pi * s.pipe_radius
+    assert traj.ok and failure(s, traj) is None
+    start = s.path.waypoints[0, 0]
+    assert traj.dv[0, 0] < np.pi * s.pipe_radius < traj.dv[-1, 0]  # crossed the seam
+    np.testing.assert_allclose(traj.dv[-1, 0], start + turn, atol=1e-3)  # once round
+    assert np.abs(traj.tracking_error[:, :3]).max() < 5e-5
+    assert np.abs(traj.dv[:, 1] - 0.35).max() < 5e-5  # on the weld all the way
+
+
+def test_narrow_passage_makes_the_qp_rows_active_which_the_baseline_breaks() -> None:
+    s, qp, base = (
+        scene("narrow-passage"),
+        run("narrow-passage", "daqp"),
+        run("narrow-passage", "pinv"),
+    )
+    margin, h_min = s.dampers.margin, s.dampers.min_height
+    assert qp.ok and set(qp.status) == {"optimal"} and qp.task_error.max() < 1e-9
+    assert margin - 1e-4 < qp.min_clearance.min() < margin + 1e-4
+    assert h_min - 1e-4 < body_heights(qp).min() < h_min + 1e-4
+    tight = tight_rows(s, qp)
+    assert sum(n for label, n in tight.items() if "/obstacle" in label) > 50
+    assert sum(n for label, n in tight.items() if label.endswith("/height")) > 50
+    assert base.min_clearance.min() < -0.02  # through an inlet
+    assert body_heights(base).min() < h_min - 0.005  # below the minimum height
+
+
+def test_joint_limit_scene_stops_the_carriage_at_its_limit() -> None:
+    s, qp, base = scene("joint-limit"), run("joint-limit", "daqp"), run("joint-limit", "pinv")
+    q_max = s.robot.q_max[0]
+    assert s.robot.q_max[0] - s.robot.q_min[0] < 0.2  # a tight limit on the carriage
+    assert qp.ok and qp.q[:, 0].max() <= q_max + 1e-9
+    at_limit = np.abs(qp.q[:, 0] - q_max) < 1e-6
+    assert at_limit.sum() > 0.5 * qp.n_steps  # the bound is active most of the run
+    relaxed = np.flatnonzero(qp.status == "relaxed")
+    assert relaxed.size > 10 and qp.t[relaxed[0]] > 3.0  # the task is given up at the end only
+    assert np.all(qp.status[: relaxed[0]] == "optimal")
+    assert base.q[:, 0].max() > q_max + 0.5  # the baseline runs far past the limit
+
+
+def test_many_obstacles_scene_holds_the_margin_at_several_obstacles() -> None:
+    s, qp, base = (
+        scene("many-obstacles"),
+        run("many-obstacles", "daqp"),
+        run("many-obstacles", "pinv"),
+    )
+    assert len(s.obstacles) >= 20
+    assert qp.ok and failure(s, qp) is None and qp.task_error.max() < 1e-9
+    assert qp.min_clearance.min() > s.dampers.margin - 5e-4
+    tight = tight_rows(s, qp)
+    obstacles = {label.split("/")[1] for label in tight if "/obstacle" in label}
+    assert len(obstacles & {"obstacle1", "obstacle2", "obstacle3"}) >= 2  # low clamps in turn
+    assert base.min_clearance.min() < -0.003

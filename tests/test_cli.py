@@ -1,0 +1,233 @@
+"""The ``dvqp`` command line end to end: exit codes, files written (or not), outputs."""
+
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dvqp import Trajectory
+from dvqp.cli import main
+from tests.common import Q0
+
+SCENE = """
+name = "{name}"
+[pipe]
+radius = 0.254
+weld = 0.35
+[robot]
+model = "ndt13"
+link_lengths = [0.334, 0.10, 0.15, 0.15, 0.15, 0.15, 0.06]
+q0 = {q0}
+[objective]
+orbital_level = 0.08
+[[obstacles]]
+center = [0.20, 0.48]
+radius = {radius}
+[motion]
+dt = 0.005
+{motion}
+"""
+JOG = "[[motion.jog]]\nduration = 0.1\nvelocity = [0.05, 0.0, 0.0, 0.0]"
+FAR = "[motion.path]\nwaypoints = [[0.30, 0.35, 0.082, 0.0], [0.30, 1.20, 0.082, 0.0]]\nspeed = 4.0"
+
+
+def write_scene(folder: Path, name: str = "small", radius: float = 0.07, motion: str = JOG) -> str:
+    path = folder / f"{name}.toml"
+    text = SCENE.format(name=name, radius=radius, motion=motion, q0=Q0)
+    path.write_text(text, encoding="utf-8")
+    return str(path)
+
+
+def no_traceback(text: str) -> bool:
+    return "Traceback" not in text and all(line.startswith("dvqp: ") for line in text.splitlines())
+
+
+def test_plan_writes_the_trajectory_and_prints_a_summary(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = write_scene(tmp_path)
+    out = tmp_path / "traj.npz"
+    assert main(["plan", scene, "--backend", "pinv", "-o", str(out)]) == 0
+    captured = capsys.readouterr()
+    labels = [
+        "steps           20, all succeeded",
+        "max task error",
+        "min clearance",
+        "step time       median",
+        "final tool DV   l = 0.3023 m",
+        f"saved           {out}",
+    ]
+    for label in labels:
+        assert label in captured.out
+    assert captured.err == ""
+    traj = Trajectory.load(out)
+    assert traj.n_steps == 20 and traj.backend == "pinv" and "small" in traj.scene_text
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml", "traj.npz"]
+
+
+def test_plan_writes_csv_by_suffix(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "traj.csv"
+    assert main(["plan", write_scene(tmp_path), "--backend", "pinv", "-o", str(out)]) == 0
+    table = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert table.shape == (21, 1 + 13 + 4 + 4)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--backend", "nope"], "dvqp: unknown backend 'nope'; installed: pinv, "),
+        (["--backend", "pinv", "-o", "{tmp}/traj.txt"], "dvqp: output: {tmp}/traj.txt: use a "),
+        (["--backend", "pinv", "-o", "{tmp}/no/traj.npz"], "dvqp: output: {tmp}/no: no such dir"),
+    ],
+    ids=["unknown backend", "unknown suffix", "missing folder"],
+)
+def test_plan_rejects_bad_arguments_with_exit_2_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], args: list[str], message: str
+) -> None:
+    scene = write_scene(tmp_path)
+    args = [a.format(tmp=tmp_path) for a in args]
+    assert main(["plan", scene, *args]) == 2
+    captured = capsys.readouterr()
+    assert captured.err.startswith(message.format(tmp=tmp_path))
+    assert captured.err.count("\n") == 1 and no_traceback(captured.err) and captured.out == ""
+    assert [p.name for p in tmp_path.iterdir()] == ["small.toml"]
+
+
+def test_plan_of_an_invalid_scene_exits_2_naming_file_and_field(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = write_scene(tmp_path, radius=-0.07)
+    out = tmp_path / "traj.npz"
+    assert main(["plan", scene, "-o", str(out)]) == 2
+    captured = capsys.readouterr()
+    assert captured.err == f"dvqp: {scene}: obstacles[0].radius: must be > 0, got -0.07\n"
+    assert not out.exists() and captured.out == ""
+
+
+def test_plan_of_an_unreachable_path_exits_1_with_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    pytest.importorskip("daqp")
+    scene = write_scene(tmp_path, motion=FAR)
+    out = tmp_path / "traj.npz"
+    assert main(["plan", scene, "--backend", "daqp", "-o", str(out)]) == 1
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()
+    assert len(lines) == 1 and no_traceback(captured.err)
+    assert lines[0].startswith(f"dvqp: {scene}: daqp: target not reached at t = 0.215 s: ")
+    assert out.exists()  # the failed run is kept, to look at
+    assert "final tracking" in captured.out
+
+
+def test_compare_prints_one_table_and_writes_json_and_csv(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    pytest.importorskip("daqp")
+    scenes = [write_scene(tmp_path, "one"), write_scene(tmp_path, "two", radius=0.05)]
+    js, cs = tmp_path / "cmp.json", tmp_path / "cmp.csv"
+    code = main(
+        ["compare", *scenes, "--backends", "pinv,daqp", "--json", str(js), "--csv", str(cs)]
+    )
+    assert code == 0
+    captured = capsys.readouterr()
+    lines = captured.out.splitlines()
+    assert lines[0].split() == ["scene", "backend", "ok", "steps", "med", "us", "p95", "us", "x",
+                                "pinv", "task", "err", "clearance", "m", "q", "viol", "rad",
+                                "qd", "viol", "rad/s", "fails"]  # fmt: skip
+    assert [line.split()[:4] for line in lines[2:6]] == [
+        ["one", "pinv", "yes", "20"], ["one", "daqp", "yes", "20"],
+        ["two", "pinv", "yes", "20"], ["two", "daqp", "yes", "20"],
+    ]  # fmt: skip
+    assert no_traceback(captured.err)
+    doc = json.loads(js.read_text(encoding="utf-8"), parse_constant=pytest.fail)  # no NaN/inf
+    assert set(doc["machine"]) == {"platform", "processor", "cpu_count", "python"}
+    assert {"dvqp", "numpy", "pinocchio", "daqp"} <= set(doc["versions"])
+    assert doc["backends"] == ["pinv", "daqp"] and len(doc["results"]) == 4
+    first = doc["results"][0]
+    assert first["ratio_to_pinv"] == 1.0 and first["success"] is True and first["steps"] == 20
+    keys = ["median_step_us", "p95_step_us", "max_task_error", "min_clearance",
+            "max_joint_limit_violation", "max_velocity_limit_violation", "failures"]  # fmt: skip
+    for key in keys:
+        assert isinstance(first[key], (int, float)), key
+    header = cs.read_text(encoding="utf-8").splitlines()[0].split(",")
+    assert header[:3] == ["scene", "file", "backend"] and "ratio_to_pinv" in header
+
+
+def test_compare_runs_scenes_in_parallel_processes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scenes = [write_scene(tmp_path, "one"), write_scene(tmp_path, "two")]
+    assert main(["compare", *scenes, "--backends", "pinv", "--jobs", "2"]) == 0
+    rows = capsys.readouterr().out.splitlines()[2:]
+    assert [r.split()[0] for r in rows] == ["one", "two"]
+
+
+def test_compare_reports_a_failed_run_with_exit_1(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    pytest.importorskip("daqp")
+    scene = write_scene(tmp_path, "far", motion=FAR)
+    assert main(["compare", scene, "--backends", "daqp"]) == 1
+    out = capsys.readouterr().out
+    assert out.splitlines()[2].split()[:3] == ["far", "daqp", "NO"]
+    assert "far / daqp: " in out and "target not reached" in out
+
+
+def test_compare_with_an_invalid_scene_exits_2_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    good, bad = write_scene(tmp_path, "good"), write_scene(tmp_path, "bad", radius=0.0)
+    js = tmp_path / "cmp.json"
+    assert main(["compare", good, bad, "--backends", "pinv", "--json", str(js)]) == 2
+    captured = capsys.readouterr()
+    assert captured.err == f"dvqp: {bad}: obstacles[0].radius: must be > 0, got 0.0\n"
+    assert not js.exists() and captured.out == ""
+    assert main(["compare", good, "--backends", "pinv,nope"]) == 2
+    assert "unknown backend 'nope'" in capsys.readouterr().err
+
+
+def test_compare_draws_a_progress_bar_on_a_terminal(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    term = Terminal()
+    monkeypatch.setattr("sys.stderr", term)
+    assert main(["compare", write_scene(tmp_path), "--backends", "pinv"]) == 0
+    assert "[##############################] 1/1" in term.getvalue()
+    assert term.getvalue().endswith("\r")  # erased at the end
+    assert "Traceback" not in term.getvalue()
+
+
+def test_plot_draws_a_saved_trajectory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "traj.npz"
+    assert main(["plan", write_scene(tmp_path), "--backend", "pinv", "-o", str(out)]) == 0
+    png, gif = tmp_path / "fig.png", tmp_path / "anim.gif"
+    assert main(["plot", str(out), "-o", str(png)]) == 0
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    assert main(["plot", str(out), "-o", str(gif), "--gif"]) == 0
+    assert gif.read_bytes()[:3] == b"GIF"
+    assert main(["plot", str(tmp_path / "small.toml"), "-o", str(png)]) == 2
+    assert "not a dvqp trajectory" in capsys.readouterr().err
+
+
+def test_backends_lists_pinv_and_the_installed_solvers(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["backends"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("pinv ") and "dvqp" in lines[0]
+    assert any(line.split()[0] == "osqp" and line.split()[1] == "osqp" for line in lines)
+
+
+def test_usage_errors_exit_2_and_help_exits_0(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main([]) == 2
+    assert main(["plan"]) == 2
+    assert main(["compare", "x.toml", "--jobs", "0"]) == 2
+    assert main(["--help"]) == 0
+    assert "plan" in capsys.readouterr().out
