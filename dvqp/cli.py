@@ -14,14 +14,14 @@ import io
 import json
 import os
 import sys
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
 from dvqp import compare as cmp
 from dvqp import planning
-from dvqp.errors import BackendError, DvqpError, ParameterError, SingularConfigurationError
+from dvqp._files import atomic_file, output_path
+from dvqp.errors import BackendError, DvqpError, SingularConfigurationError
 from dvqp.scene import environment, load_scene
 from dvqp.trajectory import Trajectory
 
@@ -100,7 +100,7 @@ def _positive_int(text: str) -> int:
 
 def _plan(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
-    output = _output(args.output, (".npz", ".csv")) if args.output else None
+    output = output_path(args.output, (".npz", ".csv")) if args.output else None
     planning.make_resolver(scene, args.backend)  # unknown backend: exit 2 before any work
     bar = _Bar(sys.stderr)
     try:
@@ -130,8 +130,8 @@ def _compare(args: argparse.Namespace) -> int:
             raise BackendError(f"unknown backend {name!r}; installed: {', '.join(known)}")
     for path in args.scenes:
         load_scene(path)  # every scene valid before any run
-    json_out = _output(args.json, (".json",)) if args.json else None
-    csv_out = _output(args.csv, (".csv",)) if args.csv else None
+    json_out = output_path(args.json, (".json",)) if args.json else None
+    csv_out = output_path(args.csv, (".csv",)) if args.csv else None
     bar = _Bar(sys.stderr)
     try:
         rows = cmp.compare(args.scenes, backends, args.jobs, progress=bar.show)
@@ -249,26 +249,10 @@ def _csv(rows: Sequence[dict[str, Any]]) -> str:
     return buf.getvalue()
 
 
-def _output(name: str, suffixes: tuple[str, ...]) -> Path:
-    """Check an output file name before any work: known suffix, existing folder."""
-    path = Path(name)
-    if path.suffix.lower() not in suffixes:
-        raise ParameterError("output", f"{name}: use a {' or '.join(suffixes)} file")
-    if not path.parent.is_dir():
-        raise ParameterError("output", f"{path.parent}: no such directory")
-    return path
-
-
 def _write(path: Path, text: str) -> None:
     """Write ``text`` atomically: a temporary file in the same folder, then renamed."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_file(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
 
 
 class _Bar:

@@ -12,8 +12,6 @@ stay continuous where they cross the seam.
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from collections.abc import Callable, Sequence
 from numbers import Real
 from pathlib import Path
@@ -22,6 +20,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp._files import atomic_file, output_path
 from dvqp.developed_view import unwrap
 from dvqp.errors import DvqpError, ParameterError
 from dvqp.obstacles import Obstacle
@@ -80,7 +79,7 @@ def plot_trajectory(
     DvqpError
         matplotlib is not installed.
     """
-    target = _target(path, FIGURE_FORMATS)
+    target = output_path(path, FIGURE_FORMATS)
     sc = _scene(traj, obstacles, orbital_level, weld_z)
     _integer("instants", instants, 1)
     top = float(np.clip(7.6 * sc.aspect + 1.1, 2.2, 8.0))
@@ -158,7 +157,7 @@ def animate_trajectory(
     ParameterError, DvqpError
         As in :func:`plot_trajectory`.
     """
-    target = _target(path, (".gif",))
+    target = output_path(path, (".gif",))
     sc = _scene(traj, obstacles, orbital_level, weld_z)
     if isinstance(fps, bool) or not isinstance(fps, Real) or not 0 < fps < math.inf:
         raise ParameterError("fps", f"must be > 0, got {fps!r}")
@@ -202,31 +201,10 @@ def _figure(size: tuple[float, float]) -> Figure:
     return fig
 
 
-def _target(path: str | Path, formats: Sequence[str]) -> Path:
-    target = Path(path)
-    suffix = target.suffix.lower()
-    if suffix not in formats:
-        raise ParameterError(
-            "output", f"{target}: unknown format {suffix or '(none)'!r} (use {', '.join(formats)})"
-        )
-    if not target.parent.is_dir():
-        raise ParameterError("output", f"{target.parent}: no such directory")
-    return target
-
-
 def _atomic(target: Path, write: Callable[[str], None]) -> Path:
     """Call ``write(tmp)`` on a temporary file beside ``target``, then rename it to ``target``."""
-    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=target.suffix)
-    os.close(fd)
-    try:
-        write(tmp)
-        umask = os.umask(0)  # mkstemp makes the file 0600: give it the usual mode instead
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_file(target) as tmp:
+        write(str(tmp))
     return target
 
 

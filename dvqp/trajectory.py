@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -11,8 +9,9 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp._files import atomic_file, output_path
 from dvqp.developed_view import unwrap
-from dvqp.errors import DvqpError, ParameterError
+from dvqp.errors import DvqpError
 
 ARRAYS = (
     "t",
@@ -114,11 +113,15 @@ class Trajectory:
     ) -> Trajectory:
         """Build from raw samples, unwrapping l (period 2πR) and α (period 2π)."""
         period = 2.0 * np.pi * pipe_radius
-        dv = tool.copy()
-        dv[:, 0] = unwrap(tool[:, 0], period)
-        dv[:, 3] = unwrap(tool[:, 3], 2.0 * np.pi)
+        # l continuous along the body (points then tool) at the first sample, then in time.
+        first = unwrap(np.append(points[0, :, 0], tool[0, 0]), period)
         pts = points.copy()
-        pts[:, :, 0] = unwrap(points[:, :, 0], period, axis=0)
+        pts[0, :, 0] = first[:-1]
+        pts[:, :, 0] = unwrap(pts[:, :, 0], period, axis=0)
+        dv = tool.copy()
+        dv[0, 0] = first[-1]
+        dv[:, 0] = unwrap(dv[:, 0], period)
+        dv[:, 3] = unwrap(tool[:, 3], 2.0 * np.pi)
         return cls(
             t=dt * np.arange(q.shape[0]),
             q=q,
@@ -156,33 +159,20 @@ class Trajectory:
         The file appears complete or not at all: it is written to a temporary file in the
         same folder and renamed.
         """
-        target = Path(path)
-        suffix = target.suffix.lower()
-        if suffix not in (".npz", ".csv"):
-            raise ParameterError(
-                "output", f"{target}: unknown format {suffix!r} (use .npz or .csv)"
-            )
-        if not target.parent.exists():
-            raise ParameterError("output", f"{target.parent}: no such directory")
-        fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=suffix)
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                if suffix == ".npz":
-                    arrays = {name: getattr(self, name) for name in ARRAYS}
-                    np.savez_compressed(
-                        fh,
-                        **arrays,
-                        backend=np.str_(self.backend),
-                        pipe_radius=np.float64(self.pipe_radius),
-                        scene=np.str_(self.scene_text),
-                        tracking_error=self.tracking_error,
-                    )
-                else:
-                    self._write_csv(fh)
-            os.replace(tmp, target)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        target = output_path(path, (".npz", ".csv"))
+        with atomic_file(target) as tmp, open(tmp, "wb") as fh:
+            if target.suffix.lower() == ".npz":
+                arrays = {name: getattr(self, name) for name in ARRAYS}
+                np.savez_compressed(
+                    fh,
+                    **arrays,
+                    backend=np.str_(self.backend),
+                    pipe_radius=np.float64(self.pipe_radius),
+                    scene=np.str_(self.scene_text),
+                    tracking_error=self.tracking_error,
+                )
+            else:
+                self._write_csv(fh)
         return target
 
     def _write_csv(self, fh: object) -> None:

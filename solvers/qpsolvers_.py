@@ -9,7 +9,11 @@ package sign convention.
 
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
 import time
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -53,6 +57,24 @@ TOLERANCE: dict[str, float] = {
     "quadprog": 1e-6,
 }
 DEFAULT_TOLERANCE = 1e-6
+
+#: Solvers whose C library prints to standard output whatever their settings say (HiGHS
+#: prints its banner when a ``Highs()`` object is created, before any option can be set).
+CHATTY = frozenset({"highs"})
+
+
+@contextlib.contextmanager
+def _quiet_c_stdout() -> Iterator[None]:
+    """Send file descriptor 1 to the null device for the duration (C-level prints)."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, "wb") as null:
+            os.dup2(null.fileno(), 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
 
 
 def _status(extras: dict[str, Any], found: bool | None) -> str:
@@ -141,7 +163,9 @@ class QpsolversBackend:
         if self._sparse:
             P, G, A = (None if m is None else sp.csc_matrix(m) for m in (P, G, A))
         qp = qpsolvers.Problem(P, np.array(problem.q), G, h, A, b, lb, ub)
-        result = qpsolvers.solve_problem(qp, self.solver, initvals=guess, **self.settings)
+        quiet = _quiet_c_stdout() if self.solver in CHATTY else contextlib.nullcontext()
+        with quiet:
+            result = qpsolvers.solve_problem(qp, self.solver, initvals=guess, **self.settings)
         z = None
         if keep is not None and result.z is not None:
             z = np.zeros(problem.n_in)

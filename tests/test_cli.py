@@ -80,7 +80,10 @@ def test_plan_writes_csv_by_suffix(tmp_path: Path, capsys: pytest.CaptureFixture
     ("args", "message"),
     [
         (["--backend", "nope"], "dvqp: unknown backend 'nope'; installed: pinv, "),
-        (["--backend", "pinv", "-o", "{tmp}/traj.txt"], "dvqp: output: {tmp}/traj.txt: use a "),
+        (
+            ["--backend", "pinv", "-o", "{tmp}/traj.txt"],
+            "dvqp: output: {tmp}/traj.txt: unknown format '.txt' (use .npz, .csv)",
+        ),
         (["--backend", "pinv", "-o", "{tmp}/no/traj.npz"], "dvqp: output: {tmp}/no: no such dir"),
     ],
     ids=["unknown backend", "unknown suffix", "missing folder"],

@@ -105,3 +105,12 @@ def test_exception_text_is_kept_in_the_failure_message() -> None:
     assert solution.status == "exception"
     assert solution.message.startswith("qpsolvers:quadprog raised ")
     assert "positive definite" in solution.message
+
+
+def test_highs_writes_nothing_to_standard_output(capfd: pytest.CaptureFixture[str]) -> None:
+    if "qpsolvers:highs" not in available_backends():
+        pytest.skip("HiGHS not installed")
+    problem = Problem(P=np.eye(2), q=np.array([-1.0, 0.0]), lb=np.zeros(2), ub=np.ones(2))
+    solution = make_backend("qpsolvers:highs").solve(problem)
+    assert solution.found
+    assert capfd.readouterr().out == ""

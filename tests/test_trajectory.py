@@ -1,0 +1,66 @@
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dvqp import Trajectory
+from dvqp.errors import DvqpError, ParameterError
+
+R = 0.254
+
+
+def straddling(n_samples: int = 4) -> Trajectory:
+    """A body lying across the seam l = ±πR and moving in +l (steps of 1 mm)."""
+    edge = np.pi * R
+    body = np.array([edge - 0.02, edge - 0.005, -edge + 0.01])  # wrapped l of 3 points
+    drift = 0.001 * np.arange(n_samples)[:, None]
+    wrapped = (body[None, :] + drift + edge) % (2 * edge) - edge
+    points = np.zeros((n_samples, 3, 3))
+    points[:, :, 0] = wrapped
+    tool = np.zeros((n_samples, 4))
+    tool[:, 0] = (-edge + 0.03 + drift[:, 0] + edge) % (2 * edge) - edge
+    n = n_samples - 1
+    return Trajectory.from_samples(
+        dt=0.01, q=np.zeros((n_samples, 2)), qdot=np.zeros((n, 2)), tool=tool, points=points,
+        pipe_radius=R, w=np.zeros(n_samples), min_clearance=np.full(n_samples, np.inf),
+        solve_time=np.zeros(n), step_time=np.zeros(n), task_error=np.zeros(n),
+        iterations=np.zeros(n, dtype=np.int64), success=np.ones(n, dtype=bool),
+        status=["optimal"] * n, backend="test",
+    )  # fmt: skip
+
+
+def test_l_is_continuous_along_the_body_and_in_time_across_the_seam() -> None:
+    traj = straddling()
+    along_body = np.diff(np.column_stack([traj.points[:, :, 0], traj.dv[:, 0]]), axis=1)
+    assert np.abs(along_body).max() < 0.05  # no 2πR jump between neighbours
+    np.testing.assert_allclose(np.diff(traj.points[:, :, 0], axis=0), 0.001, atol=1e-12)
+    np.testing.assert_allclose(np.diff(traj.dv[:, 0]), 0.001, atol=1e-12)
+
+
+def test_saved_file_has_the_usual_mode_and_no_temporary_is_left(tmp_path: Path) -> None:
+    out = straddling().save(tmp_path / "t.npz")
+    umask = os.umask(0)
+    os.umask(umask)
+    assert out.stat().st_mode & 0o777 == 0o666 & ~umask
+    assert [p.name for p in tmp_path.iterdir()] == ["t.npz"]
+
+
+def test_a_failed_write_keeps_the_old_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    target = tmp_path / "t.csv"
+    target.write_text("old")
+
+    def explode(*args: object, **kwargs: object) -> None:
+        raise OSError("disk full")
+
+    monkeypatch.setattr(np, "savetxt", explode)
+    with pytest.raises(OSError, match="disk full"):
+        straddling().save(target)
+    assert target.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == ["t.csv"]
+
+
+def test_bad_targets_raise_before_writing(tmp_path: Path) -> None:
+    with pytest.raises(ParameterError, match="no such directory"):
+        straddling().save(tmp_path / "missing" / "t.npz")
+    with pytest.raises(DvqpError, match="not a dvqp trajectory"):
+        Trajectory.load(tmp_path / "absent.npz")
