@@ -73,6 +73,7 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--backends", help="comma-separated names (default: pinv + installed)")
     c.add_argument("--json", help="write the figures, machine and versions as JSON")
     c.add_argument("--csv", help="write the figures as CSV")
+    c.add_argument("--plot", help="write a figure of the comparison (.png/.svg/.pdf)")
     c.add_argument("--jobs", type=_positive_int, default=1, help="worker processes (scenes)")
     c.set_defaults(run=_compare)
     g = sub.add_parser("plot", help="draw a saved trajectory")
@@ -132,6 +133,7 @@ def _compare(args: argparse.Namespace) -> int:
         load_scene(path)  # every scene valid before any run
     json_out = output_path(args.json, (".json",)) if args.json else None
     csv_out = output_path(args.csv, (".csv",)) if args.csv else None
+    plot_out = output_path(args.plot, (".png", ".svg", ".pdf")) if args.plot else None
     bar = _Bar(sys.stderr)
     try:
         rows = cmp.compare(args.scenes, backends, args.jobs, progress=bar.show)
@@ -147,6 +149,10 @@ def _compare(args: argparse.Namespace) -> int:
         _write(json_out, json.dumps(doc, indent=2, allow_nan=False) + "\n")
     if csv_out is not None:
         _write(csv_out, _csv(rows))
+    if plot_out is not None:
+        from dvqp.plot_compare import plot_comparison
+
+        plot_comparison(rows, plot_out)
     return 0 if all(row["success"] for row in rows) else 1
 
 

@@ -160,6 +160,18 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
     assert header[:3] == ["scene", "file", "backend"] and "ratio_to_pinv" in header
 
 
+def test_compare_draws_its_figure(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    pytest.importorskip("matplotlib")
+    scenes = [write_scene(tmp_path, "one"), write_scene(tmp_path, "two")]
+    fig = tmp_path / "cmp.png"
+    assert main(["compare", *scenes, "--backends", "pinv", "--plot", str(fig)]) == 0
+    assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and fig.stat().st_size > 10_000
+    assert (
+        main(["compare", scenes[0], "--backends", "pinv", "--plot", str(tmp_path / "x.gif")]) == 2
+    )
+    assert "unknown format '.gif'" in capsys.readouterr().err
+
+
 def test_compare_runs_scenes_in_parallel_processes(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
