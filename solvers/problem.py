@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -114,17 +115,19 @@ class Problem:
         q = arrays["q"]
         if q is None:
             raise ProblemShapeError("q: expected shape (n,), got None")
-        _check_shape("q", q, ("n",))
+        if q.ndim != 1:
+            _check_shape("q", q, ("n",))
         n = q.shape[0]
         P = arrays["P"]
         if P is None:
             raise ProblemShapeError(f"P: expected shape ({n}, {n}), got None")
-        _check_shape("P", P, (n, n))
+        if P.shape != (n, n):
+            _check_shape("P", P, (n, n))
         for mat, vec, rows in (("A", "b", "m"), ("G", "h", "p")):
             M, v = arrays[mat], arrays[vec]
-            if M is not None:
+            if M is not None and (M.ndim != 2 or M.shape[1] != n):
                 _check_shape(mat, M, (rows, n))
-            if v is not None:
+            if v is not None and (v.ndim != 1 or (M is not None and v.shape[0] != M.shape[0])):
                 _check_shape(vec, v, (rows if M is None else M.shape[0],))
             if (M is None or M.shape[0] == 0) and (v is None or v.shape[0] == 0):
                 arrays[mat] = arrays[vec] = None
@@ -135,7 +138,7 @@ class Problem:
                 )
         for name in ("lb", "ub"):
             bound = arrays[name]
-            if bound is not None:
+            if bound is not None and bound.shape != (n,):
                 _check_shape(name, bound, (n,))
         self._check_values(arrays)
         for name, array in arrays.items():
@@ -144,27 +147,33 @@ class Problem:
             object.__setattr__(self, name, array)
 
     def _check_values(self, arrays: dict[str, np.ndarray | None]) -> None:
+        # Fast paths first (one reduction per array; a sum is finite only if every element
+        # is), exact element-wise checks only to confirm and locate a problem.
         for name in ("P", "q", "A", "b", "G"):
             array = arrays[name]
-            if array is not None:
+            if array is not None and not math.isfinite(float(array.sum())):
                 _require(name, np.isfinite(array), "must be finite")
         P = arrays["P"]
         assert P is not None
-        asym = float(np.abs(P - P.T).max(initial=0.0))
-        if asym > SYMMETRY_TOLERANCE * (1.0 + float(np.abs(P).max(initial=0.0))):
-            raise ProblemShapeError(f"P: must be symmetric, max |P - P^T| = {asym:.1e}")
+        if not (P == P.T).all():
+            asym = float(np.abs(P - P.T).max(initial=0.0))
+            if asym > SYMMETRY_TOLERANCE * (1.0 + float(np.abs(P).max(initial=0.0))):
+                raise ProblemShapeError(f"P: must be symmetric, max |P - P^T| = {asym:.1e}")
         h, lb, ub = arrays["h"], arrays["lb"], arrays["ub"]
-        if h is not None:
-            _require("h", h > -np.inf, "must not be NaN or -inf")
-        if lb is not None:
-            _require("lb", lb < np.inf, "must not be NaN or +inf")
-        if ub is not None:
-            _require("ub", ub > -np.inf, "must not be NaN or -inf")
-        if lb is not None and ub is not None:
+        finite = []  # whether h, lb, ub are free of infinite entries (used by residuals)
+        for name, v, bad, what in (
+            ("h", h, -np.inf, "must not be NaN or -inf"),
+            ("lb", lb, np.inf, "must not be NaN or +inf"),
+            ("ub", ub, -np.inf, "must not be NaN or -inf"),
+        ):
+            if v is None or math.isfinite(float(v.sum())):
+                finite.append(True)
+                continue
+            _require(name, ~np.isnan(v) & (v != bad), what)
+            finite.append(bool(np.isfinite(v).all()))
+        if lb is not None and ub is not None and (ub < lb).any():
             _require("lb", lb <= ub, "must be <= ub")
-        # Whether h, lb, ub are free of infinite entries (used by residuals).
-        finite = tuple(v is None or bool(np.isfinite(v).all()) for v in (h, lb, ub))
-        object.__setattr__(self, "_finite", finite)
+        object.__setattr__(self, "_finite", tuple(finite))
 
     @property
     def n(self) -> int:

@@ -88,10 +88,12 @@ def kkt_residuals(
     slack_in = p.h - p.G @ x if p.G is not None and p.h is not None else None
     if slack_in is not None:
         inequality = max(0.0, -float(slack_in.min()))
-    if p.lb is not None:
-        bounds = max(bounds, float((p.lb - x).max()))
-    if p.ub is not None:
-        bounds = max(bounds, float((x - p.ub).max()))
+    slack_ub = None if p.ub is None else p.ub - x
+    slack_lb = None if p.lb is None else x - p.lb
+    if slack_ub is not None:
+        bounds = max(bounds, -float(slack_ub.min()))
+    if slack_lb is not None:
+        bounds = max(bounds, -float(slack_lb.min()))
     Px = p.P @ x
     scale = max(float(np.abs(Px).max()), float(np.abs(p.q).max())) if p.n else 0.0
 
@@ -110,16 +112,25 @@ def kkt_residuals(
         complementarity = max(-float(z.min()), _slack_product(z, slack_in, h_finite))
     if z_box is not None:
         gradient += z_box
-        if p.ub is not None:
-            complementarity = max(complementarity, _slack_product(z_box, p.ub - x, ub_finite))
+        if slack_ub is not None and slack_lb is not None and ub_finite and lb_finite:
+            # z_box > 0 pairs with the upper slack, z_box < 0 with the lower one.
+            paired = np.where(z_box > 0.0, slack_ub, slack_lb)
+            complementarity = max(complementarity, float(np.abs(z_box * paired).max()))
         else:
-            complementarity = max(complementarity, float(z_box.max()))
-        if p.lb is not None:
-            complementarity = max(complementarity, _slack_product(-z_box, x - p.lb, lb_finite))
-        else:
-            complementarity = max(complementarity, -float(z_box.min()))
+            complementarity = max(complementarity, _box_product(z_box, slack_ub, ub_finite))
+            complementarity = max(
+                complementarity,
+                _box_product(-z_box, slack_lb, lb_finite),
+            )
     stationarity = float(np.abs(gradient).max()) if p.n else 0.0
     return Residuals(equality, inequality, bounds, stationarity, max(complementarity, 0.0)), scale
+
+
+def _box_product(multiplier: np.ndarray, slack: np.ndarray | None, finite: bool) -> float:
+    """Complementarity of one side of the box; a multiplier on a missing bound is all error."""
+    if slack is None:
+        return float(multiplier.max())
+    return _slack_product(multiplier, slack, finite)
 
 
 def residuals(

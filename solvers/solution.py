@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -128,7 +129,7 @@ class Solution:
         if answer.shape != (problem.n,):
             solution.message = f"{said} x has shape {answer.shape}, expected ({problem.n},)"
             return solution
-        if not np.all(np.isfinite(answer)):
+        if not math.isfinite(float(answer.sum())):
             solution.message = f"{said} x is not finite"
             return solution
         solution.y, solution.z, solution.z_box = (
