@@ -72,6 +72,7 @@ def weighted_pinv_step(
         )
     return free + jw.T @ lam
 
+
 class PseudoinverseResolver:
     """The paper's baseline resolver (name ``"pinv"``).
 
