@@ -20,7 +20,7 @@ from scipy.linalg.lapack import dposv
 
 from dvqp import _validate
 from dvqp.errors import ParameterError, SingularConfigurationError
-from dvqp.resolver import Step
+from dvqp.resolver import Step, step_inputs, task_error
 from dvqp.state import KinematicState
 
 SINGULAR_RCOND = 1e-10
@@ -109,13 +109,11 @@ class PseudoinverseResolver:
     ) -> Step:
         """One baseline step (``dt`` is unused: the baseline holds no limits)."""
         start = time.perf_counter()
-        n = state.n
-        g = _validate.vector("gradient", gradient, n)
-        jac = state.tool_jacobian
-        xd = _validate.vector("xdot", xdot, jac.shape[0])
-        qdot = weighted_pinv_step(jac, xd, g, self.inverse_weights(n), self.damping)
+        g, xd = step_inputs(state, gradient, xdot)
+        inv_w = self.inverse_weights(state.n)
+        qdot = weighted_pinv_step(state.tool_jacobian, xd, g, inv_w, self.damping)
         elapsed = time.perf_counter() - start
-        error = float(np.max(np.abs(jac @ qdot - xd)))
+        error = task_error(state, qdot, xd)
         return Step(qdot=qdot, success=True, status="optimal", task_error=error, solve_time=elapsed)
 
     def reset(self) -> None:

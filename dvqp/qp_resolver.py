@@ -18,7 +18,7 @@ import solvers
 from dvqp import _validate
 from dvqp.errors import BackendError
 from dvqp.qp_step import StepConfig, build_step_qp
-from dvqp.resolver import Step
+from dvqp.resolver import Step, step_inputs, task_error
 from dvqp.state import KinematicState
 
 
@@ -71,8 +71,7 @@ class QPResolver:
         """One QP step (assembly + solve + check); see the module docstring."""
         start = time.perf_counter()
         n = state.n
-        g = _validate.vector("gradient", gradient, n)
-        xd = _validate.vector("xdot", xdot, state.tool_jacobian.shape[0])
+        g, xd = step_inputs(state, gradient, xdot)
         step = _validate.positive("dt", dt)
         strict = build_step_qp(self.config, state, g, xd, step)
         solution = self._strict.solve(strict.problem)
@@ -88,6 +87,6 @@ class QPResolver:
                 np.zeros(n), False, f"failed: {solution.message}", np.inf, elapsed, iterations
             )
         qdot = np.array(solution.x[:n])
-        error = float(np.max(np.abs(state.tool_jacobian @ qdot - xd)))
+        error = task_error(state, qdot, xd)
         elapsed = time.perf_counter() - start
         return Step(qdot, True, status, error, elapsed, iterations)

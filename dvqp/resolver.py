@@ -8,6 +8,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp import _validate
 from dvqp.state import KinematicState
 
 
@@ -37,6 +38,28 @@ class Step:
     task_error: float
     solve_time: float
     iterations: int | None = None
+
+
+def step_inputs(
+    state: KinematicState, gradient: NDArray[np.float64], xdot: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Check a resolver's inputs: ``gradient`` (n,) and ``xdot`` (m,), finite.
+
+    Raises
+    ------
+    ShapeError, ParameterError
+        Wrong size or not finite.
+    """
+    g = _validate.vector("gradient", gradient, state.n)
+    xd = _validate.vector("xdot", xdot, state.tool_jacobian.shape[0])
+    return g, xd
+
+
+def task_error(
+    state: KinematicState, qdot: NDArray[np.float64], xdot: NDArray[np.float64]
+) -> float:
+    """``‖J̄·Q̇ − ẋ‖∞`` of the tool's DV task."""
+    return float(np.abs(state.tool_jacobian @ qdot - xdot).max())
 
 
 class Resolver(Protocol):
