@@ -165,6 +165,10 @@ class Fields:
     def _finite(self, field: str, value: Any, infinite: bool = False) -> float:
         if not is_number(value):
             self.fail(field, f"expected a number, got {kind(value)}")
-        if math.isnan(value) or (not infinite and math.isinf(value)):
+        try:
+            number = float(value)
+        except OverflowError:
+            self.fail(field, "out of range")
+        if math.isnan(number) or (not infinite and math.isinf(number)):
             self.fail(field, f"must be finite, got {value!r}")
-        return float(value)
+        return number

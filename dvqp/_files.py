@@ -27,6 +27,13 @@ def output_path(path: str | Path, suffixes: Sequence[str]) -> Path:
         )
     if not target.parent.is_dir():
         raise ParameterError("output", f"{target.parent}: no such directory")
+    try:  # find out now, not after a long run, that the folder cannot take the file
+        with tempfile.TemporaryFile(dir=target.parent):
+            pass
+    except OSError as exc:
+        raise ParameterError(
+            "output", f"{target.parent}: cannot write here ({exc.strerror})"
+        ) from exc
     return target
 
 

@@ -20,7 +20,7 @@ from dvqp.limits import DamperParameters
 from dvqp.objective import Objective
 from dvqp.obstacles import Obstacle, offsets
 from dvqp.robot import Robot
-from dvqp.simulate import JogSegment
+from dvqp.simulate import MAX_STEPS, JogSegment
 from dvqp.state import KinematicState
 
 ROBOT_KEYS = ("model", "link_lengths", "urdf", "points", "tool", "q0", "q_min", "q_max", "qd_max",
@@ -29,6 +29,11 @@ OBJECTIVE_KEYS = ("orbital_level", "k_height", "k_obstacle", "gain")
 CONSTRAINT_KEYS = ("min_height", "margin", "influence", "damper_gain")
 PATH_KEYS = ("waypoints", "speed", "gain", "tolerance", "heading_tolerance")
 MODELS = ("ndt13",)
+
+
+HEADING_ARM = 0.1
+"""m/rad: a path segment's heading change counts as this much length (at 0.02 m/s along the
+path, the probe turns at 0.2 rad/s)."""
 
 
 @dataclass(frozen=True)
@@ -54,6 +59,16 @@ class PathMotion:
     gain: float = 5.0
     tolerance: float = 0.005
     heading_tolerance: float = 0.05
+
+    @staticmethod
+    def segment_lengths(nodes: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Length (m) of each segment between consecutive ``[l, z, h, α]`` nodes, shape (m−1,).
+
+        A segment lasts as long as its (l, z, h) length or its heading change counted at
+        :data:`HEADING_ARM` m/rad, whichever is longer, so a turn in place takes time too.
+        """
+        delta = np.diff(nodes, axis=0)
+        return np.maximum(np.linalg.norm(delta[:, :3], axis=1), HEADING_ARM * np.abs(delta[:, 3]))
 
 
 def pipe(f: Fields, doc: dict[str, Any]) -> tuple[float, float | None]:
@@ -179,6 +194,12 @@ def motion(
     with f.mapped("motion"):
         dt = _validate.positive("dt", f.number(motion, "dt", "motion"))
     jog, path = _motion(f, motion)
+    if path is None:
+        steps = sum(max(1, round(seg.duration / dt)) for seg in jog)
+    else:
+        steps = float(PathMotion.segment_lengths(path.waypoints).sum()) / (path.speed * dt)
+    if steps > MAX_STEPS:
+        f.fail("motion", f"about {steps:.3g} steps of dt: too many (at most {MAX_STEPS:.0e})")
     return dt, jog, path
 
 
@@ -206,8 +227,8 @@ def _motion(f: Fields, motion: dict[str, Any]) -> tuple[tuple[JogSegment, ...], 
     for i, h in enumerate(points[:, 2]):
         if h < 0:
             f.fail(f"motion.path.waypoints[{i}]", f"h = {h:g} m is inside the pipe (must be >= 0)")
-    if not np.any(np.linalg.norm(np.diff(points[:, :3], axis=0), axis=1) > 0):
-        f.fail("motion.path.waypoints", "the path has zero length in (l, z, h)")
+    if not np.any(np.diff(points, axis=0) != 0.0):
+        f.fail("motion.path.waypoints", "the waypoints are all the same: nothing to follow")
     speed = f.number(t, "speed", "motion.path")
     gain = f.number(t, "gain", "motion.path", 5.0)
     tol = f.number(t, "tolerance", "motion.path", 0.005)

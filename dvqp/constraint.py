@@ -1,4 +1,4 @@
-"""The pieces a QP step is assembled from: a cost ``Cost(H, c)`` and a ``Constraint(G, h)``."""
+"""The pieces a QP step is assembled from: inequalities ``Constraint(G, h)`` and ``Bounds``."""
 
 from __future__ import annotations
 
@@ -7,22 +7,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
-
-
-@dataclass(frozen=True)
-class Cost:
-    """Quadratic cost ``½ xᵀ H x + cᵀ x`` over the joint velocities.
-
-    Attributes
-    ----------
-    H : ndarray, shape (n, n)
-        Hessian (s²/rad² scaled by the joint weights).
-    c : ndarray, shape (n,)
-        Linear term.
-    """
-
-    H: NDArray[np.float64]
-    c: NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,7 @@ on the pipe axis raises :class:`~dvqp.errors.SingularConfigurationError`; an und
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -54,45 +55,69 @@ def unwrap(values: ArrayLike, period: float, axis: int = 0) -> NDArray[np.float6
     return np.concatenate([first, first + np.cumsum(d, axis=axis)], axis=axis)
 
 
-def _rho(origins: NDArray[np.float64]) -> NDArray[np.float64]:
-    rho = np.hypot(origins[:, 0], origins[:, 1])
-    if np.any(rho < RHO_MIN):
-        i = int(np.argmin(rho))
-        raise SingularConfigurationError(f"point {i} lies on the pipe axis (rho = {rho[i]:.3g} m)")
-    return rho
-
-
-def position(origins: ArrayLike, radius: float) -> NDArray[np.float64]:
-    """DV position ``[l, z, h]`` of k points.
+def position_and_rows(
+    origins: ArrayLike,
+    linear_jacobians: ArrayLike,
+    radius: float,
+    names: Sequence[str] | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """DV positions of k points and their Jacobians through the frames' linear Jacobians.
 
     Parameters
     ----------
     origins
         Cartesian positions, m, shape (k, 3).
+    linear_jacobians
+        ``∂O/∂Q`` of each point, shape (k, 3, n) (the identity, (k, 3, 3), gives ``∂F/∂O``).
     radius
         Pipe radius, m.
+    names
+        Names of the points, for the error message.
 
     Returns
     -------
-    ndarray, shape (k, 3)
+    position : ndarray, shape (k, 3)
+        ``[l, z, h]``, m.
+    rows : ndarray, shape (k, 3, n)
+        ``∂[l, z, h]/∂O · ∂O/∂Q``, formed row by row without the 3×3 blocks.
+
+    Raises
+    ------
+    SingularConfigurationError
+        A point lies on the pipe axis (ρ = 0).
     """
     o = np.asarray(origins, dtype=np.float64)
-    rho = _rho(o)
-    return np.column_stack([radius * np.arctan2(o[:, 1], o[:, 0]), o[:, 2], rho - radius])
+    jv = np.asarray(linear_jacobians, dtype=np.float64)
+    x, y = o[:, 0], o[:, 1]
+    rho2 = x * x + y * y
+    rho = np.sqrt(rho2)
+    if not (rho >= RHO_MIN).all():
+        i = int(np.argmin(rho))
+        name = f"frame {names[i]!r}" if names is not None else f"point {i}"
+        raise SingularConfigurationError(f"{name} lies on the pipe axis (rho = {rho[i]:.3g} m)")
+    k, n = o.shape[0], jv.shape[2]
+    pos = np.empty((k, 3))
+    pos[:, 0] = radius * np.arctan2(y, x)
+    pos[:, 1] = o[:, 2]
+    pos[:, 2] = rho - radius
+    jx, jy = jv[:, 0, :], jv[:, 1, :]
+    rows = np.empty((k, 3, n))
+    rows[:, 0] = (radius / rho2)[:, None] * (x[:, None] * jy - y[:, None] * jx)
+    rows[:, 1] = jv[:, 2, :]
+    rows[:, 2] = (x / rho)[:, None] * jx + (y / rho)[:, None] * jy
+    return pos, rows
+
+
+def position(origins: ArrayLike, radius: float) -> NDArray[np.float64]:
+    """DV position ``[l, z, h]`` (m) of k points at ``origins`` (m, shape (k, 3)): (k, 3)."""
+    o = np.asarray(origins, dtype=np.float64)
+    return position_and_rows(o, np.zeros((o.shape[0], 3, 0)), radius)[0]
 
 
 def position_jacobian(origins: ArrayLike, radius: float) -> NDArray[np.float64]:
     """``∂[l, z, h]/∂O`` of k points, shape (k, 3, 3)."""
     o = np.asarray(origins, dtype=np.float64)
-    rho = _rho(o)
-    k = o.shape[0]
-    out = np.zeros((k, 3, 3))
-    out[:, 0, 0] = -radius * o[:, 1] / rho**2
-    out[:, 0, 1] = radius * o[:, 0] / rho**2
-    out[:, 1, 2] = 1.0
-    out[:, 2, 0] = o[:, 0] / rho
-    out[:, 2, 1] = o[:, 1] / rho
-    return out
+    return position_and_rows(o, np.broadcast_to(np.eye(3), (o.shape[0], 3, 3)), radius)[1]
 
 
 def heading_terms(

@@ -12,6 +12,7 @@ inverse: finite everywhere, at the price of a task error near singularities.
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -62,13 +63,18 @@ def weighted_pinv_step(
     free = inv_weights * gradient
     # Cholesky solve of the SPD Gram matrix (LAPACK dposv: a few µs, unlike np.linalg.solve).
     factor, lam, info = dposv(gram, xdot - jacobian @ free, lower=1)
-    pivots = np.diagonal(factor) ** 2 if info == 0 else None
-    if pivots is None or pivots.min() <= SINGULAR_RCOND * pivots.max():
-        if damping > 0.0:  # cannot happen for μ > 0 unless the data are not finite
-            raise SingularConfigurationError("damped task matrix is not positive definite")
+    pivots = np.diagonal(factor) ** 2
+    if info != 0 or not math.isfinite(float(pivots.sum() + lam.sum())):
+        if not math.isfinite(float(gram.sum() + xdot.sum() + gradient.sum())):
+            raise ParameterError("inputs", "jacobian, xdot and gradient must be finite")
         raise SingularConfigurationError(
             "task Jacobian is rank deficient (J W^-1 J^T is not positive definite); "
             "use a damped inverse"
+        )
+    if damping == 0.0 and pivots.min() <= SINGULAR_RCOND * pivots.max():
+        raise SingularConfigurationError(
+            f"task Jacobian is nearly rank deficient (Cholesky pivots from {pivots.min():.3g} "
+            f"to {pivots.max():.3g}); use a damped inverse"
         )
     return free + jw.T @ lam
 

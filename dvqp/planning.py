@@ -18,13 +18,13 @@ from numpy.typing import NDArray
 
 import solvers
 from dvqp.developed_view import wrap, wrap_angle
-from dvqp.errors import BackendError, UnreachableTargetError
+from dvqp.errors import BackendError, ParameterError, UnreachableTargetError
 from dvqp.pinv import PseudoinverseResolver
 from dvqp.qp_resolver import QPResolver
 from dvqp.qp_step import StepConfig
 from dvqp.resolver import Resolver
 from dvqp.scene import PathMotion, Scene
-from dvqp.simulate import dv_error, jog_commands, simulate
+from dvqp.simulate import MAX_STEPS, dv_error, jog_commands, simulate
 from dvqp.state import KinematicState
 from dvqp.trajectory import Trajectory
 
@@ -120,10 +120,12 @@ def path_reference(
     wp[:, 0] += start[0] + wrap(wp[0, 0] - start[0], radius) - wp[0, 0]
     wp[:, 3] += start[3] + wrap_angle(wp[0, 3] - start[3]) - wp[0, 3]
     nodes = np.vstack([start, wp])
-    seg = np.linalg.norm(np.diff(nodes[:, :3], axis=0), axis=1)
+    seg = PathMotion.segment_lengths(nodes)
     keep = np.concatenate([[True], seg > 0.0])
     nodes, s = nodes[keep], np.concatenate([[0.0], np.cumsum(seg[seg > 0.0])])
     n_steps = max(1, math.ceil(s[-1] / (path.speed * dt) - 1e-9))
+    if n_steps > MAX_STEPS:
+        raise ParameterError("motion.path", f"{n_steps} steps is too many (at most {MAX_STEPS})")
     arc = np.minimum(path.speed * dt * np.arange(n_steps + 1), s[-1])
     return np.column_stack([np.interp(arc, s, nodes[:, c]) for c in range(4)])
 

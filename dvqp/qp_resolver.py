@@ -77,7 +77,10 @@ class QPResolver:
         solution = self._strict.solve(strict.problem)
         status = "optimal"
         if not solution.found:
-            relaxed = build_step_qp(self.config, state, g, xd, step, relax_task=True)
+            relaxed = build_step_qp(
+                self.config, state, g, xd, step, relax_task=True,
+                limits=(strict.inequalities, strict.bounds),
+            )  # fmt: skip
             solution = self._relaxed.solve(relaxed.problem)
             status = "relaxed"
         iterations = solution.iterations

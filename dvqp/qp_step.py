@@ -103,12 +103,15 @@ class StepProblem:
         The QP handed to a backend.
     inequalities : Constraint
         The rows of ``problem.G`` over ``Q̇`` (their labels say what each holds).
+    bounds : Bounds
+        The box on ``Q̇``, rad/s.
     relaxed : bool
         The task carries a slack (the last 4 variables).
     """
 
     problem: Problem
     inequalities: Constraint
+    bounds: Bounds
     relaxed: bool
 
     @property
@@ -125,6 +128,7 @@ def build_step_qp(
     dt: float,
     *,
     relax_task: bool = False,
+    limits: tuple[Constraint, Bounds] | None = None,
 ) -> StepProblem:
     """Assemble the QP of one step (pure: no solver involved).
 
@@ -142,18 +146,22 @@ def build_step_qp(
         Step, s.
     relax_task
         Add the slack ``s`` on the task equality.
+    limits
+        The inequalities and bounds of this state if already computed (e.g. by the strict
+        problem of the same step), so a relaxed retry does not assemble them again.
     """
     jac = state.tool_jacobian
     m = jac.shape[0]
-    ineq = config.inequalities(state, dt)
-    box = config.bounds(state, dt)
+    if limits is None:
+        limits = (config.inequalities(state, dt), config.bounds(state, dt))
+    ineq, box = limits
     if not relax_task:
         problem = Problem(
             P=config.hessian, q=-gradient, A=jac, b=xdot,
             G=ineq.G if ineq.rows else None, h=ineq.h if ineq.rows else None,
             lb=box.lb, ub=box.ub,
         )  # fmt: skip
-        return StepProblem(problem, ineq, relaxed=False)
+        return StepProblem(problem, ineq, box, relaxed=False)
     inf = np.full(m, np.inf)
     problem = Problem(
         P=np.diag(np.concatenate([config.weights, np.full(m, config.task_weight)])),
@@ -165,4 +173,4 @@ def build_step_qp(
         lb=np.concatenate([box.lb, -inf]),
         ub=np.concatenate([box.ub, inf]),
     )
-    return StepProblem(problem, ineq, relaxed=True)
+    return StepProblem(problem, ineq, box, relaxed=True)

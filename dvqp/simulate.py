@@ -24,6 +24,9 @@ from dvqp.robot import Robot
 from dvqp.state import KinematicState
 from dvqp.trajectory import Trajectory
 
+MAX_STEPS = 10_000_000
+"""Most steps a planned motion may take."""
+
 
 @dataclass(frozen=True)
 class JogSegment:
@@ -49,7 +52,10 @@ class JogSegment:
 def jog_commands(segments: Sequence[JogSegment], dt: float) -> NDArray[np.float64]:
     """Sample JOG segments every ``dt`` seconds: the commands, shape (N, 4)."""
     step = _validate.positive("dt", dt)
-    rows = [np.tile(s.velocity, (max(1, round(s.duration / step)), 1)) for s in segments]
+    counts = [max(1, round(s.duration / step)) for s in segments]
+    if sum(counts) > MAX_STEPS:
+        raise ParameterError("dt", f"{sum(counts)} steps is too many (at most {MAX_STEPS})")
+    rows = [np.tile(s.velocity, (c, 1)) for s, c in zip(segments, counts, strict=True)]
     return np.vstack(rows) if rows else np.zeros((0, 4))
 
 

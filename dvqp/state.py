@@ -16,7 +16,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
 from dvqp import developed_view as dv
-from dvqp.errors import SingularConfigurationError
 from dvqp.robot import Robot
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -92,26 +91,9 @@ class KinematicState:
         jac = np.array([pin.getFrameJacobian(model, data, i, _LWA) for i in ids])  # (m, 6, n)
         origins = frames[:, :3, 3]
         axes = frames[:, :3, 2]
-        x, y = origins[:, 0], origins[:, 1]
-        rho2 = x * x + y * y
-        rho = np.sqrt(rho2)
-        if not (rho >= dv.RHO_MIN).all():
-            i = int(np.argmin(rho))
-            raise SingularConfigurationError(
-                f"frame {robot.frame_names[i]!r} lies on the pipe axis (rho = {rho[i]:.3g} m)"
-            )
-        r = float(radius)
-        m, n = jac.shape[0], jac.shape[2]
-        pos = np.empty((m, 3))
-        pos[:, 0] = r * np.arctan2(y, x)
-        pos[:, 1] = origins[:, 2]
-        pos[:, 2] = rho - r
-        # Rows of ∂[l, z, h]/∂O · Jv, combined without forming the 3×3 blocks.
-        jx, jy = jac[:, 0, :], jac[:, 1, :]
-        lin = np.empty((m, 3, n))
-        lin[:, 0] = (r / rho2)[:, None] * (x[:, None] * jy - y[:, None] * jx)
-        lin[:, 1] = jac[:, 2, :]
-        lin[:, 2] = (x / rho)[:, None] * jx + (y / rho)[:, None] * jy
+        r = _validate.positive("radius", radius)
+        pos, lin = dv.position_and_rows(origins, jac[:, :3, :], r, robot.frame_names)
+        n = jac.shape[2]
         # Heading row: ∂α/∂O·Jv + ∂α/∂z·(−S(z)·Jω) = ∂α/∂O·Jv + (z × ∂α/∂z)·Jω  (ż = ω × z)
         ox, oy, _ = origins[-1].tolist()
         zx, zy, zz = axes[-1].tolist()

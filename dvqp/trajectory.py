@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -200,5 +201,5 @@ class Trajectory:
                         data["tracking_error"] if "tracking_error" in data else np.zeros((0, 4))
                     ),
                 )
-        except (OSError, KeyError, ValueError) as exc:
+        except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile) as exc:
             raise DvqpError(f"{path}: not a dvqp trajectory ({exc})") from exc

@@ -85,9 +85,11 @@ class Solution:
         """Build a solution and decide ``found`` from recomputed residuals.
 
         ``found`` is True iff ``x`` has shape (n,), is finite, its primal
-        residuals are ``<= tolerance`` and, when all multipliers are given,
-        stationarity and complementarity are ``<= tolerance * (1 + s)`` with
-        ``s = max(||P x||_inf, ||q||_inf)`` (they are in gradient units).
+        residuals are ``<= tolerance``, the multipliers of every constraint
+        kind present are given, and stationarity and complementarity are
+        ``<= tolerance * (1 + s)`` with ``s = max(||P x||_inf, ||q||_inf)``
+        (they are in gradient units). Without multipliers a feasible but
+        non-optimal ``x`` could not be told from the optimum, so it is refused.
 
         Parameters
         ----------
@@ -150,6 +152,8 @@ class Solution:
             for name, value, tol in checks
             if value is not None and not value <= tol
         ]
+        if res.stationarity is None:  # a feasible x is not yet an optimal one
+            failed.append("no multipliers were returned, so optimality cannot be checked")
         solution.found = not failed
         solution.message = f"{said} {', '.join(failed)}" if failed else ""
         return solution

@@ -75,9 +75,13 @@ def test_obstacle_across_the_seam_acts_on_a_point_near_the_other_side(
 def test_orbital_term_is_zero_at_the_orbital_level_and_negative_elsewhere(
     state0: KinematicState,
 ) -> None:
-    exact = Objective(n_points=5, orbital_level=0.0, k_height=0.0)
-    assert exact.orbital(state0).value == 0.0
-    assert objective_with([]).orbital(state0).value <= 0.0
+    h = state0.points[:, 2]
+    gains = np.array([0.0, 3.0, 0.0, 0.0, 0.0])  # only point 2 counts
+    at_level = Objective(n_points=5, orbital_level=float(h[1]), k_height=gains)
+    assert at_level.orbital(state0).value == 0.0
+    assert np.all(at_level.orbital(state0).gradient == 0.0)
+    off = Objective(n_points=5, orbital_level=float(h[1]) + 0.01, k_height=gains)
+    assert off.orbital(state0).value == pytest.approx(-0.5 * 3.0 * 0.01**2)
 
 
 def test_gradient_ascent_raises_w(robot: Robot, q0: np.ndarray) -> None:

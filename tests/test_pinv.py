@@ -67,3 +67,17 @@ def test_bad_inputs_raise_typed_errors(state0: KinematicState) -> None:
         PseudoinverseResolver(weights=[0.0] * 13)
     with pytest.raises(ParameterError, match="damping"):
         PseudoinverseResolver(damping=-1.0)
+
+
+def test_a_small_damping_is_finite_on_a_rank_deficient_task() -> None:
+    jac = np.zeros((4, 13))
+    jac[0, 0] = 1.0  # rank 1
+    for mu in (1e-3, 1e-6, 1e-9):
+        qdot = weighted_pinv_step(jac, np.ones(4), np.zeros(13), np.ones(13), damping=mu)
+        assert np.all(np.isfinite(qdot))
+
+
+def test_non_finite_inputs_are_refused_not_propagated() -> None:
+    jac = np.eye(4, 13)
+    with pytest.raises(ParameterError, match="finite"):
+        weighted_pinv_step(jac, np.array([np.nan, 0, 0, 0]), np.zeros(13), np.ones(13))

@@ -190,3 +190,14 @@ def test_saving_to_an_unknown_format_writes_nothing(tmp_path: Path) -> None:
     with pytest.raises(Exception, match="unknown format"):
         traj.save(tmp_path / "traj.txt")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_turn_in_place_takes_time_and_reaches_its_heading() -> None:
+    wp = np.array([[0.30, 0.35, 0.08, 0.0], [0.35, 0.35, 0.08, 0.0], [0.35, 0.35, 0.08, 1.0]])
+    start = wp[0].copy()
+    ref = path_reference(PathMotion(wp, speed=0.02), start, dt=0.01, radius=PIPE_RADIUS)
+    assert ref[-1, 3] == pytest.approx(1.0)
+    turning = np.abs(np.diff(ref[:, 3])) > 0
+    # 0.05 m of travel, then 1 rad counted as 0.1 m: 2.5 s + 5 s at 0.02 m/s, 0.01 s steps
+    assert ref.shape[0] == 751 and turning.sum() in (500, 501)
+    assert np.abs(np.diff(ref[:, 3])).max() <= 0.02 * 0.01 / 0.1 + 1e-12

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from solvers import Backend, Problem, Solution, SolverFailure
-from tests.solvers_qp_cases import KktCase, kkt_case
+from tests.solvers_qp_cases import KktCase, equality_case, kkt_case
 
 TOL = 1e-6
 
@@ -115,3 +115,13 @@ def test_failure_record_carries_message_and_no_answer(case: KktCase) -> None:
         case.problem, backend="fake", tolerance=TOL, status="exception", message="boom"
     )
     assert (solution.found, solution.x, solution.message) == (False, None, "boom")
+
+
+def test_an_answer_without_multipliers_is_not_trusted() -> None:
+    case = equality_case(np.random.default_rng(8))
+    with_duals = Solution.checked(
+        case.problem, case.x, backend="t", tolerance=1e-8, status="solved", y=case.y
+    )
+    assert with_duals.found
+    without = Solution.checked(case.problem, case.x, backend="t", tolerance=1e-8, status="solved")
+    assert not without.found and "no multipliers" in without.message

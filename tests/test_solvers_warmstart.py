@@ -107,12 +107,13 @@ def test_reset_makes_the_next_solve_cold() -> None:
     assert setups[0] == 2
 
 
-def exact(problem: Problem) -> np.ndarray:
-    """Closed-form solution of an equality-constrained QP."""
+def exact(problem: Problem, offset: float = 0.0) -> RawResult:
+    """Closed-form solution (x shifted by ``offset``) and multipliers of an equality QP."""
     assert problem.A is not None and problem.b is not None
     n, m = problem.n, problem.n_eq
     kkt = np.block([[problem.P, problem.A.T], [problem.A, np.zeros((m, m))]])
-    return np.linalg.solve(kkt, np.concatenate([-problem.q, problem.b]))[:n]
+    sol = np.linalg.solve(kkt, np.concatenate([-problem.q, problem.b]))
+    return RawResult(sol[:n] + offset, "solved", y=sol[n:])
 
 
 class Scripted(StatefulBackend):
@@ -131,13 +132,13 @@ class Scripted(StatefulBackend):
         self.setups += 1
         if isinstance(self.warm, type) and self.setups > 1:
             raise self.warm("cold set-up failed too")
-        return RawResult(exact(problem) + self.cold_offset, "solved")
+        return exact(problem, self.cold_offset)
 
     def _update(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
         self.updates += 1
         if isinstance(self.warm, type):
             raise self.warm("warm update failed")
-        return RawResult(exact(problem) + (self.warm or 0.0), "solved")
+        return exact(problem, self.warm or 0.0)
 
 
 PROBLEMS = [equality_case(np.random.default_rng(seed)).problem for seed in range(3)]

@@ -72,3 +72,9 @@ def test_nan_configuration_is_refused(robot: Robot, q0: np.ndarray) -> None:
     q0[3] = np.nan
     with pytest.raises(ValueError, match="finite"):
         KinematicState.compute(robot, q0, R)
+
+
+@pytest.mark.parametrize("radius", [np.nan, np.inf, 0.0, -0.1])
+def test_a_bad_pipe_radius_is_refused(robot: Robot, q0: np.ndarray, radius: float) -> None:
+    with pytest.raises(ValueError, match="radius"):
+        KinematicState.compute(robot, q0, radius)

@@ -64,3 +64,18 @@ def test_bad_targets_raise_before_writing(tmp_path: Path) -> None:
         straddling().save(tmp_path / "missing" / "t.npz")
     with pytest.raises(DvqpError, match="not a dvqp trajectory"):
         Trajectory.load(tmp_path / "absent.npz")
+
+
+@pytest.mark.parametrize("content", [b"", b"PK\x03\x04 not really a zip", b"plain text"])
+def test_a_corrupt_file_is_a_typed_error(tmp_path: Path, content: bytes) -> None:
+    bad = tmp_path / "bad.npz"
+    bad.write_bytes(content)
+    with pytest.raises(DvqpError, match="not a dvqp trajectory"):
+        Trajectory.load(bad)
+
+
+def test_an_unwritable_folder_is_refused_before_any_work() -> None:
+    if not Path("/proc/self").exists():
+        pytest.skip("needs /proc")
+    with pytest.raises(ParameterError, match="cannot write here"):
+        straddling().save("/proc/t.npz")
