@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp._files import atomic_file, output_path
-from dvqp.developed_view import unwrap
+from dvqp.developed_view import unwrap, wrap
 from dvqp.errors import DvqpError, ParameterError
 from dvqp.obstacles import Obstacle
 from dvqp.trajectory import Trajectory
@@ -249,9 +249,8 @@ def _scene(
 
 
 def _wrap(l: NDArray[np.float64] | float, radius: float) -> NDArray[np.float64]:
-    """Arc length wrapped into ``(−πR, πR]``, m."""
-    period = 2.0 * np.pi * radius
-    return np.asarray(l - period * np.ceil((np.asarray(l) - 0.5 * period) / period))
+    """Arc length wrapped into ``(−πR, πR]`` (atan2's interval), m."""
+    return -wrap(-np.asarray(l, dtype=np.float64), radius)  # wrap() gives [−πR, πR)
 
 
 def _body(traj: Trajectory, i: int) -> NDArray[np.float64]:
