@@ -1,0 +1,36 @@
+"""Write ``reference_runs.npz``: every bundled scene on the exact backends, as a regression record.
+
+The stored file was produced by this script on main at commit 4a597ea (before the step was
+composed from task, term and limit objects); ``tests/test_reference_runs.py`` checks that
+today's code reproduces it within 1e-9. Run ``python tests/data/make_reference_runs.py`` only
+when a change of results is intended, and say why in the commit.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from dvqp import load_scene, plan
+
+HERE = Path(__file__).resolve().parent
+SCENES = HERE.parent.parent / "scenes"
+BACKENDS = ("pinv", "daqp", "quadprog")
+FIELDS = ("q", "qdot", "w", "min_clearance", "task_error")
+
+
+def main() -> None:
+    out: dict[str, np.ndarray] = {}
+    for path in sorted(SCENES.glob("*.toml")):
+        scene = load_scene(path)
+        for backend in BACKENDS:
+            traj = plan(scene, backend)
+            for name in FIELDS:
+                out[f"{path.stem}/{backend}/{name}"] = getattr(traj, name)
+            out[f"{path.stem}/{backend}/status"] = np.asarray(traj.status, dtype=str)
+    np.savez_compressed(HERE / "reference_runs.npz", **out)
+
+
+if __name__ == "__main__":
+    main()
