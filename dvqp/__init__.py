@@ -20,15 +20,15 @@ from dvqp.errors import (
     UnreachableTargetError,
 )
 from dvqp.objective import Objective, Term
-from dvqp.obstacles import Obstacle
-from dvqp.pinv import PseudoinverseResolver
+from dvqp.geometry.obstacle import Obstacle
+from dvqp.resolution.pinv import PseudoinverseResolver
 from dvqp.planning import plan
-from dvqp.resolver import Resolver, Step
-from dvqp.robot import Robot
-from dvqp.scene import Scene, load_scene
-from dvqp.simulate import JogSegment, jog_commands, simulate
-from dvqp.state import KinematicState
-from dvqp.trajectory import Trajectory
+from dvqp.resolution.step import Resolver, Step
+from dvqp.kinematics.robot import Robot
+from dvqp.scenes.scene import Scene, load_scene
+from dvqp.motion.simulate import JogSegment, jog_commands, simulate
+from dvqp.kinematics.state import KinematicState
+from dvqp.motion.trajectory import Trajectory
 
 __version__ = "0.1.0"
 

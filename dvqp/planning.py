@@ -1,8 +1,8 @@
-"""Offline trajectory generation from a :class:`~dvqp.scene.Scene`.
+"""Offline trajectory generation from a :class:`~dvqp.scenes.scene.Scene`.
 
 :func:`plan` runs a scene's motion with a named backend: ``"pinv"`` is the paper's baseline
-(:class:`~dvqp.pinv.PseudoinverseResolver`), any other name a QP backend of :mod:`solvers`
-behind :class:`~dvqp.qp_resolver.QPResolver`. In JOG mode the tool gets the JOG velocities;
+(:class:`~dvqp.resolution.pinv.PseudoinverseResolver`), any other name a QP backend of :mod:`solvers`
+behind :class:`~dvqp.resolution.qp_resolver.QPResolver`. In JOG mode the tool gets the JOG velocities;
 in path mode it follows the waypoints with position feedback ``ẋ = ẋ_d + K(x_d − x)``.
 """
 
@@ -17,16 +17,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 import solvers
-from dvqp.developed_view import wrap, wrap_angle
+from dvqp.kinematics.developed_view import wrap, wrap_angle
 from dvqp.errors import BackendError, ParameterError, UnreachableTargetError
-from dvqp.pinv import PseudoinverseResolver
-from dvqp.qp_resolver import QPResolver
-from dvqp.qp_step import StepConfig
-from dvqp.resolver import Resolver
-from dvqp.scene import PathMotion, Scene
-from dvqp.simulate import MAX_STEPS, dv_error, jog_commands, simulate
-from dvqp.state import KinematicState
-from dvqp.trajectory import Trajectory
+from dvqp.resolution.pinv import PseudoinverseResolver
+from dvqp.resolution.qp_resolver import QPResolver
+from dvqp.resolution.qp import StepConfig
+from dvqp.resolution.step import Resolver
+from dvqp.scenes.scene import PathMotion, Scene
+from dvqp.motion.simulate import MAX_STEPS, dv_error, jog_commands, simulate
+from dvqp.kinematics.state import KinematicState
+from dvqp.motion.trajectory import Trajectory
 
 PINV = "pinv"
 """Name of the pseudoinverse baseline."""

@@ -14,8 +14,8 @@ import pytest
 
 from dvqp import KinematicState, Scene, Trajectory, load_scene, plan
 from dvqp.planning import failure, motion
-from dvqp.qp_step import StepConfig
-from dvqp.scene import loads
+from dvqp.resolution.qp import StepConfig
+from dvqp.scenes.scene import loads
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 

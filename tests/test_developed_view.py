@@ -3,7 +3,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from dvqp import developed_view as dv
+from dvqp.kinematics import developed_view as dv
 from dvqp.errors import SingularConfigurationError
 from tests.common import PIPE_RADIUS, central_difference
 

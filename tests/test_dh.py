@@ -2,9 +2,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from dvqp.dh import DHRow, check_transform, dh_transform, forward_dh, ndt13_table
+from dvqp.kinematics.dh import DHRow, check_transform, dh_transform, forward_dh, ndt13_table
 from dvqp.errors import ParameterError, ShapeError
-from dvqp.robot import NDT13_POINT_JOINTS, Robot
+from dvqp.kinematics.robot import NDT13_POINT_JOINTS, Robot
 from tests.common import LINK_LENGTHS, random_configurations
 
 

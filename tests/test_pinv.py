@@ -5,7 +5,7 @@ from hypothesis import strategies as st
 
 from dvqp import KinematicState, PseudoinverseResolver, Robot
 from dvqp.errors import ParameterError, ShapeError, SingularConfigurationError
-from dvqp.pinv import weighted_pinv_step
+from dvqp.resolution.pinv import weighted_pinv_step
 from tests.common import PIPE_RADIUS, random_configurations
 
 

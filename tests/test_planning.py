@@ -11,8 +11,8 @@ import pytest
 
 from dvqp import BackendError, KinematicState, Trajectory, plan
 from dvqp.planning import available_backends, default_backends, failure, motion, path_reference
-from dvqp.scene import PathMotion, Scene, loads
-from dvqp.simulate import dv_error
+from dvqp.scenes.scene import PathMotion, Scene, loads
+from dvqp.motion.simulate import dv_error
 from tests.common import PIPE_RADIUS
 
 SCENE = """

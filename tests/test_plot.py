@@ -20,9 +20,9 @@ from dvqp import (
     Robot,
     Trajectory,
     jog_commands,
-    plot,
     simulate,
 )
+from dvqp.cli import plot
 from tests.common import PIPE_RADIUS, Q0, objective_with
 
 pytest.importorskip("matplotlib")
@@ -193,10 +193,10 @@ def test_seam_wrapping_of_the_drawn_body(seam: Trajectory) -> None:
 
 
 def test_no_pyplot_and_an_unusable_interactive_backend(seam: Trajectory, tmp_path: Path) -> None:
-    """In a fresh process: dvqp.plot does not import matplotlib until called, never pyplot."""
+    """In a fresh process: dvqp.cli.plot does not import matplotlib until called, never pyplot."""
     seam.save(tmp_path / "run.npz")
     code = (
-        "import sys; import dvqp.plot as p; from dvqp import Trajectory\n"
+        "import sys; import dvqp.cli.plot as p; from dvqp import Trajectory\n"
         "assert 'matplotlib' not in sys.modules\n"
         f"p.plot_trajectory(Trajectory.load({str(tmp_path / 'run.npz')!r}), "
         f"{str(tmp_path / 'out.png')!r})\n"

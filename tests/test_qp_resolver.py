@@ -6,9 +6,9 @@ from dvqp import JogSegment, KinematicState, Obstacle, PseudoinverseResolver, Ro
 from dvqp import simulate as run
 from dvqp.errors import BackendError
 from dvqp.limits import DamperParameters
-from dvqp.pinv import weighted_pinv_step
-from dvqp.qp_resolver import QPResolver
-from dvqp.qp_step import StepConfig
+from dvqp.resolution.pinv import weighted_pinv_step
+from dvqp.resolution.qp_resolver import QPResolver
+from dvqp.resolution.qp import StepConfig
 from tests.common import LINK_LENGTHS, PIPE_RADIUS, objective_with, random_configurations
 
 DT = 0.005

@@ -3,8 +3,8 @@ import pytest
 
 from dvqp import KinematicState, Obstacle, Robot
 from dvqp.limits import DamperParameters, joint_position_bounds, obstacle_dampers, surface_height
-from dvqp.proximity import ObstacleSet, proximity
-from dvqp.qp_step import StepConfig, build_step_qp
+from dvqp.geometry.proximity import ObstacleSet, proximity
+from dvqp.resolution.qp import StepConfig, build_step_qp
 from tests.common import PIPE_RADIUS, central_difference
 
 DT = 0.005

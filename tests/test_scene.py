@@ -9,7 +9,7 @@ import pytest
 
 from dvqp import KinematicState, SceneError, load_scene, plan
 from dvqp.limits import DamperParameters
-from dvqp.scene import environment, loads
+from dvqp.scenes.scene import environment, loads
 from tests.common import LINK_LENGTHS, ORBITAL_LEVEL, PIPE_RADIUS, Q0
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"

@@ -11,7 +11,7 @@ from dvqp import (
     simulate,
 )
 from dvqp.errors import ParameterError, ShapeError
-from dvqp.simulate import dv_error, min_clearance
+from dvqp.motion.simulate import dv_error, min_clearance
 from tests.common import PIPE_RADIUS, objective_with
 
 DT = 0.005

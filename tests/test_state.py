@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from dvqp import KinematicState, Robot
-from dvqp import developed_view as dv
+from dvqp.kinematics import developed_view as dv
 from dvqp.errors import ShapeError
 from tests.common import PIPE_RADIUS, central_difference, random_configurations
 

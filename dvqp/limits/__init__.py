@@ -1,5 +1,5 @@
 """Limits of the QP step, one concept per module; each returns a :class:`Bounds` or a
-:class:`~dvqp.constraint.Constraint` built from a :class:`~dvqp.state.KinematicState`."""
+:class:`~dvqp.limits.limit.Constraint` built from a :class:`~dvqp.kinematics.state.KinematicState`."""
 
 from dvqp.limits.joint_position import joint_position_bounds
 from dvqp.limits.joint_velocity import joint_velocity_bounds

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from dvqp.constraint import Bounds
-from dvqp.robot import Robot
-from dvqp.state import KinematicState
+from dvqp.limits.limit import Bounds
+from dvqp.kinematics.robot import Robot
+from dvqp.kinematics.state import KinematicState
 
 
 def joint_position_bounds(robot: Robot, state: KinematicState, dt: float) -> Bounds:

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from dvqp.constraint import Bounds
-from dvqp.robot import Robot
+from dvqp.limits.limit import Bounds
+from dvqp.kinematics.robot import Robot
 
 
 def joint_velocity_bounds(robot: Robot) -> Bounds:

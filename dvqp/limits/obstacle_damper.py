@@ -19,10 +19,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from dvqp import _validate
-from dvqp.constraint import Constraint
+from dvqp.limits.limit import Constraint
 from dvqp.errors import ParameterError
-from dvqp.proximity import ObstacleSet, proximity
-from dvqp.state import KinematicState
+from dvqp.geometry.proximity import ObstacleSet, proximity
+from dvqp.kinematics.state import KinematicState
 
 _TINY = 1e-12
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from dvqp.constraint import Constraint
+from dvqp.limits.limit import Constraint
 from dvqp.limits.obstacle_damper import DamperParameters
-from dvqp.state import KinematicState
+from dvqp.kinematics.state import KinematicState
 
 
 def surface_height(state: KinematicState, params: DamperParameters, dt: float) -> Constraint:

@@ -15,14 +15,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
-from dvqp.developed_view import wrap, wrap_angle
+from dvqp.kinematics.developed_view import wrap, wrap_angle
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.objective import Objective
-from dvqp.proximity import proximity
-from dvqp.resolver import Resolver
-from dvqp.robot import Robot
-from dvqp.state import KinematicState
-from dvqp.trajectory import Trajectory
+from dvqp.geometry.proximity import proximity
+from dvqp.resolution.step import Resolver
+from dvqp.kinematics.robot import Robot
+from dvqp.kinematics.state import KinematicState
+from dvqp.motion.trajectory import Trajectory
 
 MAX_STEPS = 10_000_000
 """Most steps a planned motion may take."""

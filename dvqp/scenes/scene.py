@@ -18,15 +18,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp import _scene_sections as sec
-from dvqp._fields import Fields
-from dvqp._scene_sections import PathMotion
+from dvqp.scenes import sections as sec
+from dvqp.scenes.fields import Fields
+from dvqp.scenes.sections import PathMotion
 from dvqp.errors import SceneError
 from dvqp.limits import DamperParameters
 from dvqp.objective import Objective
-from dvqp.obstacles import Obstacle
-from dvqp.robot import Robot
-from dvqp.simulate import JogSegment
+from dvqp.geometry.obstacle import Obstacle
+from dvqp.kinematics.robot import Robot
+from dvqp.motion.simulate import JogSegment
 
 if sys.version_info >= (3, 11):
     import tomllib

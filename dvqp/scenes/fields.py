@@ -1,4 +1,4 @@
-"""Typed readers of parsed TOML tables for :mod:`dvqp.scene` (private).
+"""Typed readers of parsed TOML tables for :mod:`dvqp.scenes.scene` (private).
 
 Every reader takes the table, the key and the dotted path of the table (``"robot"``,
 ``"obstacles[1]"``) and raises :class:`~dvqp.errors.SceneError` naming the full field on a

@@ -9,7 +9,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp import _validate
-from dvqp.state import KinematicState
+from dvqp.kinematics.state import KinematicState
 
 
 @dataclass(frozen=True)

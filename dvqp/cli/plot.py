@@ -21,10 +21,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp._files import atomic_file, output_path
-from dvqp.developed_view import unwrap, wrap
+from dvqp.kinematics.developed_view import unwrap, wrap
 from dvqp.errors import DvqpError, ParameterError
-from dvqp.obstacles import Obstacle
-from dvqp.trajectory import Trajectory
+from dvqp.geometry.obstacle import Obstacle
+from dvqp.motion.trajectory import Trajectory
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from dvqp._files import output_path
-from dvqp.plot import FIGURE_FORMATS, _atomic, _figure
+from dvqp.cli.plot import FIGURE_FORMATS, _atomic, _figure
 
 
 def plot_comparison(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:

@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
-from dvqp.developed_view import wrap
+from dvqp.kinematics.developed_view import wrap
 
 
 @dataclass(frozen=True, eq=False)

@@ -18,12 +18,12 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from dvqp import compare as cmp
+from dvqp.cli import compare as cmp
 from dvqp import planning
 from dvqp._files import atomic_file, output_path
 from dvqp.errors import BackendError, DvqpError, SingularConfigurationError
-from dvqp.scene import environment, load_scene
-from dvqp.trajectory import Trajectory
+from dvqp.scenes.scene import environment, load_scene
+from dvqp.motion.trajectory import Trajectory
 
 TABLE = (  # (row key, header, format)
     ("scene", "scene", "{}"), ("backend", "backend", "{}"), ("success", "ok", "{}"),
@@ -150,7 +150,7 @@ def _compare(args: argparse.Namespace) -> int:
     if csv_out is not None:
         _write(csv_out, _csv(rows))
     if plot_out is not None:
-        from dvqp.plot_compare import plot_comparison
+        from dvqp.cli.plot_compare import plot_comparison
 
         plot_comparison(rows, plot_out)
     return 0 if all(row["success"] for row in rows) else 1
@@ -164,8 +164,8 @@ def _plot(args: argparse.Namespace) -> int:
         else None
     )
     try:
-        from dvqp import plot
-    except ImportError as exc:  # pragma: no cover - dvqp.plot ships with dvqp
+        from dvqp.cli import plot
+    except ImportError as exc:  # pragma: no cover - dvqp.cli.plot ships with dvqp
         raise DvqpError(f"plotting is not available: {exc}") from exc
     draw = plot.animate_trajectory if args.gif else plot.plot_trajectory
     kw: dict[str, Any] = {}

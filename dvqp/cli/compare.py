@@ -19,8 +19,8 @@ import numpy as np
 import solvers
 from dvqp.errors import DvqpError
 from dvqp.planning import PINV, failure, final_errors, plan
-from dvqp.scene import Scene, load_scene
-from dvqp.trajectory import Trajectory
+from dvqp.scenes.scene import Scene, load_scene
+from dvqp.motion.trajectory import Trajectory
 
 FIELDS = (
     "scene", "file", "backend", "success", "steps", "failures", "median_step_us", "p95_step_us",

@@ -21,8 +21,8 @@ from scipy.linalg.lapack import dposv
 
 from dvqp import _validate
 from dvqp.errors import ParameterError, SingularConfigurationError
-from dvqp.resolver import Step, step_inputs, task_error
-from dvqp.state import KinematicState
+from dvqp.resolution.step import Step, step_inputs, task_error
+from dvqp.kinematics.state import KinematicState
 
 SINGULAR_RCOND = 1e-10
 """Smallest ratio of Cholesky pivots of ``J̄ W⁻¹ J̄ᵀ`` (about its reciprocal condition number)

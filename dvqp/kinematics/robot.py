@@ -16,7 +16,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
-from dvqp.dh import DHRow, check_transform, fixed_part, ndt13_table
+from dvqp.kinematics.dh import DHRow, check_transform, fixed_part, ndt13_table
 from dvqp.errors import DvqpError, ParameterError
 
 NDT13_POINT_JOINTS = (4, 6, 8, 10, 13)

@@ -17,9 +17,9 @@ from numpy.typing import NDArray
 import solvers
 from dvqp import _validate
 from dvqp.errors import BackendError
-from dvqp.qp_step import StepConfig, build_step_qp
-from dvqp.resolver import Step, step_inputs, task_error
-from dvqp.state import KinematicState
+from dvqp.resolution.qp import StepConfig, build_step_qp
+from dvqp.resolution.step import Step, step_inputs, task_error
+from dvqp.kinematics.state import KinematicState
 
 
 def make_backend(name: str) -> solvers.Backend:

@@ -1,7 +1,7 @@
-"""Readers of the sections of a scene file for :mod:`dvqp.scene` (private).
+"""Readers of the sections of a scene file for :mod:`dvqp.scenes.scene` (private).
 
 Each reader takes the parsed TOML document (or a section of it) and returns typed objects,
-raising :class:`~dvqp.errors.SceneError` through :class:`~dvqp._fields.Fields`.
+raising :class:`~dvqp.errors.SceneError` through :class:`~dvqp.scenes.fields.Fields`.
 """
 
 from __future__ import annotations
@@ -14,14 +14,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp import _validate
-from dvqp._fields import Fields, join
+from dvqp.scenes.fields import Fields, join
 from dvqp.errors import DvqpError, ParameterError
 from dvqp.limits import DamperParameters
 from dvqp.objective import Objective
-from dvqp.obstacles import Obstacle, offsets
-from dvqp.robot import Robot
-from dvqp.simulate import MAX_STEPS, JogSegment
-from dvqp.state import KinematicState
+from dvqp.geometry.obstacle import Obstacle, offsets
+from dvqp.kinematics.robot import Robot
+from dvqp.motion.simulate import MAX_STEPS, JogSegment
+from dvqp.kinematics.state import KinematicState
 
 ROBOT_KEYS = ("model", "link_lengths", "urdf", "points", "tool", "q0", "q_min", "q_max", "qd_max",
               "weights")  # fmt: skip

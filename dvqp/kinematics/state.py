@@ -15,8 +15,8 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
-from dvqp import developed_view as dv
-from dvqp.robot import Robot
+from dvqp.kinematics import developed_view as dv
+from dvqp.kinematics.robot import Robot
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -44,7 +44,7 @@ class KinematicState:
     tool_jacobian : ndarray, shape (4, n)
         The DV task Jacobian ``J̄(Q)``.
     cache : dict
-        Quantities derived from this state once and shared (e.g. :func:`dvqp.proximity.proximity`).
+        Quantities derived from this state once and shared (e.g. :func:`dvqp.geometry.proximity.proximity`).
     """
 
     q: NDArray[np.float64]

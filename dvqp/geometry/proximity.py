@@ -2,7 +2,7 @@
 
 The objective's obstacle terms, the QP's dampers and the clearance diagnostic all need the
 offsets of the body points and links to every obstacle circle. :func:`proximity` computes them
-once for a :class:`~dvqp.state.KinematicState` and an :class:`ObstacleSet` and caches the
+once for a :class:`~dvqp.kinematics.state.KinematicState` and an :class:`ObstacleSet` and caches the
 result on the state, so each step does that geometry a single time.
 """
 
@@ -15,10 +15,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp import _validate
-from dvqp.developed_view import wrap
+from dvqp.kinematics.developed_view import wrap
 from dvqp.errors import ParameterError
-from dvqp.obstacles import Obstacle, offsets
-from dvqp.state import KinematicState
+from dvqp.geometry.obstacle import Obstacle, offsets
+from dvqp.kinematics.state import KinematicState
 
 
 class ObstacleSet:

@@ -18,9 +18,9 @@ from numpy.typing import NDArray
 
 from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
-from dvqp.obstacles import Obstacle
-from dvqp.proximity import ObstacleSet, proximity
-from dvqp.state import KinematicState
+from dvqp.geometry.obstacle import Obstacle
+from dvqp.geometry.proximity import ObstacleSet, proximity
+from dvqp.kinematics.state import KinematicState
 
 
 @dataclass(frozen=True)
@@ -46,7 +46,7 @@ class Objective:
     k_obstacle
         ``k¹``, scalar or shape (k,), >= 0; ``k¹_i`` also weights link i (points i, i+1).
     obstacles
-        Circles in the (l, z) plane (kept as an :class:`~dvqp.proximity.ObstacleSet`).
+        Circles in the (l, z) plane (kept as an :class:`~dvqp.geometry.proximity.ObstacleSet`).
     gain
         ``λ`` that scales ``∇w`` in the resolution step (>= 0).
     """

@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp._files import atomic_file, output_path
-from dvqp.developed_view import unwrap
+from dvqp.kinematics.developed_view import unwrap
 from dvqp.errors import DvqpError
 
 ARRAYS = (

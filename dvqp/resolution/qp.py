@@ -9,7 +9,7 @@ Decision variable ``x = Q̇`` (rad/s), or ``x = [Q̇; s]`` when the task is rela
                 lb ≤ Q̇ ≤ ub                          joint position (one step ahead) and velocity
 
 With no active inequality its KKT conditions are exactly the weighted pseudoinverse step
-(:func:`dvqp.pinv.weighted_pinv_step`).
+(:func:`dvqp.resolution.pinv.weighted_pinv_step`).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
-from dvqp.constraint import Bounds, Constraint
+from dvqp.limits.limit import Bounds, Constraint
 from dvqp.errors import ParameterError
 from dvqp.limits import (
     DamperParameters,
@@ -29,10 +29,10 @@ from dvqp.limits import (
     obstacle_dampers,
     surface_height,
 )
-from dvqp.obstacles import Obstacle
-from dvqp.proximity import ObstacleSet
-from dvqp.robot import Robot
-from dvqp.state import KinematicState
+from dvqp.geometry.obstacle import Obstacle
+from dvqp.geometry.proximity import ObstacleSet
+from dvqp.kinematics.robot import Robot
+from dvqp.kinematics.state import KinematicState
 from solvers import Problem
 
 DEFAULT_TASK_WEIGHT = 1e4
