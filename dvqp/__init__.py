@@ -1,13 +1,16 @@
 """dvqp: QP-based redundancy resolution of hyper-redundant manipulators in a pipe's developed view.
 
-The pieces, in the order a step uses them:
+The pieces, in the order a step uses them (one subpackage each):
 
-- :class:`Robot` — Pinocchio model, body-point and tool frames, joint limits;
-- :class:`KinematicState` — one kinematics update per step, in Cartesian and DV coordinates;
-- :class:`Objective` — the paper's ``w(Q)`` with its gradient, :class:`Obstacle` circles;
-- resolvers — :class:`PseudoinverseResolver` (paper eq. 18) and the per-step QP;
-- :func:`simulate` — JOG / path integration into a :class:`Trajectory`;
-- :func:`load_scene` and :func:`plan` — a scene file run with a named backend.
+- :mod:`dvqp.kinematics` — :class:`Robot` on Pinocchio and the per-step :class:`KinematicState`;
+- :mod:`dvqp.geometry` — :class:`Obstacle` circles and the body's proximity to them;
+- :mod:`dvqp.tasks` — what the joints must do: the tool's DV task :class:`ToolTask`;
+- :mod:`dvqp.objective` — ``w(Q)`` as a sum of terms, :class:`Objective`;
+- :mod:`dvqp.limits` — joint, obstacle and height limits, each ``Constraint(G, h)`` or ``Bounds``;
+- :mod:`dvqp.resolution` — :class:`StepSpec`, the QP built from it, the QP and pseudoinverse
+  resolvers and the registry of their names;
+- :mod:`dvqp.motion` — JOG and path commands, :func:`simulate`, :class:`Trajectory`;
+- :mod:`dvqp.scenes` — scene files; :func:`plan` runs one with a named backend.
 """
 
 from dvqp.errors import (
@@ -19,28 +22,41 @@ from dvqp.errors import (
     SingularConfigurationError,
     UnreachableTargetError,
 )
-from dvqp.objective import Objective, Term
-from dvqp.geometry.obstacle import Obstacle
-from dvqp.resolution.pinv import PseudoinverseResolver
-from dvqp.planning import plan
-from dvqp.resolution.step import Resolver, Step
-from dvqp.kinematics.robot import Robot
-from dvqp.scenes.scene import Scene, load_scene
-from dvqp.motion.simulate import JogSegment, jog_commands, simulate
-from dvqp.kinematics.state import KinematicState
-from dvqp.motion.trajectory import Trajectory
+from dvqp.geometry import Obstacle, ObstacleSet
+from dvqp.kinematics import KinematicState, Robot
+from dvqp.limits import Bounds, Constraint, Limit, VelocityDamper
+from dvqp.motion import JogSegment, ToolPath, Trajectory, jog_commands, simulate
+from dvqp.objective import Objective, ObjectiveTerm, Term
+from dvqp.planning import check_run, plan
+from dvqp.resolution import (
+    PseudoinverseResolver,
+    QPResolver,
+    Resolver,
+    Step,
+    StepSpec,
+    build_qp,
+    make_resolver,
+)
+from dvqp.scenes import Scene, load_scene
+from dvqp.tasks import Task, TaskRows, ToolTask
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 __all__ = [
     "BackendError",
+    "Bounds",
+    "Constraint",
     "DvqpError",
     "JogSegment",
     "KinematicState",
+    "Limit",
     "Objective",
+    "ObjectiveTerm",
     "Obstacle",
+    "ObstacleSet",
     "ParameterError",
     "PseudoinverseResolver",
+    "QPResolver",
     "Resolver",
     "Robot",
     "Scene",
@@ -48,12 +64,21 @@ __all__ = [
     "ShapeError",
     "SingularConfigurationError",
     "Step",
+    "StepSpec",
+    "Task",
+    "TaskRows",
     "Term",
+    "ToolPath",
+    "ToolTask",
     "Trajectory",
     "UnreachableTargetError",
+    "VelocityDamper",
     "__version__",
+    "build_qp",
+    "check_run",
     "jog_commands",
     "load_scene",
+    "make_resolver",
     "plan",
     "simulate",
 ]

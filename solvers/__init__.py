@@ -8,21 +8,32 @@
 from .exceptions import ProblemShapeError, SolverError, SolverFailure, UnknownBackendError
 from .problem import Problem
 from .protocol import Backend
-from .registry import available_backends, backend_versions, make_backend
+from .registry import (
+    BackendInfo,
+    available_backends,
+    backend_versions,
+    describe_backends,
+    make_backend,
+)
 from .residuals import Residuals, residuals
 from .solution import Solution
+from .stateful import RawResult, StatefulBackend
 
 __all__ = [
     "Backend",
+    "BackendInfo",
     "Problem",
     "ProblemShapeError",
+    "RawResult",
     "Residuals",
     "Solution",
     "SolverError",
     "SolverFailure",
+    "StatefulBackend",
     "UnknownBackendError",
     "available_backends",
     "backend_versions",
+    "describe_backends",
     "make_backend",
     "residuals",
 ]

@@ -23,8 +23,8 @@ import clarabel
 import numpy as np
 
 from ._csc import CscPattern
-from ._stateful import RawResult, StatefulBackend
 from .problem import Problem
+from .stateful import RawResult, StatefulBackend
 
 
 def _finite_masks(problem: Problem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -24,8 +24,8 @@ from typing import Any, ClassVar
 import daqp
 import numpy as np
 
-from ._stateful import RawResult, StatefulBackend
 from .problem import Problem
+from .stateful import RawResult, StatefulBackend
 
 #: DAQP exit flags, from DAQP's ``constants.h``.
 EXIT_FLAGS = {

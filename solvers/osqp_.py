@@ -26,8 +26,8 @@ import numpy as np
 import osqp
 
 from ._csc import CscPattern
-from ._stateful import RawResult, StatefulBackend
 from .problem import Problem
+from .stateful import RawResult, StatefulBackend
 
 
 class OsqpBackend(StatefulBackend):

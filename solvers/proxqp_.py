@@ -22,8 +22,8 @@ from typing import Any, ClassVar
 import numpy as np
 from proxsuite import proxqp
 
-from ._stateful import RawResult, StatefulBackend
 from .problem import Problem
+from .stateful import RawResult, StatefulBackend
 
 
 class ProxqpBackend(StatefulBackend):

@@ -20,9 +20,9 @@ import numpy as np
 import qpsolvers
 import scipy.sparse as sp
 
-from ._stateful import RawResult, check_initvals, solve_guarded
 from .problem import Problem
 from .solution import Solution
+from .stateful import RawResult, check_initvals, solve_guarded
 
 #: Settings that push each solver to ~1e-7 accuracy on ``x`` (defaults are looser).
 SETTINGS: dict[str, dict[str, Any]] = {

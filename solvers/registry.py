@@ -4,7 +4,8 @@ Plain names are the best adapter for a solver: the direct stateful adapters
 for ``osqp``, ``clarabel``, ``daqp`` and ``proxqp``, the generic ``qpsolvers``
 path for every other solver ``qpsolvers`` finds (``quadprog``, ``piqp``,
 ``highs``, ...). ``qpsolvers:NAME`` forces the generic path for any solver
-``qpsolvers`` has installed.
+``qpsolvers`` has installed. :func:`describe_backends` says which package
+(and version) is behind each name.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from __future__ import annotations
 import functools
 import importlib
 from collections.abc import Callable
+from dataclasses import dataclass
 from importlib import metadata
 from typing import Any
 
@@ -19,6 +21,9 @@ from .exceptions import UnknownBackendError
 from .protocol import Backend
 
 QPSOLVERS_PREFIX = "qpsolvers:"
+
+#: Version shown for a distribution whose metadata is not found.
+UNKNOWN = "?"
 
 #: Direct adapters: backend name -> (module, class name).
 DIRECT: dict[str, tuple[str, str]] = {
@@ -60,7 +65,8 @@ def _generic(solver: str, name: str) -> Factory:
 
 
 @functools.cache
-def _factories() -> dict[str, Factory]:
+def _direct_factories() -> dict[str, Factory]:
+    """The direct adapters whose solver package imports here."""
     factories: dict[str, Factory] = {}
     for name, (module_name, class_name) in DIRECT.items():
         try:
@@ -68,6 +74,12 @@ def _factories() -> dict[str, Factory]:
         except ImportError:
             continue
         factories[name] = getattr(module, class_name)
+    return factories
+
+
+@functools.cache
+def _factories() -> dict[str, Factory]:
+    factories = dict(_direct_factories())
     for solver in _qpsolvers_names():
         factories.setdefault(solver, _generic(solver, solver))
         factories[QPSOLVERS_PREFIX + solver] = _generic(solver, QPSOLVERS_PREFIX + solver)
@@ -122,10 +134,54 @@ def backend_versions() -> dict[str, str]:
     """
     solvers = {name.removeprefix(QPSOLVERS_PREFIX) for name in _factories()}
     distributions = {"qpsolvers", *(DISTRIBUTIONS.get(s, s) for s in solvers)}
-    versions: dict[str, str] = {}
-    for dist in sorted(distributions):
-        try:
-            versions[dist] = metadata.version(dist)
-        except metadata.PackageNotFoundError:
-            continue
-    return versions
+    versions = {dist: _version(dist) for dist in sorted(distributions)}
+    return {dist: version for dist, version in versions.items() if version != UNKNOWN}
+
+
+@dataclass(frozen=True)
+class BackendInfo:
+    """The package behind one backend name.
+
+    Attributes
+    ----------
+    name : str
+        The name :func:`make_backend` accepts, e.g. ``'daqp'`` or ``'qpsolvers:quadprog'``.
+    distribution : str
+        The Python distribution of the solver, e.g. ``'proxsuite'`` for ``proxqp``.
+    version : str
+        Its installed version, ``'?'`` if unknown.
+    note : str
+        How the solver is reached: ``'via qpsolvers 4.13.0'`` on the generic path, ``''``
+        for a direct adapter.
+    """
+
+    name: str
+    distribution: str
+    version: str
+    note: str
+
+
+def describe_backends() -> list[BackendInfo]:
+    """One :class:`BackendInfo` per name of :func:`available_backends`, in that order.
+
+    Returns
+    -------
+    list of BackendInfo
+        E.g. ``BackendInfo('highs', 'highspy', '1.16.0', 'via qpsolvers 4.13.0')``.
+    """
+    direct = _direct_factories()
+    via = f"via qpsolvers {_version('qpsolvers')}"
+    infos = []
+    for name in available_backends():
+        solver = name.removeprefix(QPSOLVERS_PREFIX)
+        dist = DISTRIBUTIONS.get(solver, solver)
+        infos.append(BackendInfo(name, dist, _version(dist), "" if name in direct else via))
+    return infos
+
+
+def _version(distribution: str) -> str:
+    """The installed version of a distribution, :data:`UNKNOWN` if it is not found."""
+    try:
+        return metadata.version(distribution)
+    except metadata.PackageNotFoundError:
+        return UNKNOWN

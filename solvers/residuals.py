@@ -48,11 +48,6 @@ class Residuals:
     stationarity: float | None = None
     complementarity: float | None = None
 
-    @property
-    def max_primal(self) -> float:
-        """Largest primal violation (equality, inequality or bounds)."""
-        return max(self.equality, self.inequality, self.bounds)
-
 
 def _multiplier(name: str, value: npt.ArrayLike | None, size: int) -> np.ndarray | None:
     if value is None:
@@ -112,18 +107,26 @@ def kkt_residuals(
         complementarity = max(-float(z.min()), _slack_product(z, slack_in, h_finite))
     if z_box is not None:
         gradient += z_box
-        if slack_ub is not None and slack_lb is not None and ub_finite and lb_finite:
-            # z_box > 0 pairs with the upper slack, z_box < 0 with the lower one.
-            paired = np.where(z_box > 0.0, slack_ub, slack_lb)
-            complementarity = max(complementarity, float(np.abs(z_box * paired).max()))
-        else:
-            complementarity = max(complementarity, _box_product(z_box, slack_ub, ub_finite))
-            complementarity = max(
-                complementarity,
-                _box_product(-z_box, slack_lb, lb_finite),
-            )
+        bound = _bound_complementarity(z_box, slack_lb, slack_ub, lb_finite, ub_finite)
+        complementarity = max(complementarity, bound)
     stationarity = float(np.abs(gradient).max()) if p.n else 0.0
     return Residuals(equality, inequality, bounds, stationarity, max(complementarity, 0.0)), scale
+
+
+def _bound_complementarity(
+    z_box: np.ndarray,
+    slack_lb: np.ndarray | None,
+    slack_ub: np.ndarray | None,
+    lb_finite: bool,
+    ub_finite: bool,
+) -> float:
+    """Largest ``|z_box| * slack`` of the bounds, each sign paired with its side of the box."""
+    if slack_ub is not None and slack_lb is not None and ub_finite and lb_finite:
+        # z_box > 0 pairs with the upper slack, z_box < 0 with the lower one.
+        paired = np.where(z_box > 0.0, slack_ub, slack_lb)
+        return float(np.abs(z_box * paired).max())
+    upper = _box_product(z_box, slack_ub, ub_finite)
+    return max(upper, _box_product(-z_box, slack_lb, lb_finite))
 
 
 def _box_product(multiplier: np.ndarray, slack: np.ndarray | None, finite: bool) -> float:

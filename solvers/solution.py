@@ -118,42 +118,19 @@ class Solution:
             solve_time=solve_time,
             retried=retried,
         )
-        said = f"{backend} said {status!r} but"
         if x is None:
             solution.message = f"{backend} returned no solution (status {status!r})"
             return solution
-        try:
-            answer = np.array(x, dtype=np.float64)
-        except (TypeError, ValueError):
-            solution.message = f"{said} x is not a numeric array"
-            return solution
+        said = f"{backend} said {status!r} but"
+        answer, flaw = _primal(problem, x)
         solution.x = answer
-        if answer.shape != (problem.n,):
-            solution.message = f"{said} x has shape {answer.shape}, expected ({problem.n},)"
+        if answer is None or flaw:
+            solution.message = f"{said} {flaw}"
             return solution
-        if not math.isfinite(float(answer.sum())):
-            solution.message = f"{said} x is not finite"
-            return solution
-        solution.y, solution.z, solution.z_box = (
-            None if v is None else np.array(v, dtype=np.float64) for v in (y, z, z_box)
-        )
+        solution.y, solution.z, solution.z_box = (_floats(v) for v in (y, z, z_box))
         res, scale = kkt_residuals(problem, answer, solution.y, solution.z, solution.z_box)
         solution.residuals = res
-        dual_tol = tolerance * (1.0 + scale)
-        checks = [
-            ("equality", res.equality, tolerance),
-            ("inequality", res.inequality, tolerance),
-            ("bounds", res.bounds, tolerance),
-            ("stationarity", res.stationarity, dual_tol),
-            ("complementarity", res.complementarity, dual_tol),
-        ]
-        failed = [
-            f"{name} residual {value:.1e} > tol {tol:.2g}"
-            for name, value, tol in checks
-            if value is not None and not value <= tol
-        ]
-        if res.stationarity is None:  # a feasible x is not yet an optimal one
-            failed.append("no multipliers were returned, so optimality cannot be checked")
+        failed = _failed_checks(res, tolerance, scale)
         solution.found = not failed
         solution.message = f"{said} {', '.join(failed)}" if failed else ""
         return solution
@@ -199,3 +176,57 @@ class Solution:
         if not self.found or self.x is None:
             raise SolverFailure(self)
         return self.x
+
+
+def _primal(problem: Problem, x: npt.ArrayLike) -> tuple[np.ndarray | None, str]:
+    """``x`` as a float64 array (None if not numeric) and why it is unusable (``''`` if not)."""
+    try:
+        answer = np.array(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        return None, "x is not a numeric array"
+    if answer.shape != (problem.n,):
+        return answer, f"x has shape {answer.shape}, expected ({problem.n},)"
+    if not math.isfinite(float(answer.sum())):
+        return answer, "x is not finite"
+    return answer, ""
+
+
+def _floats(value: npt.ArrayLike | None) -> np.ndarray | None:
+    """A multiplier as a float64 array, or None."""
+    return None if value is None else np.array(value, dtype=np.float64)
+
+
+def _failed_checks(res: Residuals, tolerance: float, scale: float) -> list[str]:
+    """One phrase per residual above its tolerance, and one if optimality is unchecked.
+
+    Parameters
+    ----------
+    res : Residuals
+        The recomputed residuals.
+    tolerance : float
+        Absolute tolerance on the primal residuals.
+    scale : float
+        Gradient scale ``max(||P x||_inf, ||q||_inf)``; the dual residuals (stationarity,
+        complementarity) are held to ``tolerance * (1 + scale)``.
+
+    Returns
+    -------
+    list of str
+        Empty when the solution is accepted.
+    """
+    dual_tol = tolerance * (1.0 + scale)
+    checks = [
+        ("equality", res.equality, tolerance),
+        ("inequality", res.inequality, tolerance),
+        ("bounds", res.bounds, tolerance),
+        ("stationarity", res.stationarity, dual_tol),
+        ("complementarity", res.complementarity, dual_tol),
+    ]
+    failed = [
+        f"{name} residual {value:.1e} > tol {tol:.2g}"
+        for name, value, tol in checks
+        if value is not None and not value <= tol
+    ]
+    if res.stationarity is None:  # a feasible x is not yet an optimal one
+        failed.append("no multipliers were returned, so optimality cannot be checked")
+    return failed

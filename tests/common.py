@@ -3,8 +3,18 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from dvqp import Objective, Obstacle
+from dvqp import (
+    KinematicState,
+    Objective,
+    Obstacle,
+    ObstacleSet,
+    PseudoinverseResolver,
+    StepSpec,
+    Term,
+    ToolTask,
+)
 
 PIPE_RADIUS = 0.254
 ORBITAL_LEVEL = 0.08
@@ -33,8 +43,8 @@ def random_configurations(count: int, seed: int = 0, spread: float = 0.6) -> np.
 
 
 def objective_with(obstacles: list[Obstacle], **kw: object) -> Objective:
-    """The paper's objective (5 points, h* = 0.08 m) with the given obstacles."""
-    return Objective(n_points=5, orbital_level=ORBITAL_LEVEL, obstacles=tuple(obstacles), **kw)  # type: ignore[arg-type]
+    """The paper's objective (h* = 0.08 m) with the given obstacles."""
+    return Objective.paper(ORBITAL_LEVEL, ObstacleSet(obstacles), **kw)  # type: ignore[arg-type]
 
 
 def central_difference(f, x: np.ndarray, eps: float = 1e-6, wrap=None) -> np.ndarray:  # type: ignore[no-untyped-def]
@@ -51,3 +61,31 @@ def central_difference(f, x: np.ndarray, eps: float = 1e-6, wrap=None) -> np.nda
             d = wrap(d)
         cols.append(d / (2 * eps))
     return np.stack(cols, axis=-1)
+
+
+class ConstantGradient:
+    """An objective term with value 0 and a fixed gradient (to feed a resolver a given g)."""
+
+    name = "constant"
+
+    def __init__(self, gradient: ArrayLike) -> None:
+        self.gradient = np.asarray(gradient, dtype=float)
+
+    def evaluate(self, state: KinematicState) -> Term:
+        return Term(0.0, self.gradient)
+
+
+def spec_with(gradient: ArrayLike, weights: ArrayLike = 1.0, limits: tuple = ()) -> StepSpec:  # type: ignore[type-arg]
+    """The tool's DV task, ``g = gradient`` (λ = 1), the given weights and limits."""
+    objective = Objective((ConstantGradient(gradient),), gain=1.0)
+    return StepSpec((ToolTask(),), objective, limits, weights)
+
+
+def baseline(objective: Objective) -> PseudoinverseResolver:
+    """The paper's baseline on the tool's DV task and ``objective``."""
+    return PseudoinverseResolver(StepSpec((ToolTask(),), objective))
+
+
+def obstacles_of(objective: Objective) -> ObstacleSet:
+    """The obstacle set of an objective made by :func:`objective_with`."""
+    return objective.terms[1].obstacles  # type: ignore[attr-defined, no-any-return]

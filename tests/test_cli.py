@@ -11,6 +11,7 @@ import pytest
 
 from dvqp import Trajectory
 from dvqp.cli import main
+from dvqp.resolution.registry import available_resolvers
 from tests.common import Q0
 
 SCENE = """
@@ -237,7 +238,12 @@ def test_backends_lists_pinv_and_the_installed_solvers(capsys: pytest.CaptureFix
     assert main(["backends"]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith("pinv ") and "dvqp" in lines[0]
+    assert lines[0].endswith("(pseudoinverse baseline, paper eq. 18)")
+    assert [line.split()[0] for line in lines] == available_resolvers()
     assert any(line.split()[0] == "osqp" and line.split()[1] == "osqp" for line in lines)
+    for line in lines:
+        generic = line.startswith("qpsolvers:")
+        assert generic <= (" via qpsolvers " in line), line
 
 
 def test_usage_errors_exit_2_and_help_exits_0(capsys: pytest.CaptureFixture[str]) -> None:

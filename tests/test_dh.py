@@ -2,8 +2,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from dvqp.kinematics.dh import DHRow, check_transform, dh_transform, forward_dh, ndt13_table
 from dvqp.errors import ParameterError, ShapeError
+from dvqp.kinematics.dh import DHRow, check_transform, dh_transform, forward_dh, ndt13_table
 from dvqp.kinematics.robot import NDT13_POINT_JOINTS, Robot
 from tests.common import LINK_LENGTHS, random_configurations
 

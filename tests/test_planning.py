@@ -10,9 +10,12 @@ import numpy as np
 import pytest
 
 from dvqp import BackendError, KinematicState, Trajectory, plan
-from dvqp.planning import available_backends, default_backends, failure, motion, path_reference
-from dvqp.scenes.scene import PathMotion, Scene, loads
+from dvqp.errors import UnreachableTargetError
+from dvqp.motion.path import ToolPath
 from dvqp.motion.simulate import dv_error
+from dvqp.planning import check_run, scene_commands
+from dvqp.resolution.registry import available_resolvers, default_resolvers
+from dvqp.scenes.scene import Scene, loads
 from tests.common import PIPE_RADIUS
 
 SCENE = """
@@ -52,24 +55,24 @@ def path(waypoints: str, speed: float = 0.1, extra: str = "") -> str:
 
 
 def test_backend_names_are_pinv_then_the_installed_qp_backends() -> None:
-    names = available_backends()
+    names = available_resolvers()
     assert names[0] == "pinv" and len(names) == len(set(names))
-    assert default_backends()[0] == "pinv"
-    assert all(":" not in b for b in default_backends())
-    assert set(default_backends()) <= set(names)
+    assert default_resolvers()[0] == "pinv"
+    assert all(":" not in b for b in default_resolvers())
+    assert set(default_resolvers()) <= set(names)
 
 
 def test_an_unknown_backend_lists_the_installed_ones() -> None:
     with pytest.raises(BackendError) as info:
         plan(scene(), "no-such-solver")
     assert str(info.value).startswith("unknown backend 'no-such-solver'; installed: pinv, ")
-    assert ", ".join(available_backends()) in str(info.value)
+    assert ", ".join(available_resolvers()) in str(info.value)
 
 
 def test_jog_reference_is_the_start_plus_the_integrated_commands() -> None:
     s = scene()
-    m = motion(s)
-    assert m.commands.shape == (30, 4) and m.reference.shape == (31, 4)
+    m = scene_commands(s)
+    assert m.velocity.shape == (30, 4) and m.reference.shape == (31, 4)
     assert m.feedback_gain == 0.0
     start = KinematicState.compute(s.robot, s.q0, s.pipe_radius).tool
     np.testing.assert_allclose(m.reference[0], start)
@@ -82,13 +85,13 @@ def test_a_jog_plan_tracks_its_commands_and_carries_the_scene() -> None:
     assert traj.ok and traj.backend == "pinv" and traj.scene_text == s.text
     assert traj.tracking_error.shape == (31, 4)
     assert np.abs(traj.tracking_error[:, :3]).max() < 2e-4  # Euler drift only
-    assert failure(s, traj) is None
+    check_run(s, traj)
 
 
 def test_path_reference_moves_at_constant_speed_through_every_waypoint() -> None:
     wp = np.array([[0.30, 0.35, 0.08, 0.0], [0.40, 0.35, 0.08, 0.5], [0.40, 0.30, 0.08, 0.5]])
     start = np.array([0.30, 0.35, 0.08, 0.0])
-    ref = path_reference(PathMotion(wp, speed=0.1), start, dt=0.01, radius=PIPE_RADIUS)
+    ref = ToolPath(wp, speed=0.1).reference(start, dt=0.01, radius=PIPE_RADIUS)
     assert ref.shape == (151, 4)  # 0.15 m at 0.1 m/s, 0.01 s steps
     step = np.linalg.norm(np.diff(ref[:, :3], axis=0), axis=1)
     np.testing.assert_allclose(step[step > 0], 1e-3, rtol=1e-9, atol=0.3e-3)
@@ -102,7 +105,7 @@ def test_path_reference_moves_at_constant_speed_through_every_waypoint() -> None
 def test_path_reference_approaches_the_first_waypoint_from_the_start() -> None:
     wp = np.array([[0.32, 0.35, 0.08, 0.0], [0.42, 0.35, 0.08, 0.0]])
     start = np.array([0.30, 0.35, 0.08, 0.0])
-    ref = path_reference(PathMotion(wp, speed=0.1), start, dt=0.01, radius=PIPE_RADIUS)
+    ref = ToolPath(wp, speed=0.1).reference(start, dt=0.01, radius=PIPE_RADIUS)
     assert ref.shape == (121, 4)  # 0.02 m approach + 0.10 m path at 0.1 m/s, 0.01 s steps
     np.testing.assert_allclose(ref[[0, 20, -1], 0], [0.30, 0.32, 0.42])
 
@@ -111,7 +114,7 @@ def test_waypoints_written_a_turn_away_are_shifted_by_whole_turns() -> None:
     turn = 2 * np.pi * PIPE_RADIUS
     wp = np.array([[0.30 + turn, 0.35, 0.08, 2 * np.pi], [0.40 + turn, 0.35, 0.08, 2 * np.pi]])
     start = np.array([0.30, 0.35, 0.08, 0.0])
-    ref = path_reference(PathMotion(wp, speed=0.1), start, dt=0.01, radius=PIPE_RADIUS)
+    ref = ToolPath(wp, speed=0.1).reference(start, dt=0.01, radius=PIPE_RADIUS)
     assert ref.shape == (101, 4)  # no approach over a whole turn
     np.testing.assert_allclose(ref[-1], [0.40, 0.35, 0.08, 0.0], atol=1e-12)
 
@@ -119,16 +122,17 @@ def test_waypoints_written_a_turn_away_are_shifted_by_whole_turns() -> None:
 def test_path_following_across_the_seam_keeps_the_tracking_error_bounded() -> None:
     # carriage turned so the tool starts at l = 0.75 m, just before the seam πR = 0.798 m
     s = scene(path("[[0.75, 0.35, 0.082, 0.0], [0.90, 0.35, 0.082, 0.2]]"), q1=3.35308, dt=0.01)
-    backends = ["pinv"] + (["daqp"] if "daqp" in available_backends() else [])
+    backends = ["pinv"] + (["daqp"] if "daqp" in available_resolvers() else [])
     for backend in backends:
         traj = plan(s, backend)
-        assert traj.ok and failure(s, traj) is None, backend
-        assert traj.dv[0, 0] < math.pi * PIPE_RADIUS < traj.dv[-1, 0]  # crossed, unwrapped
-        np.testing.assert_allclose(traj.dv[-1], [0.90, 0.35, 0.082, 0.2], atol=2e-4)
+        assert traj.ok, backend
+        check_run(s, traj)
+        assert traj.tool[0, 0] < math.pi * PIPE_RADIUS < traj.tool[-1, 0]  # crossed, unwrapped
+        np.testing.assert_allclose(traj.tool[-1], [0.90, 0.35, 0.082, 0.2], atol=2e-4)
         assert np.abs(traj.tracking_error[:, :3]).max() < 5e-4
         assert np.abs(traj.tracking_error[:, 3]).max() < 5e-3
         wrapped = np.arctan2(
-            np.sin(traj.dv[:, 0] / PIPE_RADIUS), np.cos(traj.dv[:, 0] / PIPE_RADIUS)
+            np.sin(traj.tool[:, 0] / PIPE_RADIUS), np.cos(traj.tool[:, 0] / PIPE_RADIUS)
         )
         assert wrapped.min() < -3.0 and wrapped.max() > 3.0  # the raw l jumped by 2πR
 
@@ -139,12 +143,14 @@ def test_an_unreachable_path_is_returned_and_reported_as_a_failure() -> None:
     s = scene(path("[[0.30, 0.35, 0.082, 0.0], [0.30, 1.20, 0.082, 0.0]]", speed=0.4))
     traj = plan(s, "daqp")
     assert traj.ok  # every step kept the limits (the task was relaxed)
-    why = failure(s, traj)
-    assert why is not None and why.step == traj.n_steps and why.error > 0.005
+    with pytest.raises(UnreachableTargetError) as info:
+        check_run(s, traj)
+    why = info.value
+    assert why.step == traj.n_steps and why.error is not None and why.error > 0.005
     message = str(why)
     assert message.startswith(f"small.toml: daqp: target not reached at t = {traj.t[-1]:.3f} s:")
     assert message.endswith("(tolerance 5 mm / 0.05 rad)") and "\n" not in message
-    final = np.abs(dv_error(np.array([0.30, 1.20, 0.082, 0.0]), traj.dv[-1], PIPE_RADIUS))
+    final = np.abs(dv_error(np.array([0.30, 1.20, 0.082, 0.0]), traj.tool[-1], PIPE_RADIUS))
     assert final[:3].max() == pytest.approx(why.error)
 
 
@@ -155,12 +161,14 @@ def test_failed_steps_are_reported_with_the_first_time() -> None:
     success[[7, 12]] = False
     status = traj.status.astype("<U40")
     status[7] = "failed: solver gave up"
-    why = failure(s, dataclasses.replace(traj, success=success, status=status))
+    with pytest.raises(UnreachableTargetError) as info:
+        check_run(s, dataclasses.replace(traj, success=success, status=status))
+    why = info.value
     assert str(why) == (
         f"small.toml: pinv: 2 of 30 steps failed, first at t = {traj.t[7]:.3f} s "
         "(failed: solver gave up)"
     )
-    assert why is not None and why.step == 7
+    assert why.step == 7
 
 
 @pytest.mark.parametrize("suffix", [".npz", ".csv"])
@@ -181,7 +189,7 @@ def test_a_trajectory_round_trips_through_its_file(tmp_path: Path, suffix: str) 
     table = np.loadtxt(out, delimiter=",", skiprows=1)
     header = out.read_text(encoding="utf-8").splitlines()[0].split(",")
     assert header[:2] == ["t", "q1"] and header[-5:] == ["alpha", "e_l", "e_z", "e_h", "e_alpha"]
-    expected = np.column_stack([traj.t, traj.q, traj.dv, traj.tracking_error])
+    expected = np.column_stack([traj.t, traj.q, traj.tool, traj.tracking_error])
     np.testing.assert_allclose(table, expected, rtol=1e-9, atol=1e-12)
 
 
@@ -195,7 +203,7 @@ def test_saving_to_an_unknown_format_writes_nothing(tmp_path: Path) -> None:
 def test_a_turn_in_place_takes_time_and_reaches_its_heading() -> None:
     wp = np.array([[0.30, 0.35, 0.08, 0.0], [0.35, 0.35, 0.08, 0.0], [0.35, 0.35, 0.08, 1.0]])
     start = wp[0].copy()
-    ref = path_reference(PathMotion(wp, speed=0.02), start, dt=0.01, radius=PIPE_RADIUS)
+    ref = ToolPath(wp, speed=0.02).reference(start, dt=0.01, radius=PIPE_RADIUS)
     assert ref[-1, 3] == pytest.approx(1.0)
     turning = np.abs(np.diff(ref[:, 3])) > 0
     # 0.05 m of travel, then 1 rad counted as 0.1 m: 2.5 s + 5 s at 0.02 m/s, 0.01 s steps

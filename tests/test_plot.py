@@ -11,26 +11,44 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dvqp import (
-    DvqpError,
-    JogSegment,
-    Obstacle,
-    ParameterError,
-    PseudoinverseResolver,
-    Robot,
-    Trajectory,
-    jog_commands,
-    simulate,
-)
-from dvqp.cli import plot
-from tests.common import PIPE_RADIUS, Q0, objective_with
+from dvqp import DvqpError, Obstacle, ParameterError, Trajectory, load_scene, plan
+from dvqp.cli import drawing, plot
+from tests.common import LINK_LENGTHS, PIPE_RADIUS, Q0
 
 pytest.importorskip("matplotlib")
 
-DT = 0.01
 HALF = np.pi * PIPE_RADIUS
 ROOT = Path(__file__).resolve().parents[1]
 PNG = b"\x89PNG\r\n\x1a\n"
+SCENE = """
+name = "{name}"
+[pipe]
+radius = {radius}
+[robot]
+model = "ndt13"
+link_lengths = {links}
+q0 = {q0}
+[objective]
+orbital_level = 0.08
+[motion]
+dt = 0.01
+[[motion.jog]]
+duration = {duration}
+velocity = {velocity}
+"""
+
+
+def planned(
+    folder: Path, name: str, q0: list[float], duration: float, velocity: list[float]
+) -> Trajectory:
+    """A JOG scene of the paper's arm, run with the pseudoinverse baseline."""
+    text = SCENE.format(
+        name=name, radius=PIPE_RADIUS, links=LINK_LENGTHS, q0=q0, duration=duration,
+        velocity=velocity,
+    )  # fmt: skip
+    path = folder / f"{name}.toml"
+    path.write_text(text, encoding="utf-8")
+    return plan(load_scene(path), "pinv")
 
 
 @pytest.fixture(scope="module")
@@ -39,21 +57,17 @@ def obstacles() -> list[Obstacle]:
 
 
 @pytest.fixture(scope="module")
-def plain(robot: Robot, obstacles: list[Obstacle]) -> Trajectory:
-    cmd = jog_commands([JogSegment(0.4, np.array([0.05, 0.0, 0.0, 0.1]))], DT)
-    objective = objective_with(obstacles)
-    return simulate(robot, PIPE_RADIUS, objective, PseudoinverseResolver(), Q0, cmd, DT)
+def plain(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
+    return planned(tmp_path_factory.mktemp("plain"), "plain", Q0, 0.4, [0.05, 0.0, 0.0, 0.1])
 
 
 @pytest.fixture(scope="module")
-def seam(robot: Robot, obstacles: list[Obstacle]) -> Trajectory:
+def seam(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
     """The carriage joint turned so the tool starts at l = 0.75 m and crosses l = πR."""
-    q0 = np.array(Q0)
+    q0 = list(Q0)
     q0[0] += (0.75 - 0.2973) / PIPE_RADIUS
-    cmd = jog_commands([JogSegment(0.6, np.array([0.2, 0.0, 0.0, 0.0]))], DT)
-    objective = objective_with(obstacles)
-    traj = simulate(robot, PIPE_RADIUS, objective, PseudoinverseResolver(), q0, cmd, DT)
-    assert traj.dv[0, 0] < HALF < traj.dv[-1, 0], "the tool must cross the seam"
+    traj = planned(tmp_path_factory.mktemp("seam"), "seam", q0, 0.6, [0.2, 0.0, 0.0, 0.0])
+    assert traj.tool[0, 0] < HALF < traj.tool[-1, 0], "the tool must cross the seam"
     assert traj.points[-1, -1, 0] > HALF, "the last body point must cross the seam"
     return traj
 
@@ -183,10 +197,10 @@ def test_missing_matplotlib_is_a_clear_error(
 
 
 def test_seam_wrapping_of_the_drawn_body(seam: Trajectory) -> None:
-    wrapped = plot._wrap(seam.dv[:, 0], PIPE_RADIUS)
+    wrapped = drawing.wrap_arc(seam.tool[:, 0], PIPE_RADIUS)
     assert np.all((wrapped > -HALF) & (wrapped <= HALF))
-    np.testing.assert_allclose(plot._wrap(np.array([HALF, -HALF]), PIPE_RADIUS), [HALF, HALF])
-    body = plot._body(seam, seam.t.shape[0] - 1)  # last point and tool beyond the seam
+    np.testing.assert_allclose(drawing.wrap_arc(np.array([HALF, -HALF]), PIPE_RADIUS), [HALF, HALF])
+    body = drawing.body_at(seam, seam.t.shape[0] - 1)  # last point and tool beyond the seam
     assert -HALF < body[0, 0] <= HALF
     assert np.all(np.abs(np.diff(body[:, 0])) < 0.5 * HALF), "the polyline jumps"
     assert body[-1, 0] > HALF  # drawn continuous, past the seam, plus a copy 2πR to the left

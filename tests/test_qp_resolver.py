@@ -1,15 +1,27 @@
+"""The QP resolver: agreement with the baseline, limits held, relaxed and failed steps."""
+
 import numpy as np
 import pytest
 
 import solvers
-from dvqp import JogSegment, KinematicState, Obstacle, PseudoinverseResolver, Robot, jog_commands
+from dvqp import (
+    JogSegment,
+    KinematicState,
+    Obstacle,
+    ObstacleSet,
+    PseudoinverseResolver,
+    Robot,
+    StepSpec,
+    ToolTask,
+    jog_commands,
+)
 from dvqp import simulate as run
 from dvqp.errors import BackendError
-from dvqp.limits import DamperParameters
+from dvqp.limits import JointPositionLimit, JointVelocityLimit, ObstacleDamper, SurfaceHeight
+from dvqp.objective import Objective
 from dvqp.resolution.pinv import weighted_pinv_step
 from dvqp.resolution.qp_resolver import QPResolver
-from dvqp.resolution.qp import StepConfig
-from tests.common import LINK_LENGTHS, PIPE_RADIUS, objective_with, random_configurations
+from tests.common import LINK_LENGTHS, PIPE_RADIUS, objective_with, random_configurations, spec_with
 
 DT = 0.005
 
@@ -38,13 +50,12 @@ def test_qp_equals_the_pseudoinverse_step_when_no_inequality_is_active(
     rng = np.random.default_rng(17)
     weights = rng.uniform(0.5, 3.0, 13) if weighted else np.ones(13)
     # Loose limits, no obstacle, a floor far below: nothing is active.
-    config = StepConfig(robot, (), DamperParameters(min_height=-1.0), weights=weights)
-    resolver = QPResolver(config, backend)
+    limits = (JointPositionLimit(robot), JointVelocityLimit(robot), SurfaceHeight(-1.0))
     tol = AGREEMENT_TOLERANCE[backend.removeprefix("qpsolvers:")]
     for q in random_configurations(5, seed=23, spread=0.3):
         state = KinematicState.compute(robot, q, PIPE_RADIUS)
         g, xdot = 0.1 * rng.normal(size=13), 0.02 * rng.normal(size=4)
-        step = resolver.resolve(state, g, xdot, DT)
+        step = QPResolver(spec_with(g, weights, limits), backend).resolve(state, xdot, DT)
         assert step.success and step.status == "optimal", step.status
         expected = weighted_pinv_step(state.tool_jacobian, xdot, g, 1.0 / weights)
         np.testing.assert_allclose(step.qdot, expected, atol=tol, rtol=0)
@@ -53,6 +64,19 @@ def test_qp_equals_the_pseudoinverse_step_when_no_inequality_is_active(
 def limited_robot() -> Robot:
     lim = np.r_[np.inf, np.full(12, 1.2)]
     return Robot.ndt13(LINK_LENGTHS, q_min=-lim, q_max=lim, qd_max=1.0)
+
+
+def paper_spec(
+    robot: Robot, objective: Objective, obstacles: ObstacleSet, min_height: float, **damper: float
+) -> StepSpec:
+    """The paper's step with every limit of a scene."""
+    limits = (
+        JointPositionLimit(robot),
+        JointVelocityLimit(robot),
+        ObstacleDamper(obstacles, **damper),
+        SurfaceHeight(min_height, damper.get("gain", 0.5)),
+    )
+    return StepSpec((ToolTask(),), objective, limits)
 
 
 def clearance_history(traj, obstacles) -> np.ndarray:  # type: ignore[no-untyped-def]
@@ -70,8 +94,8 @@ def test_limits_hold_along_a_jog_that_breaks_them_with_the_pseudoinverse(q0: np.
         Obstacle(np.array([0.08, 0.30]), 0.03, 10.0),
     ]
     objective = objective_with(obstacles)
-    params = DamperParameters(min_height=0.06, margin=0.005, influence=0.05, gain=0.5)
-    config = StepConfig(robot, objective.obstacles, params)
+    obstacle_set = objective.terms[1].obstacles
+    spec = paper_spec(robot, objective, obstacle_set, 0.06, margin=0.005, influence=0.05)
     cmd = jog_commands(
         [
             JogSegment(1.0, np.array([0.0, 0.06, 0, 0])),
@@ -80,10 +104,10 @@ def test_limits_hold_along_a_jog_that_breaks_them_with_the_pseudoinverse(q0: np.
         DT,
     )
     runs = {
-        name: run(robot, PIPE_RADIUS, objective, resolver, q0, cmd, DT)
+        name: run(robot, PIPE_RADIUS, resolver, q0, cmd, DT, obstacles=obstacle_set)
         for name, resolver in (
-            ("pinv", PseudoinverseResolver()),
-            ("qp", QPResolver(config, "daqp")),
+            ("pinv", PseudoinverseResolver(spec)),
+            ("qp", QPResolver(spec, "daqp")),
         )
     }
     qp, pinv = runs["qp"], runs["pinv"]
@@ -106,9 +130,9 @@ def test_an_infeasible_command_is_relaxed_with_a_reported_task_error(
     q0: np.ndarray, backend: str
 ) -> None:
     robot = limited_robot()
-    config = StepConfig(robot, (), DamperParameters(min_height=0.0))
+    spec = paper_spec(robot, objective_with([]), ObstacleSet(), 0.0)
     cmd = jog_commands([JogSegment(0.1, np.array([2.0, 0.0, 0.0, 0.0]))], DT)  # 2 m/s: too fast
-    traj = run(robot, PIPE_RADIUS, objective_with([]), QPResolver(config, backend), q0, cmd, DT)
+    traj = run(robot, PIPE_RADIUS, QPResolver(spec, backend), q0, cmd, DT)
     assert traj.ok and set(traj.status) == {"relaxed"}
     assert traj.task_error.min() > 0.1
     assert np.all(np.abs(traj.qdot) <= robot.qd_max + 1e-9)
@@ -137,12 +161,12 @@ class CorruptingBackend:
 def test_a_wrong_answer_reported_as_solved_fails_the_step(
     state0: KinematicState, robot: Robot
 ) -> None:
-    resolver = QPResolver(StepConfig(robot), CorruptingBackend)
-    step = resolver.resolve(state0, np.zeros(13), np.array([0.01, 0, 0, 0]), DT)
+    resolver = QPResolver(spec_with(np.zeros(13)), CorruptingBackend)
+    step = resolver.resolve(state0, np.array([0.01, 0, 0, 0]), DT)
     assert not step.success and step.status.startswith("failed")
     assert np.all(step.qdot == 0.0)
 
 
 def test_unknown_backend_lists_the_installed_ones(robot: Robot) -> None:
     with pytest.raises(BackendError, match=r"installed: .*daqp"):
-        QPResolver(StepConfig(robot), "nosuchsolver")
+        QPResolver(spec_with(np.zeros(13)), "nosuchsolver")

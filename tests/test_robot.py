@@ -60,9 +60,3 @@ def test_limits_are_validated() -> None:
         Robot.ndt13(LINK_LENGTHS, q_min=1.0, q_max=0.0)
     with pytest.raises(ParameterError, match="qd_max"):
         Robot.ndt13(LINK_LENGTHS, qd_max=0.0)
-
-
-def test_within_limits(robot: Robot, q0: np.ndarray) -> None:
-    assert robot.within_limits(q0)
-    q0[3] = 4.0
-    assert not robot.within_limits(q0)

@@ -8,7 +8,12 @@ import numpy as np
 import pytest
 
 from dvqp import KinematicState, SceneError, load_scene, plan
-from dvqp.limits import DamperParameters
+from dvqp.limits import (
+    JointPositionLimit,
+    JointVelocityLimit,
+    ObstacleDamper,
+    SurfaceHeight,
+)
 from dvqp.scenes.scene import environment, loads
 from tests.common import LINK_LENGTHS, ORBITAL_LEVEL, PIPE_RADIUS, Q0
 
@@ -67,8 +72,14 @@ def test_a_valid_scene_becomes_typed_objects() -> None:
     assert [o.radius for o in scene.obstacles] == [0.06, 0.05]
     assert [o.weight for o in scene.obstacles] == [10.0, 1.0]  # weight defaults to 1
     np.testing.assert_array_equal(scene.obstacles[0].center, [0.20, 0.45])
-    assert scene.objective.orbital_level == ORBITAL_LEVEL and scene.objective.gain == 1.0
-    assert scene.dampers == DamperParameters(0.0, 0.01, 0.06, 0.5)
+    assert scene.orbital_level == ORBITAL_LEVEL and scene.objective.gain == 1.0
+    assert scene.objective.terms[0].level == ORBITAL_LEVEL
+    kinds = (JointPositionLimit, JointVelocityLimit, ObstacleDamper, SurfaceHeight)
+    assert [type(limit) for limit in scene.limits] == list(kinds)
+    damper, height = scene.limits[2], scene.limits[3]
+    assert (damper.margin, damper.influence, damper.gain) == (0.01, 0.06, 0.5)
+    assert (height.min_height, height.gain) == (0.0, 0.5)
+    assert damper.obstacles is scene.obstacles is scene.objective.terms[1].obstacles
     assert scene.dt == 0.005 and len(scene.jog) == 1 and scene.path is None
     np.testing.assert_array_equal(scene.weights, np.ones(13))
     np.testing.assert_array_equal(scene.robot.qd_max, np.full(13, 1.5))
@@ -84,7 +95,7 @@ def test_per_joint_and_per_point_values_are_read_as_given() -> None:
     assert scene.robot.q_min[0] == -np.inf and scene.robot.q_min[1] == -3.0
     assert np.all(scene.robot.q_max == np.inf)
     np.testing.assert_array_equal(scene.weights, np.arange(1, 14))
-    np.testing.assert_array_equal(scene.objective.k_height, [1, 2, 3, 4, 5])
+    np.testing.assert_array_equal(scene.objective.terms[0].k_height, [1, 2, 3, 4, 5])
     assert scene.weld == 0.35
 
 
@@ -296,7 +307,7 @@ velocity = [0.02, 0.01, 0.0, 0.0]
     np.testing.assert_array_equal(scene.robot.q_max, np.full(6, 3.0))
     traj = plan(scene, "pinv")
     assert traj.ok and traj.task_error.max() < 1e-9
-    np.testing.assert_allclose(traj.dv[-1, :2] - traj.dv[0, :2], [0.004, 0.002], atol=2e-4)
+    np.testing.assert_allclose(traj.tool[-1, :2] - traj.tool[0, :2], [0.004, 0.002], atol=2e-4)
     bad = text.replace('tool = "tool"', 'tool = "probe"')
     with pytest.raises(SceneError, match=r"robot\.tool: no frame named 'probe'"):
         loads(bad, "<string>", base_dir=tmp_path)

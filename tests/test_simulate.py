@@ -1,18 +1,13 @@
+"""Offline integration of JOG commands, with and without position feedback."""
+
 import numpy as np
 import pytest
 
-from dvqp import (
-    JogSegment,
-    KinematicState,
-    Obstacle,
-    PseudoinverseResolver,
-    Robot,
-    jog_commands,
-    simulate,
-)
+from dvqp import JogSegment, KinematicState, Obstacle, Robot, jog_commands, simulate
 from dvqp.errors import ParameterError, ShapeError
-from dvqp.motion.simulate import dv_error, min_clearance
-from tests.common import PIPE_RADIUS, objective_with
+from dvqp.geometry import min_clearance
+from dvqp.motion.simulate import dv_error
+from tests.common import PIPE_RADIUS, baseline, objective_with, obstacles_of
 
 DT = 0.005
 
@@ -20,10 +15,10 @@ DT = 0.005
 def test_jog_tracks_the_commanded_dv_velocity(robot: Robot, q0: np.ndarray) -> None:
     v = np.array([0.04, -0.02, 0.0, 0.1])
     cmd = jog_commands([JogSegment(0.5, v)], DT)
-    traj = simulate(robot, PIPE_RADIUS, objective_with([]), PseudoinverseResolver(), q0, cmd, DT)
+    traj = simulate(robot, PIPE_RADIUS, baseline(objective_with([])), q0, cmd, DT)
     assert traj.task_error.max() < 1e-10
     # Euler integration of the exact velocity: first-order drift only.
-    np.testing.assert_allclose(traj.dv[-1] - traj.dv[0], 0.5 * v, atol=2e-3)
+    np.testing.assert_allclose(traj.tool[-1] - traj.tool[0], 0.5 * v, atol=2e-3)
     assert np.all(np.isfinite(traj.q)) and traj.ok
 
 
@@ -33,9 +28,10 @@ def test_jog_pushes_body_points_out_of_an_obstacle_they_start_in(
     state = KinematicState.compute(robot, q0, PIPE_RADIUS)
     obstacle = Obstacle(state.points[2, :2] + np.array([0.0, 0.02]), 0.03, 20.0)
     objective = objective_with([obstacle])
-    assert min_clearance(state, objective) < 0
+    obstacles = obstacles_of(objective)
+    assert min_clearance(state, obstacles) < 0
     cmd = jog_commands([JogSegment(2.0, np.array([0.02, 0.01, 0.0, 0.0]))], DT)
-    traj = simulate(robot, PIPE_RADIUS, objective, PseudoinverseResolver(), q0, cmd, DT)
+    traj = simulate(robot, PIPE_RADIUS, baseline(objective), q0, cmd, DT, obstacles=obstacles)
     point_clearance = (
         np.linalg.norm(traj.points[:, :, :2] - obstacle.center, axis=-1) - obstacle.radius
     )
@@ -43,6 +39,7 @@ def test_jog_pushes_body_points_out_of_an_obstacle_they_start_in(
     assert point_clearance[-1].min() > 0.005, "a body point is still inside the obstacle"
     assert traj.w[-1] > traj.w[0]
     assert traj.task_error.max() < 1e-9
+    assert traj.min_clearance[0] < 0 < traj.min_clearance[-1]
 
 
 def test_feedback_removes_a_reference_offset(robot: Robot, q0: np.ndarray) -> None:
@@ -52,15 +49,14 @@ def test_feedback_removes_a_reference_offset(robot: Robot, q0: np.ndarray) -> No
     traj = simulate(
         robot,
         PIPE_RADIUS,
-        objective_with([]),
-        PseudoinverseResolver(),
+        baseline(objective_with([])),
         q0,
         np.zeros((n, 4)),
         DT,
         reference=np.tile(target, (n, 1)),
         feedback_gain=5.0,
     )
-    assert np.abs(dv_error(target, traj.dv[-1], PIPE_RADIUS)).max() < 1e-3
+    assert np.abs(dv_error(target, traj.tool[-1], PIPE_RADIUS)).max() < 1e-3
 
 
 def test_dv_error_wraps_l_and_alpha() -> None:
@@ -70,14 +66,16 @@ def test_dv_error_wraps_l_and_alpha() -> None:
 
 
 def test_bad_commands_raise_typed_errors(robot: Robot, q0: np.ndarray) -> None:
-    objective, resolver = objective_with([]), PseudoinverseResolver()
+    resolver = baseline(objective_with([]))
     with pytest.raises(ShapeError, match="commands"):
-        simulate(robot, PIPE_RADIUS, objective, resolver, q0, np.zeros((5, 3)), DT)
+        simulate(robot, PIPE_RADIUS, resolver, q0, np.zeros((5, 3)), DT)
     with pytest.raises(ParameterError, match="dt"):
-        simulate(robot, PIPE_RADIUS, objective, resolver, q0, np.zeros((5, 4)), 0.0)
+        simulate(robot, PIPE_RADIUS, resolver, q0, np.zeros((5, 4)), 0.0)
     with pytest.raises(ShapeError, match="q0"):
-        simulate(robot, PIPE_RADIUS, objective, resolver, q0[:5], np.zeros((5, 4)), DT)
+        simulate(robot, PIPE_RADIUS, resolver, q0[:5], np.zeros((5, 4)), DT)
     with pytest.raises(ParameterError, match="commands"):
-        simulate(robot, PIPE_RADIUS, objective, resolver, q0, np.full((5, 4), np.nan), DT)
+        simulate(robot, PIPE_RADIUS, resolver, q0, np.full((5, 4), np.nan), DT)
+    with pytest.raises(ShapeError, match="reference"):
+        simulate(robot, PIPE_RADIUS, resolver, q0, np.zeros((5, 4)), DT, reference=np.zeros(4))
     with pytest.raises(ParameterError, match="duration"):
         JogSegment(0.0, np.zeros(4))

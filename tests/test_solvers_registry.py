@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
+from importlib import metadata
+
 import pytest
 
 import solvers
@@ -83,3 +86,37 @@ def test_direct_adapter_rejects_unknown_settings(name: str, module: str) -> None
     pytest.importorskip(module)
     with pytest.raises(SolverError, match=rf"^{name}: unknown settings \['bogus'\]"):
         make_backend(name, bogus=1)
+
+
+def test_describe_backends_has_one_entry_per_available_name_in_order() -> None:
+    infos = solvers.describe_backends()
+    assert [info.name for info in infos] == available_backends()
+    for info in infos:
+        assert isinstance(info, solvers.BackendInfo)
+        assert info.distribution and info.version
+
+
+def test_describe_backends_names_distribution_version_and_path() -> None:
+    versions = solvers.backend_versions()
+    via = f"via qpsolvers {qpsolvers.__version__}"
+    for info in solvers.describe_backends():
+        solver = info.name.removeprefix("qpsolvers:")
+        assert info.version == versions[info.distribution]
+        assert info.distribution == DIRECT.get(solver, "highspy" if solver == "highs" else solver)
+        assert info.note == ("" if info.name in DIRECT else via), info
+
+
+def test_describe_backends_marks_an_unknown_version(monkeypatch: pytest.MonkeyPatch) -> None:
+    def missing(dist: str) -> str:
+        raise metadata.PackageNotFoundError(dist)
+
+    monkeypatch.setattr(metadata, "version", missing)
+    infos = solvers.describe_backends()
+    assert infos and all(info.version == "?" for info in infos)
+    assert all(info.note in ("", "via qpsolvers ?") for info in infos)
+
+
+def test_backend_info_is_frozen() -> None:
+    info = solvers.describe_backends()[0]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        info.version = "0"  # type: ignore[misc]

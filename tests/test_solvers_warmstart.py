@@ -8,8 +8,7 @@ from typing import Any, ClassVar
 import numpy as np
 import pytest
 
-from solvers import Problem, SolverError, make_backend
-from solvers._stateful import RawResult, StatefulBackend
+from solvers import Problem, RawResult, SolverError, StatefulBackend, make_backend
 from tests.solvers_qp_cases import equality_case, random_problem, random_walk
 
 DIRECT = {"osqp": "osqp", "clarabel": "clarabel", "daqp": "daqp", "proxqp": "proxsuite"}

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from dvqp import KinematicState, Robot
-from dvqp.kinematics import developed_view as dv
 from dvqp.errors import ShapeError
+from dvqp.kinematics import developed_view as dv
 from tests.common import PIPE_RADIUS, central_difference, random_configurations
 
 R = PIPE_RADIUS

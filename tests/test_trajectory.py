@@ -32,10 +32,10 @@ def straddling(n_samples: int = 4) -> Trajectory:
 
 def test_l_is_continuous_along_the_body_and_in_time_across_the_seam() -> None:
     traj = straddling()
-    along_body = np.diff(np.column_stack([traj.points[:, :, 0], traj.dv[:, 0]]), axis=1)
+    along_body = np.diff(np.column_stack([traj.points[:, :, 0], traj.tool[:, 0]]), axis=1)
     assert np.abs(along_body).max() < 0.05  # no 2πR jump between neighbours
     np.testing.assert_allclose(np.diff(traj.points[:, :, 0], axis=0), 0.001, atol=1e-12)
-    np.testing.assert_allclose(np.diff(traj.dv[:, 0]), 0.001, atol=1e-12)
+    np.testing.assert_allclose(np.diff(traj.tool[:, 0]), 0.001, atol=1e-12)
 
 
 def test_saved_file_has_the_usual_mode_and_no_temporary_is_left(tmp_path: Path) -> None:

@@ -12,15 +12,18 @@ import os
 import platform
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 import solvers
-from dvqp.errors import DvqpError
-from dvqp.planning import PINV, failure, final_errors, plan
-from dvqp.scenes.scene import Scene, load_scene
-from dvqp.motion.trajectory import Trajectory
+from dvqp import load_scene, plan
+from dvqp.errors import DvqpError, UnreachableTargetError
+from dvqp.planning import check_run, final_errors
+from dvqp.resolution.registry import PINV
+
+if TYPE_CHECKING:
+    from dvqp import Scene, Trajectory
 
 FIELDS = (
     "scene", "file", "backend", "success", "steps", "failures", "median_step_us", "p95_step_us",
@@ -41,6 +44,13 @@ def _finite(value: float) -> float | None:
 def summarize(scene: Scene, traj: Trajectory) -> Row:
     """The figures of one run.
 
+    Parameters
+    ----------
+    scene
+        The scene that was run.
+    traj
+        Its trajectory, from :func:`dvqp.plan`.
+
     Returns
     -------
     dict
@@ -53,7 +63,7 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
     """
     robot = scene.robot
     ok = traj.success
-    why = failure(scene, traj)
+    why = run_error(scene, traj)
     steps_us = traj.step_time * 1e6
     q_out = np.maximum(robot.q_min - traj.q, traj.q - robot.q_max)
     qd_out = np.abs(traj.qdot) - robot.qd_max
@@ -75,9 +85,18 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
         "max_joint_limit_violation": float(max(0.0, np.max(q_out))),
         "max_velocity_limit_violation": float(max(0.0, np.max(qd_out, initial=0.0))),
         "final_tracking_error": tracking,
-        "final_tool": [float(v) for v in traj.dv[-1]],
-        "error": None if why is None else str(why),
+        "final_tool": [float(v) for v in traj.tool[-1]],
+        "error": why,
     }
+
+
+def run_error(scene: Scene, traj: Trajectory) -> str | None:
+    """Why a planned run failed (the message of :func:`dvqp.planning.check_run`), or None."""
+    try:
+        check_run(scene, traj)
+    except UnreachableTargetError as exc:
+        return str(exc)
+    return None
 
 
 def run_scene(
@@ -95,17 +114,28 @@ def run_scene(
         try:
             row = summarize(scene, plan(scene, backend))
         except DvqpError as exc:
-            row = {key: None for key in (*FIELDS, "final_tool")}
-            row.update(scene=scene.name, file=scene.source, backend=backend, success=False,
-                       error=str(exc))  # fmt: skip
+            row = _error_row(scene, backend, exc)
         rows.append(row)
         if progress is not None:
             progress(backend)
+    _add_ratios(rows)
+    return rows
+
+
+def _error_row(scene: Scene, backend: str, exc: DvqpError) -> Row:
+    """The row of a run that raised: every figure None, ``success`` False, ``error`` set."""
+    row: Row = {key: None for key in (*FIELDS, "final_tool")}
+    row.update(scene=scene.name, file=scene.source, backend=backend, success=False)
+    row["error"] = str(exc)
+    return row
+
+
+def _add_ratios(rows: Sequence[Row]) -> None:
+    """Set ``ratio_to_pinv``: median step time over ``pinv``'s among ``rows`` (one scene)."""
     base = next((r["median_step_us"] for r in rows if r["backend"] == PINV), None)
     for row in rows:
         if base and row["median_step_us"] is not None:
             row["ratio_to_pinv"] = row["median_step_us"] / base
-    return rows
 
 
 def compare(
@@ -121,7 +151,8 @@ def compare(
     paths
         Scene files (already validated by the caller, or errors surface here).
     backends
-        Backend names.
+        Resolver names (checked by the caller with
+        :func:`dvqp.resolution.registry.check_name`; an unknown one gives failed rows).
     jobs
         Worker processes (one scene per task); 1 runs in this process.
     progress

@@ -1,18 +1,24 @@
-"""A figure of a backend comparison (the rows of :func:`dvqp.compare.compare`)."""
+"""A figure of a backend comparison (the rows of :func:`dvqp.cli.compare.compare`)."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from dvqp._files import output_path
-from dvqp.cli.plot import FIGURE_FORMATS, _atomic, _figure
+from dvqp.cli.figures import FIGURE_FORMATS, new_figure, save_figure
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+Row = dict[str, Any]
 
 
-def plot_comparison(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
+def plot_comparison(rows: Sequence[Row], path: str | Path) -> Path:
     """Median step time and minimum clearance per scene and backend, as grouped bars.
 
     Parameters
@@ -22,29 +28,24 @@ def plot_comparison(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
         ``p95_step_us`` and ``min_clearance`` (m; None without obstacles).
     path
         ``.png``, ``.svg`` or ``.pdf``; written atomically.
+
+    Returns
+    -------
+    Path
+        The written file.
     """
     target = output_path(path, FIGURE_FORMATS)
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     backends = list(dict.fromkeys(r["backend"] for r in rows))
     by_key = {(r["scene"], r["backend"]): r for r in rows}
-    fig = _figure((max(8.0, 1.6 * len(scenes) + 3.0), 7.0))
+    fig = new_figure((max(8.0, 1.6 * len(scenes) + 3.0), 7.0))
     time_ax, clear_ax = fig.subplots(2, 1, sharex=True)
     width = 0.8 / max(len(backends), 1)
     x = np.arange(len(scenes))
     for k, backend in enumerate(backends):
-        get = [by_key.get((s, backend), {}) for s in scenes]
-        med = np.array(
-            [np.nan if r.get("median_step_us") is None else r["median_step_us"] for r in get]
-        )
-        p95 = np.array([np.nan if r.get("p95_step_us") is None else r["p95_step_us"] for r in get])
-        clear = np.array(
-            [np.nan if r.get("min_clearance") is None else r["min_clearance"] for r in get]
-        )
+        got = [by_key.get((s, backend), {}) for s in scenes]
         offset = x + (k - (len(backends) - 1) / 2) * width
-        time_ax.bar(
-            offset, med, width, label=backend, yerr=[np.zeros_like(med), p95 - med], capsize=2
-        )
-        clear_ax.bar(offset, 1000.0 * clear, width, label=backend)
+        _bars(time_ax, clear_ax, offset, width, backend, got)
     time_ax.set_yscale("log")
     time_ax.set_ylabel("full step time, µs (median, bar to p95)")
     time_ax.legend(ncol=min(len(backends), 5), fontsize="small")
@@ -52,4 +53,25 @@ def plot_comparison(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
     clear_ax.axhline(0.0, color="k", lw=0.8)
     clear_ax.set_ylabel("min clearance to obstacles, mm")
     clear_ax.set_xticks(x, scenes, rotation=15)
-    return _atomic(target, lambda tmp: fig.savefig(tmp, format=target.suffix[1:], dpi=120))
+    return save_figure(fig, target, dpi=120)
+
+
+def _bars(
+    time_ax: Axes,
+    clear_ax: Axes,
+    offset: NDArray[np.float64],
+    width: float,
+    backend: str,
+    rows: Sequence[Row],
+) -> None:
+    """One backend's bars: median step time (µs, error bar to p95) and min clearance (mm)."""
+    med, p95 = _column(rows, "median_step_us"), _column(rows, "p95_step_us")
+    clear = _column(rows, "min_clearance")
+    errors = [np.zeros_like(med), p95 - med]
+    time_ax.bar(offset, med, width, label=backend, yerr=errors, capsize=2)
+    clear_ax.bar(offset, 1000.0 * clear, width, label=backend)
+
+
+def _column(rows: Sequence[Row], key: str) -> NDArray[np.float64]:
+    """``row[key]`` of every row as floats, NaN where missing or None."""
+    return np.array([np.nan if r.get(key) is None else r[key] for r in rows], dtype=np.float64)

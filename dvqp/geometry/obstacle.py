@@ -6,12 +6,14 @@ An obstacle is a circle in the (l, z) plane (m). Differences in l are wrapped mo
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
+from dvqp.errors import ParameterError
 from dvqp.kinematics.developed_view import wrap
 
 
@@ -39,6 +41,60 @@ class Obstacle:
         )
         object.__setattr__(self, "radius", _validate.positive("radius", self.radius))
         object.__setattr__(self, "weight", _validate.positive("weight", self.weight, strict=False))
+
+
+class ObstacleSet:
+    """An immutable set of obstacle circles, packed as arrays (identity-hashed cache key).
+
+    Parameters
+    ----------
+    obstacles
+        The circles.
+
+    Attributes
+    ----------
+    centers : ndarray, shape (J, 2)
+        ``[l, z]`` of each centre, m.
+    radii : ndarray, shape (J,)
+        m.
+    weights : ndarray, shape (J,)
+        Objective weights ``w_j``.
+    """
+
+    def __init__(self, obstacles: Sequence[Obstacle] = ()) -> None:
+        self.obstacles = tuple(obstacles)
+        for i, o in enumerate(self.obstacles):
+            if not isinstance(o, Obstacle):
+                raise ParameterError(f"obstacles[{i}]", "must be an Obstacle")
+        ro = _validate.readonly
+        if self.obstacles:
+            self.centers = ro(np.array([o.center for o in self.obstacles]))
+            self.radii = ro(np.array([o.radius for o in self.obstacles]))
+            self.weights = ro(np.array([o.weight for o in self.obstacles]))
+        else:
+            self.centers, self.radii, self.weights = (
+                ro(np.zeros((0, 2))),
+                ro(np.zeros(0)),
+                ro(np.zeros(0)),
+            )
+
+    @classmethod
+    def of(cls, obstacles: ObstacleSet | Sequence[Obstacle]) -> ObstacleSet:
+        """``obstacles`` itself if it is a set already (keeping its cache identity), else a new
+        set of them."""
+        return obstacles if isinstance(obstacles, ObstacleSet) else cls(obstacles)
+
+    def __len__(self) -> int:
+        return len(self.obstacles)
+
+    def __getitem__(self, index: int) -> Obstacle:
+        return self.obstacles[index]
+
+    def __iter__(self):  # type: ignore[no-untyped-def]
+        return iter(self.obstacles)
+
+    def __repr__(self) -> str:
+        return f"ObstacleSet({list(self.obstacles)!r})"
 
 
 def offsets(lz: ArrayLike, centers: ArrayLike, pipe_radius: float) -> NDArray[np.float64]:

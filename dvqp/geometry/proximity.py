@@ -8,62 +8,14 @@ result on the state, so each step does that geometry a single time.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp import _validate
+from dvqp.geometry.obstacle import ObstacleSet, offsets
 from dvqp.kinematics.developed_view import wrap
-from dvqp.errors import ParameterError
-from dvqp.geometry.obstacle import Obstacle, offsets
 from dvqp.kinematics.state import KinematicState
-
-
-class ObstacleSet:
-    """An immutable set of obstacle circles, packed as arrays (identity-hashed cache key).
-
-    Parameters
-    ----------
-    obstacles
-        The circles.
-
-    Attributes
-    ----------
-    centers : ndarray, shape (J, 2)
-        ``[l, z]`` of each centre, m.
-    radii : ndarray, shape (J,)
-        m.
-    weights : ndarray, shape (J,)
-        Objective weights ``w_j``.
-    """
-
-    def __init__(self, obstacles: Sequence[Obstacle] = ()) -> None:
-        self.obstacles = tuple(obstacles)
-        for i, o in enumerate(self.obstacles):
-            if not isinstance(o, Obstacle):
-                raise ParameterError(f"obstacles[{i}]", "must be an Obstacle")
-        ro = _validate.readonly
-        if self.obstacles:
-            self.centers = ro(np.array([o.center for o in self.obstacles]))
-            self.radii = ro(np.array([o.radius for o in self.obstacles]))
-            self.weights = ro(np.array([o.weight for o in self.obstacles]))
-        else:
-            self.centers, self.radii, self.weights = (
-                ro(np.zeros((0, 2))),
-                ro(np.zeros(0)),
-                ro(np.zeros(0)),
-            )
-
-    def __len__(self) -> int:
-        return len(self.obstacles)
-
-    def __iter__(self):  # type: ignore[no-untyped-def]
-        return iter(self.obstacles)
-
-    def __repr__(self) -> str:
-        return f"ObstacleSet({list(self.obstacles)!r})"
 
 
 @dataclass(frozen=True)
@@ -135,3 +87,13 @@ def proximity(state: KinematicState, obstacles: ObstacleSet) -> Proximity:
     )
     cache[obstacles] = result
     return result
+
+
+def min_clearance(state: KinematicState, obstacles: ObstacleSet) -> float:
+    """Smallest signed clearance (m) of any body point or link to ``obstacles``.
+
+    Negative inside an obstacle; ``inf`` with no obstacles.
+    """
+    if not len(obstacles):
+        return float("inf")
+    return proximity(state, obstacles).min_clearance()

@@ -108,18 +108,6 @@ def position_and_rows(
     return pos, rows
 
 
-def position(origins: ArrayLike, radius: float) -> NDArray[np.float64]:
-    """DV position ``[l, z, h]`` (m) of k points at ``origins`` (m, shape (k, 3)): (k, 3)."""
-    o = np.asarray(origins, dtype=np.float64)
-    return position_and_rows(o, np.zeros((o.shape[0], 3, 0)), radius)[0]
-
-
-def position_jacobian(origins: ArrayLike, radius: float) -> NDArray[np.float64]:
-    """``∂[l, z, h]/∂O`` of k points, shape (k, 3, 3)."""
-    o = np.asarray(origins, dtype=np.float64)
-    return position_and_rows(o, np.broadcast_to(np.eye(3), (o.shape[0], 3, 3)), radius)[1]
-
-
 def heading_terms(
     ox: float, oy: float, zx: float, zy: float, zz: float
 ) -> tuple[float, tuple[float, float, float, float, float]]:
@@ -144,35 +132,24 @@ def heading_terms(
     return math.atan2(s, c), partials
 
 
-def heading(origin: ArrayLike, axis: ArrayLike) -> float:
-    """Heading ``α`` (rad) of the unit ``axis`` at ``origin`` (m) projected on the surface."""
-    (ox, oy, _), (zx, zy, zz) = np.asarray(origin, float).tolist(), np.asarray(axis, float).tolist()
-    return heading_terms(ox, oy, zx, zy, zz)[0]
+def heading_row(
+    origin: NDArray[np.float64], axis: NDArray[np.float64], frame_jacobian: NDArray[np.float64]
+) -> tuple[float, NDArray[np.float64]]:
+    """Heading ``α`` (rad) of a frame and its Jacobian row ``∂α/∂Q``, shape (n,).
 
+    With ``ż = ω × z``: ``∂α/∂Q = ∂α/∂O·J_v + ∂α/∂z·(−S(z)·J_ω) = ∂α/∂O·J_v + (z × ∂α/∂z)·J_ω``.
 
-def heading_gradient(origin: ArrayLike, axis: ArrayLike) -> NDArray[np.float64]:
-    """``∂α/∂[O; z]``, shape (6,), bounded near the undefined heading (axis radial)."""
-    (ox, oy, _), (zx, zy, zz) = np.asarray(origin, float).tolist(), np.asarray(axis, float).tolist()
-    d = heading_terms(ox, oy, zx, zy, zz)[1]
-    return np.array([d[0], d[1], 0.0, d[2], d[3], d[4]])
-
-
-def coordinates(origin: ArrayLike, axis: ArrayLike, radius: float) -> NDArray[np.float64]:
-    """Full DV coordinates ``F(X) = [l, z, h, α]`` of one frame, shape (4,)."""
-    o = np.asarray(origin, dtype=np.float64)
-    return np.append(position(o[None, :], radius)[0], heading(o, axis))
-
-
-def coordinates_jacobian(origin: ArrayLike, axis: ArrayLike, radius: float) -> NDArray[np.float64]:
-    """``∂F/∂X`` of one frame, ``X = [O; z]``, shape (4, 6)."""
-    o = np.asarray(origin, dtype=np.float64)
-    out = np.zeros((4, 6))
-    out[:3, :3] = position_jacobian(o[None, :], radius)[0]
-    out[3] = heading_gradient(o, axis)
-    return out
-
-
-def skew(v: ArrayLike) -> NDArray[np.float64]:
-    """Skew-symmetric matrix ``S(v)`` with ``S(v)·u = v × u``, shape (3, 3)."""
-    x, y, z = np.asarray(v, dtype=np.float64)
-    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    Parameters
+    ----------
+    origin, axis
+        Frame origin (m) and unit z axis, shape (3,) each, base frame.
+    frame_jacobian
+        The frame's ``[J_v; J_ω]`` in the base orientation (LOCAL_WORLD_ALIGNED), (6, n).
+    """
+    ox, oy, _ = origin.tolist()
+    zx, zy, zz = axis.tolist()
+    alpha, (dox, doy, dzx, dzy, dzz) = heading_terms(ox, oy, zx, zy, zz)
+    weights = np.array(
+        [dox, doy, 0.0, zy * dzz - zz * dzy, zz * dzx - zx * dzz, zx * dzy - zy * dzx]
+    )
+    return alpha, weights @ frame_jacobian

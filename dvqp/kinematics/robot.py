@@ -16,8 +16,8 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
-from dvqp.kinematics.dh import DHRow, check_transform, fixed_part, ndt13_table
 from dvqp.errors import DvqpError, ParameterError
+from dvqp.kinematics.dh import DHRow, check_transform, fixed_part, ndt13_table
 
 NDT13_POINT_JOINTS = (4, 6, 8, 10, 13)
 """Joints (1-based) whose output frames are the paper's five body points."""
@@ -105,12 +105,6 @@ class Robot:
         """Return ``q`` as a finite float vector of length :attr:`n`, or raise."""
         return _validate.vector(name, q, self.n)
 
-    def within_limits(self, q: ArrayLike, tol: float = 1e-9) -> bool:
-        """True if ``q`` lies within the joint position limits (with tolerance, rad)."""
-        qv = self.check_q(q)
-        return bool(np.all(qv >= self.q_min - tol) and np.all(qv <= self.q_max + tol))
-
-    # ------------------------------------------------------------------ constructors
     @classmethod
     def from_dh(
         cls,

@@ -34,7 +34,10 @@ class KinematicState:
     origins : ndarray, shape (k+1, 3)
         Frame origins of the k body points then the tool, m, base frame.
     axes : ndarray, shape (k+1, 3)
-        Unit z axes of the same frames.
+        Unit z axes of the same frames (the last one is the probe's axis).
+    frame_jacobians : ndarray, shape (k+1, 6, n)
+        ``[J_v; J_ω]`` of the same frames in the base orientation (Pinocchio's
+        LOCAL_WORLD_ALIGNED): ``ȯ = J_v Q̇``, ``ω = J_ω Q̇``; a user task reads these.
     points : ndarray, shape (k, 3)
         Body points in DV, ``[l, z, h]`` (m).
     point_jacobians : ndarray, shape (k, 3, n)
@@ -44,13 +47,15 @@ class KinematicState:
     tool_jacobian : ndarray, shape (4, n)
         The DV task Jacobian ``J̄(Q)``.
     cache : dict
-        Quantities derived from this state once and shared (e.g. :func:`dvqp.geometry.proximity.proximity`).
+        Quantities derived from this state once and shared: the proximity to an obstacle
+        set (:func:`dvqp.geometry.proximity`), an objective's value and gradient.
     """
 
     q: NDArray[np.float64]
     radius: float
     origins: NDArray[np.float64]
     axes: NDArray[np.float64]
+    frame_jacobians: NDArray[np.float64]
     points: NDArray[np.float64]
     point_jacobians: NDArray[np.float64]
     tool: NDArray[np.float64]
@@ -93,26 +98,20 @@ class KinematicState:
         axes = frames[:, :3, 2]
         r = _validate.positive("radius", radius)
         pos, lin = dv.position_and_rows(origins, jac[:, :3, :], r, robot.frame_names)
-        n = jac.shape[2]
-        # Heading row: ∂α/∂O·Jv + ∂α/∂z·(−S(z)·Jω) = ∂α/∂O·Jv + (z × ∂α/∂z)·Jω  (ż = ω × z)
-        ox, oy, _ = origins[-1].tolist()
-        zx, zy, zz = axes[-1].tolist()
-        alpha, (dox, doy, dzx, dzy, dzz) = dv.heading_terms(ox, oy, zx, zy, zz)
-        weights = np.array(
-            [dox, doy, 0.0, zy * dzz - zz * dzy, zz * dzx - zx * dzz, zx * dzy - zy * dzx]
-        )
+        alpha, alpha_row = dv.heading_row(origins[-1], axes[-1], jac[-1])
         tool = np.empty(4)
         tool[:3] = pos[-1]
         tool[3] = alpha
-        tool_jac = np.empty((4, n))
+        tool_jac = np.empty((4, jac.shape[2]))
         tool_jac[:3] = lin[-1]
-        tool_jac[3] = weights @ jac[-1]
+        tool_jac[3] = alpha_row
         ro = _validate.readonly
         return cls(
             q=ro(qv),
             radius=float(radius),
             origins=ro(origins),
             axes=ro(axes),
+            frame_jacobians=ro(jac),
             points=ro(pos[:-1]),
             point_jacobians=ro(lin[:-1]),
             tool=ro(tool),

@@ -2,10 +2,19 @@
 
 from __future__ import annotations
 
-from dvqp.limits.limit import Bounds
 from dvqp.kinematics.robot import Robot
+from dvqp.kinematics.state import KinematicState
+from dvqp.limits.limit import Bounds
 
 
-def joint_velocity_bounds(robot: Robot) -> Bounds:
-    """``−q̇_max ≤ Q̇ ≤ q̇_max`` (rad/s), shape (n,) each."""
-    return Bounds(-robot.qd_max, robot.qd_max.copy())
+class JointVelocityLimit:
+    """``−q̇_max ≤ Q̇ ≤ q̇_max`` (rad/s), from the robot's ``qd_max``, shape (n,)."""
+
+    name = "joint_velocity"
+
+    def __init__(self, robot: Robot) -> None:
+        self.qd_max = robot.qd_max
+
+    def compute(self, state: KinematicState, dt: float) -> Bounds:
+        """The constant box (``state`` and ``dt`` are not used)."""
+        return Bounds(-self.qd_max, self.qd_max.copy())

@@ -1,22 +1,31 @@
-"""The pieces a QP step is assembled from: inequalities ``Constraint(G, h)`` and ``Bounds``."""
+"""What a limit gives the QP: inequalities ``Constraint(G, h)`` or a ``Bounds`` box.
+
+A limit is any object with a ``name`` and ``compute(state, dt)`` returning one of the two (the
+:class:`Limit` protocol). :func:`dvqp.resolution.qp.build_qp` stacks the constraints in the
+order the limits are given and intersects the boxes.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp.kinematics.state import KinematicState
+
 
 @dataclass(frozen=True)
 class Constraint:
-    """Linear inequalities ``G x ≤ h`` on the joint velocities, with a label per row.
+    """Linear inequalities ``G Q̇ ≤ h`` on the joint velocities, with a label per row.
 
     Attributes
     ----------
     G : ndarray, shape (p, n)
     h : ndarray, shape (p,)
+        Usually m/s (a damper) or rad/s.
     describe : callable, optional
         Returns what each row holds, e.g. ``"point3/obstacle1"``; called only when
         :attr:`labels` is read, so the per-step hot path formats no strings.
@@ -62,7 +71,7 @@ class Constraint:
 
 @dataclass(frozen=True)
 class Bounds:
-    """Box ``lb ≤ x ≤ ub`` on the joint velocities, rad/s, each shape (n,)."""
+    """Box ``lb ≤ Q̇ ≤ ub`` on the joint velocities, rad/s, each shape (n,)."""
 
     lb: NDArray[np.float64]
     ub: NDArray[np.float64]
@@ -70,3 +79,26 @@ class Bounds:
     def intersect(self, other: Bounds) -> Bounds:
         """The tighter of two boxes."""
         return Bounds(np.maximum(self.lb, other.lb), np.minimum(self.ub, other.ub))
+
+
+@runtime_checkable
+class Limit(Protocol):
+    """A hard limit of the QP step, linear in ``Q̇`` at the current state.
+
+    Implement ``name`` and :meth:`compute`; pass the object in ``StepSpec.limits`` (or
+    ``dvqp.plan(..., limits=[...])``). The pseudoinverse baseline ignores limits.
+    """
+
+    name: str
+
+    def compute(self, state: KinematicState, dt: float) -> Constraint | Bounds:
+        """The limit's rows at ``state`` for a step of ``dt`` seconds.
+
+        Parameters
+        ----------
+        state
+            Kinematics of this step (read-only).
+        dt
+            Step, s, > 0.
+        """
+        ...

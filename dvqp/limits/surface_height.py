@@ -2,30 +2,42 @@
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 
-from dvqp.limits.limit import Constraint
-from dvqp.limits.obstacle_damper import DamperParameters
+from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
+from dvqp.limits.damper import Distances, VelocityDamper
 
 
-def surface_height(state: KinematicState, params: DamperParameters, dt: float) -> Constraint:
-    """``h_i ≥ h_min`` for every body point, linearised one step ahead as a damper::
+class SurfaceHeight(VelocityDamper):
+    """``h_i ≥ h_min`` for every body point, as a damper row each (labels ``"point3/height"``).
 
-        ∂h_i/∂Q · Q̇ ≥ −γ (h_i − h_min)/dt      i.e.   −∂h_i/∂Q · Q̇ ≤ γ (h_i − h_min)/dt
-
-    A point already below ``h_min`` may not descend further (right-hand side clipped at 0).
-
-    Returns
-    -------
-    Constraint
-        k rows (one per body point), ``h`` in m/s, labels ``"point3/height"``.
+    Parameters
+    ----------
+    min_height
+        ``h_min``, m (finite).
+    gain
+        ``γ`` in (0, 1].
     """
-    h = state.points[:, 2]
-    rhs = np.maximum(params.gain / dt * (h - params.min_height), 0.0)
-    k = h.shape[0]
-    return Constraint(
-        -state.point_jacobians[:, 2, :],
-        rhs,
-        lambda: tuple(f"point{i + 1}/height" for i in range(k)),
-    )
+
+    name = "height"
+    SCENE_KEYS: ClassVar[dict[str, str]] = {"min_height": "min_height", "damper_gain": "gain"}
+    """Keys of the scene file's ``[constraints]`` table -> constructor arguments."""
+
+    def __init__(self, min_height: float = 0.0, gain: float = 0.5) -> None:
+        super().__init__(gain)
+        if not np.isfinite(min_height):
+            raise ParameterError("min_height", "must be finite")
+        self.min_height = float(min_height)
+
+    def distances(self, state: KinematicState) -> Distances:
+        """The body points' heights h (m) and ``∂h/∂Q``, safe value ``h_min``."""
+        k = state.points.shape[0]
+        return Distances(
+            state.points[:, 2],
+            state.point_jacobians[:, 2, :],
+            self.min_height,
+            lambda: tuple(f"point{i + 1}/height" for i in range(k)),
+        )

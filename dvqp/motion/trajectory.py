@@ -11,14 +11,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp._files import atomic_file, output_path
-from dvqp.kinematics.developed_view import unwrap
 from dvqp.errors import DvqpError
+from dvqp.kinematics.developed_view import unwrap
 
 ARRAYS = (
     "t",
     "q",
     "qdot",
-    "dv",
+    "tool",
     "points",
     "w",
     "min_clearance",
@@ -43,7 +43,7 @@ class Trajectory:
         Joint configuration, rad.
     qdot : ndarray, shape (N, n)
         Joint velocity applied during step k, rad/s.
-    dv : ndarray, shape (N+1, 4)
+    tool : ndarray, shape (N+1, 4)
         Tool ``[l, z, h, α]`` with l (m) and α (rad) unwrapped along the run.
     points : ndarray, shape (N+1, k, 3)
         Body points ``[l, z, h]`` (m), l unwrapped per point.
@@ -77,7 +77,7 @@ class Trajectory:
     t: NDArray[np.float64]
     q: NDArray[np.float64]
     qdot: NDArray[np.float64]
-    dv: NDArray[np.float64]
+    tool: NDArray[np.float64]
     points: NDArray[np.float64]
     w: NDArray[np.float64]
     min_clearance: NDArray[np.float64]
@@ -119,15 +119,15 @@ class Trajectory:
         pts = points.copy()
         pts[0, :, 0] = first[:-1]
         pts[:, :, 0] = unwrap(pts[:, :, 0], period, axis=0)
-        dv = tool.copy()
-        dv[0, 0] = first[-1]
-        dv[:, 0] = unwrap(dv[:, 0], period)
-        dv[:, 3] = unwrap(tool[:, 3], 2.0 * np.pi)
+        unwrapped = tool.copy()
+        unwrapped[0, 0] = first[-1]
+        unwrapped[:, 0] = unwrap(unwrapped[:, 0], period)
+        unwrapped[:, 3] = unwrap(tool[:, 3], 2.0 * np.pi)
         return cls(
             t=dt * np.arange(q.shape[0]),
             q=q,
             qdot=qdot,
-            dv=dv,
+            tool=unwrapped,
             points=pts,
             w=w,
             min_clearance=min_clearance,
@@ -179,7 +179,7 @@ class Trajectory:
     def _write_csv(self, fh: object) -> None:
         n = self.q.shape[1]
         header = ["t"] + [f"q{i + 1}" for i in range(n)] + ["l", "z", "h", "alpha"]
-        columns = [self.t, self.q, self.dv]
+        columns = [self.t, self.q, self.tool]
         if self.tracking_error.shape[0] == self.t.shape[0]:
             header += ["e_l", "e_z", "e_h", "e_alpha"]
             columns.append(self.tracking_error)
@@ -191,7 +191,10 @@ class Trajectory:
         """Read a trajectory written by :meth:`save` (``.npz``)."""
         try:
             with np.load(path, allow_pickle=False) as data:
-                arrays = {name: data[name] for name in ARRAYS}
+                # files written before 0.2 call the tool's DV coordinates "dv"
+                arrays = {
+                    name: data["dv" if name == "tool" and "dv" in data else name] for name in ARRAYS
+                }
                 return cls(
                     **arrays,
                     backend=str(data["backend"]),

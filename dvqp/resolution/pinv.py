@@ -1,5 +1,9 @@
 """The paper's baseline (eq. 18): pseudoinverse plus null-space projection of ``∇w``.
 
+It uses the same tasks and objective as the QP (:func:`dvqp.resolution.qp.step_terms`) and
+ignores the limits. With soft tasks the metric becomes ``W + H`` (dense): the step is then
+the equality-constrained minimiser of the same cost, solved through its Cholesky factor.
+
 Weighted least-norm form with a positive diagonal ``W`` (``W = I`` gives eq. 18)::
 
     J̄_W⁺ = W⁻¹ J̄ᵀ (J̄ W⁻¹ J̄ᵀ + μ² I)⁻¹
@@ -17,12 +21,15 @@ import time
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.linalg import cho_factor, cho_solve
 from scipy.linalg.lapack import dposv
 
 from dvqp import _validate
 from dvqp.errors import ParameterError, SingularConfigurationError
-from dvqp.resolution.step import Step, step_inputs, task_error
 from dvqp.kinematics.state import KinematicState
+from dvqp.resolution.qp import StepTerms, step_terms
+from dvqp.resolution.spec import StepSpec
+from dvqp.resolution.step import Step, check_command
 
 SINGULAR_RCOND = 1e-10
 """Smallest ratio of Cholesky pivots of ``J̄ W⁻¹ J̄ᵀ`` (about its reciprocal condition number)
@@ -79,48 +86,71 @@ def weighted_pinv_step(
     return free + jw.T @ lam
 
 
+def dense_pinv_step(
+    jacobian: NDArray[np.float64],
+    xdot: NDArray[np.float64],
+    gradient: NDArray[np.float64],
+    metric: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """``Q̇ = M⁻¹g + M⁻¹J̄ᵀ (J̄ M⁻¹ J̄ᵀ)⁻¹ (ẋ − J̄ M⁻¹ g)`` for a dense SPD metric ``M``.
+
+    The minimiser of ``½ Q̇ᵀ M Q̇ − gᵀ Q̇`` subject to ``J̄ Q̇ = ẋ``; with ``M`` diagonal it
+    equals :func:`weighted_pinv_step`.
+
+    Raises
+    ------
+    SingularConfigurationError
+        ``M`` is not positive definite or ``J̄ M⁻¹ J̄ᵀ`` is singular.
+    """
+    try:
+        factor = cho_factor(metric, lower=True)
+        inv_jt = cho_solve(factor, jacobian.T)  # M⁻¹ J̄ᵀ, (n, m)
+        free = cho_solve(factor, gradient)
+        gram = cho_factor(jacobian @ inv_jt, lower=True)
+    except np.linalg.LinAlgError as exc:
+        raise SingularConfigurationError(
+            "task Jacobian or soft-task metric is rank deficient"
+        ) from exc
+    return free + inv_jt @ cho_solve(gram, xdot - jacobian @ free)
+
+
 class PseudoinverseResolver:
-    """The paper's baseline resolver (name ``"pinv"``).
+    """The paper's baseline resolver (name ``"pinv"``) on the tasks and objective of a spec.
 
     Parameters
     ----------
-    weights
-        Diagonal of ``W`` (> 0), scalar or shape (n,). Default: identity.
+    spec
+        Tasks, objective and weights (its limits are not used: the baseline holds none).
     damping
         ``μ >= 0`` of the damped inverse; 0 reproduces eq. 18 and raises at singularities.
     """
 
     name = "pinv"
 
-    def __init__(self, weights: ArrayLike | None = None, damping: float = 0.0) -> None:
-        self._weights = None if weights is None else np.asarray(weights, dtype=float)
-        if self._weights is not None and (
-            not np.all(np.isfinite(self._weights)) or np.any(self._weights <= 0)
-        ):
-            raise ParameterError("weights", "must be finite and > 0")
+    def __init__(self, spec: StepSpec, damping: float = 0.0) -> None:
+        self.spec = spec
         self.damping = _validate.positive("damping", damping, strict=False)
 
-    def inverse_weights(self, n: int) -> NDArray[np.float64]:
-        """Diagonal of ``W⁻¹`` for n joints, shape (n,)."""
-        if self._weights is None:
-            return np.ones(n)
-        return 1.0 / _validate.broadcast("weights", self._weights, n)
-
-    def resolve(
-        self,
-        state: KinematicState,
-        gradient: NDArray[np.float64],
-        xdot: NDArray[np.float64],
-        dt: float,
-    ) -> Step:
-        """One baseline step (``dt`` is unused: the baseline holds no limits)."""
+    def resolve(self, state: KinematicState, command: ArrayLike, dt: float) -> Step:
+        """One baseline step (``dt`` only reaches the tasks: the baseline holds no limits)."""
         start = time.perf_counter()
-        g, xd = step_inputs(state, gradient, xdot)
-        inv_w = self.inverse_weights(state.n)
-        qdot = weighted_pinv_step(state.tool_jacobian, xd, g, inv_w, self.damping)
+        cmd = check_command(command)
+        terms = step_terms(self.spec, state, cmd, dt)
+        qdot = self.solve(terms)
         elapsed = time.perf_counter() - start
-        error = task_error(state, qdot, xd)
+        error = terms.task_error(qdot)
         return Step(qdot=qdot, success=True, status="optimal", task_error=error, solve_time=elapsed)
+
+    def solve(self, terms: StepTerms) -> NDArray[np.float64]:
+        """``Q̇`` (rad/s, shape (n,)) of eq. 18 for evaluated step terms."""
+        if terms.soft_hessian is None:
+            return weighted_pinv_step(
+                terms.A, terms.b, terms.gradient, 1.0 / terms.weights, self.damping
+            )
+        metric = np.diag(terms.weights) + terms.soft_hessian
+        if self.damping > 0.0:
+            raise ParameterError("damping", "the damped inverse takes no soft tasks")
+        return dense_pinv_step(terms.A, terms.b, terms.gradient, metric)
 
     def reset(self) -> None:
         """Nothing to forget: the baseline is stateless."""

@@ -1,115 +1,80 @@
-"""The per-step QP, assembled by a pure function so every backend gets the identical problem.
+"""The per-step QP, assembled by pure functions so every backend gets the identical problem.
 
-Decision variable ``x = Q̇`` (rad/s), or ``x = [Q̇; s]`` when the task is relaxed by a slack
-``s`` (task units: m/s, m/s, m/s, rad/s)::
+Decision variable ``x = Q̇`` (rad/s), or ``x = [Q̇; s]`` when the hard tasks are relaxed by a
+slack ``s`` (task units per s)::
 
-    minimise    ½ Q̇ᵀ W Q̇ − gᵀ Q̇  (+ ½ ρ ‖s‖²)        g = λ ∂w/∂Q
-    subject to  J̄ Q̇ = ẋ           (J̄ Q̇ − s = ẋ)      the tool's DV task
-                G Q̇ ≤ h                              obstacle dampers, surface height
-                lb ≤ Q̇ ≤ ub                          joint position (one step ahead) and velocity
+    minimise    ½ Q̇ᵀ (W + H) Q̇ + (c − g)ᵀ Q̇  (+ ½ ρ ‖s‖²)     g = λ ∂w/∂Q
+    subject to  A Q̇ = b             (A Q̇ − s = b)            hard tasks (the tool's DV task)
+                G Q̇ ≤ h                                      the limits' constraints
+                lb ≤ Q̇ ≤ ub                                  the limits' bounds
 
-With no active inequality its KKT conditions are exactly the weighted pseudoinverse step
-(:func:`dvqp.resolution.pinv.weighted_pinv_step`).
+``H, c`` are the soft tasks' costs (none in the paper). With no active inequality the KKT
+conditions are exactly the weighted pseudoinverse step (:mod:`dvqp.resolution.pinv`), which
+is built from the same :func:`step_terms`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from dvqp import _validate
-from dvqp.limits.limit import Bounds, Constraint
-from dvqp.errors import ParameterError
-from dvqp.limits import (
-    DamperParameters,
-    joint_position_bounds,
-    joint_velocity_bounds,
-    obstacle_dampers,
-    surface_height,
-)
-from dvqp.geometry.obstacle import Obstacle
-from dvqp.geometry.proximity import ObstacleSet
-from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
+from dvqp.limits.limit import Bounds, Constraint
+from dvqp.resolution.spec import StepSpec
 from solvers import Problem
 
-DEFAULT_TASK_WEIGHT = 1e4
-"""``ρ`` of the task slack (dimensionless relative to W): large, so the task is given up last."""
-
 
 @dataclass(frozen=True)
-class StepConfig:
-    """What stays constant between the steps of a run.
+class StepTerms:
+    """The unconstrained part of a step: metric, cost and hard-task equality.
 
-    Parameters
+    Attributes
     ----------
-    robot
-        Joint limits come from here.
-    obstacles
-        Circles in the developed view; pass the objective's :class:`ObstacleSet` to share
-        the per-step geometry with it.
-    dampers
-        Margin, influence, gain and minimum height of the inequality rows.
-    weights
-        Diagonal of ``W`` (> 0), scalar or shape (n,).
-    task_weight
-        ``ρ`` of the task slack in the relaxed problem, > 0.
+    weights : ndarray, shape (n,)
+        Diagonal of ``W``.
+    soft_hessian : ndarray, shape (n, n), or None
+        ``H`` of the soft tasks (None without soft tasks).
+    gradient : ndarray, shape (n,)
+        ``g − c``: what the step follows (``g = λ ∂w/∂Q``, ``c`` from the soft tasks).
+    A : ndarray, shape (m, n)
+        Stacked Jacobians of the hard tasks.
+    b : ndarray, shape (m,)
+        Their wanted velocities.
     """
 
-    robot: Robot
-    obstacles: ObstacleSet | tuple[Obstacle, ...] = ()
-    dampers: DamperParameters = field(default_factory=DamperParameters)
-    weights: ArrayLike = 1.0
-    task_weight: float = DEFAULT_TASK_WEIGHT
+    weights: NDArray[np.float64]
+    soft_hessian: NDArray[np.float64] | None
+    gradient: NDArray[np.float64]
+    A: NDArray[np.float64]
+    b: NDArray[np.float64]
 
-    def __post_init__(self) -> None:
-        w = _validate.broadcast("weights", self.weights, self.robot.n)
-        if np.any(w <= 0):
-            raise ParameterError("weights", "must be > 0")
-        object.__setattr__(self, "weights", _validate.readonly(w))
-        if not isinstance(self.obstacles, ObstacleSet):
-            object.__setattr__(self, "obstacles", ObstacleSet(self.obstacles))
-        object.__setattr__(self, "task_weight", _validate.positive("task_weight", self.task_weight))
-
-    @property
-    def hessian(self) -> NDArray[np.float64]:
-        """``W = diag(weights)``, shape (n, n), built once."""
-        cached = self.__dict__.get("_hessian")
-        if cached is None:
-            cached = _validate.readonly(np.diag(np.asarray(self.weights)))
-            object.__setattr__(self, "_hessian", cached)
-        return cached  # type: ignore[no-any-return]
-
-    def inequalities(self, state: KinematicState, dt: float) -> Constraint:
-        """Obstacle dampers then surface-height rows at this state."""
-        dampers = obstacle_dampers(state, self.obstacles, self.dampers, dt)  # type: ignore[arg-type]
-        return Constraint.stack([dampers, surface_height(state, self.dampers, dt)], state.n)
-
-    def bounds(self, state: KinematicState, dt: float) -> Bounds:
-        """Joint position (one step ahead) and velocity bounds, rad/s."""
-        position = joint_position_bounds(self.robot, state, dt)
-        return position.intersect(joint_velocity_bounds(self.robot))
+    def task_error(self, qdot: NDArray[np.float64]) -> float:
+        """``‖A Q̇ − b‖∞`` of the hard tasks."""
+        return float(np.abs(self.A @ qdot - self.b).max())
 
 
 @dataclass(frozen=True)
-class StepProblem:
+class StepQP:
     """The QP of one step and what its rows mean.
 
     Attributes
     ----------
     problem : solvers.Problem
         The QP handed to a backend.
+    terms : StepTerms
+        Its unconstrained part.
     inequalities : Constraint
         The rows of ``problem.G`` over ``Q̇`` (their labels say what each holds).
     bounds : Bounds
         The box on ``Q̇``, rad/s.
     relaxed : bool
-        The task carries a slack (the last 4 variables).
+        The hard tasks carry a slack (the last m variables).
     """
 
     problem: Problem
+    terms: StepTerms
     inequalities: Constraint
     bounds: Bounds
     relaxed: bool
@@ -120,57 +85,95 @@ class StepProblem:
         return self.inequalities.labels
 
 
-def build_step_qp(
-    config: StepConfig,
+def step_terms(
+    spec: StepSpec, state: KinematicState, command: NDArray[np.float64], dt: float
+) -> StepTerms:
+    """Evaluate the tasks and the objective of ``spec`` at ``state`` (pure)."""
+    n = state.n
+    hard_rows, hessian, gradient = [], None, spec.objective.scaled_gradient(state)
+    for task in spec.tasks:
+        rows = task.compute(state, command, dt)
+        if task.hard:
+            hard_rows.append(rows)
+            continue
+        h, c = rows.objective()
+        hessian = h if hessian is None else hessian + h
+        gradient = gradient - c
+    if len(hard_rows) == 1:
+        A, b = hard_rows[0].jacobian, hard_rows[0].velocity
+    else:
+        A = np.vstack([r.jacobian for r in hard_rows])
+        b = np.concatenate([r.velocity for r in hard_rows])
+    return StepTerms(spec.diagonal(n), hessian, gradient, A, b)
+
+
+def limit_rows(spec: StepSpec, state: KinematicState, dt: float) -> tuple[Constraint, Bounds]:
+    """The limits of ``spec`` at ``state``: stacked constraints and intersected bounds."""
+    n = state.n
+    parts: list[Constraint] = []
+    box = Bounds(np.full(n, -np.inf), np.full(n, np.inf))
+    first_box = True
+    for limit in spec.limits:
+        rows = limit.compute(state, dt)
+        if isinstance(rows, Bounds):
+            box = rows if first_box else box.intersect(rows)
+            first_box = False
+        else:
+            parts.append(rows)
+    return Constraint.stack(parts, n), box
+
+
+def build_qp(
+    spec: StepSpec,
     state: KinematicState,
-    gradient: NDArray[np.float64],
-    xdot: NDArray[np.float64],
+    command: NDArray[np.float64],
     dt: float,
     *,
-    relax_task: bool = False,
-    limits: tuple[Constraint, Bounds] | None = None,
-) -> StepProblem:
+    relax: bool = False,
+    parts: tuple[StepTerms, Constraint, Bounds] | None = None,
+) -> StepQP:
     """Assemble the QP of one step (pure: no solver involved).
 
     Parameters
     ----------
-    config
-        Constant parts (limits, obstacles, weights).
+    spec
+        Tasks, objective, limits, weights.
     state
         Kinematics of this step.
-    gradient
-        ``g = λ ∂w/∂Q``, shape (n,).
-    xdot
-        Commanded tool DV velocity, shape (m,) with m = 4.
+    command
+        The operator's tool DV velocity, shape (4,).
     dt
         Step, s.
-    relax_task
-        Add the slack ``s`` on the task equality.
-    limits
-        The inequalities and bounds of this state if already computed (e.g. by the strict
-        problem of the same step), so a relaxed retry does not assemble them again.
+    relax
+        Add the slack ``s`` on the hard tasks.
+    parts
+        The terms, inequalities and bounds of this state if already computed (e.g. by the
+        strict problem of the same step), so a relaxed retry does not evaluate them again.
     """
-    jac = state.tool_jacobian
-    m = jac.shape[0]
-    if limits is None:
-        limits = (config.inequalities(state, dt), config.bounds(state, dt))
-    ineq, box = limits
-    if not relax_task:
-        problem = Problem(
-            P=config.hessian, q=-gradient, A=jac, b=xdot,
-            G=ineq.G if ineq.rows else None, h=ineq.h if ineq.rows else None,
-            lb=box.lb, ub=box.ub,
-        )  # fmt: skip
-        return StepProblem(problem, ineq, box, relaxed=False)
+    if parts is None:
+        parts = (step_terms(spec, state, command, dt), *limit_rows(spec, state, dt))
+    terms, ineq, box = parts
+    P = spec.hessian(state.n)
+    if terms.soft_hessian is not None:
+        P = P + terms.soft_hessian
+    G, h = (ineq.G, ineq.h) if ineq.rows else (None, None)
+    if not relax:
+        problem = Problem(P=P, q=-terms.gradient, A=terms.A, b=terms.b, G=G, h=h,
+                          lb=box.lb, ub=box.ub)  # fmt: skip
+        return StepQP(problem, terms, ineq, box, relaxed=False)
+    m = terms.A.shape[0]
     inf = np.full(m, np.inf)
+    P_relaxed = np.zeros((state.n + m, state.n + m))
+    P_relaxed[: state.n, : state.n] = P
+    P_relaxed[state.n :, state.n :] = np.diag(np.full(m, spec.task_weight))
     problem = Problem(
-        P=np.diag(np.concatenate([config.weights, np.full(m, config.task_weight)])),
-        q=np.concatenate([-gradient, np.zeros(m)]),
-        A=np.hstack([jac, -np.eye(m)]),
-        b=xdot,
-        G=np.hstack([ineq.G, np.zeros((ineq.rows, m))]) if ineq.rows else None,
-        h=ineq.h if ineq.rows else None,
+        P=P_relaxed,
+        q=np.concatenate([-terms.gradient, np.zeros(m)]),
+        A=np.hstack([terms.A, -np.eye(m)]),
+        b=terms.b,
+        G=np.hstack([G, np.zeros((ineq.rows, m))]) if G is not None else None,
+        h=h,
         lb=np.concatenate([box.lb, -inf]),
         ub=np.concatenate([box.ub, inf]),
     )
-    return StepProblem(problem, ineq, box, relaxed=True)
+    return StepQP(problem, terms, ineq, box, relaxed=True)

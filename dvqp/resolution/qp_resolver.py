@@ -1,8 +1,8 @@
-"""The per-step QP resolver: the paper's step plus joint, obstacle and height limits.
+"""The per-step QP resolver: the paper's step plus every limit of the spec.
 
-Each step first solves the QP with the task as a hard equality. If that fails (the task and
+Each step first solves the QP with the hard tasks as equalities. If that fails (the tasks and
 the limits conflict, or the backend's answer does not pass the residual check), it solves the
-relaxed QP whose task carries a heavily weighted slack: the step then keeps every limit and
+relaxed QP whose tasks carry a heavily weighted slack: the step then keeps every limit and
 reports its task error (status ``"relaxed"``). Only if that fails too is the step a failure.
 """
 
@@ -12,14 +12,15 @@ import time
 from collections.abc import Callable
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike
 
 import solvers
 from dvqp import _validate
 from dvqp.errors import BackendError
-from dvqp.resolution.qp import StepConfig, build_step_qp
-from dvqp.resolution.step import Step, step_inputs, task_error
 from dvqp.kinematics.state import KinematicState
+from dvqp.resolution.qp import build_qp
+from dvqp.resolution.spec import StepSpec
+from dvqp.resolution.step import Step, check_command
 
 
 def make_backend(name: str) -> solvers.Backend:
@@ -41,16 +42,16 @@ class QPResolver:
 
     Parameters
     ----------
-    config
-        Limits, obstacles and weights of the run.
+    spec
+        Tasks, objective, limits and weights of the run.
     backend
         Backend name, e.g. ``"daqp"``, ``"osqp"``, ``"qpsolvers:quadprog"``, or a zero-argument
         callable returning a fresh :class:`solvers.Backend` (two are made: the strict and the
         relaxed problem keep their own warm starts).
     """
 
-    def __init__(self, config: StepConfig, backend: str | Callable[[], solvers.Backend]) -> None:
-        self.config = config
+    def __init__(self, spec: StepSpec, backend: str | Callable[[], solvers.Backend]) -> None:
+        self.spec = spec
         factory = (lambda: make_backend(backend)) if isinstance(backend, str) else backend
         self._strict = factory()
         self._relaxed = factory()
@@ -61,35 +62,25 @@ class QPResolver:
         self._strict.reset()
         self._relaxed.reset()
 
-    def resolve(
-        self,
-        state: KinematicState,
-        gradient: NDArray[np.float64],
-        xdot: NDArray[np.float64],
-        dt: float,
-    ) -> Step:
+    def resolve(self, state: KinematicState, command: ArrayLike, dt: float) -> Step:
         """One QP step (assembly + solve + check); see the module docstring."""
         start = time.perf_counter()
-        n = state.n
-        g, xd = step_inputs(state, gradient, xdot)
-        step = _validate.positive("dt", dt)
-        strict = build_step_qp(self.config, state, g, xd, step)
+        cmd = check_command(command)
+        dt = _validate.positive("dt", dt)
+        strict = build_qp(self.spec, state, cmd, dt)
         solution = self._strict.solve(strict.problem)
         status = "optimal"
         if not solution.found:
-            relaxed = build_step_qp(
-                self.config, state, g, xd, step, relax_task=True,
-                limits=(strict.inequalities, strict.bounds),
-            )  # fmt: skip
-            solution = self._relaxed.solve(relaxed.problem)
+            parts = (strict.terms, strict.inequalities, strict.bounds)
+            solution = self._relaxed.solve(
+                build_qp(self.spec, state, cmd, dt, relax=True, parts=parts).problem
+            )
             status = "relaxed"
-        iterations = solution.iterations
         if not solution.found or solution.x is None:
             elapsed = time.perf_counter() - start
-            return Step(
-                np.zeros(n), False, f"failed: {solution.message}", np.inf, elapsed, iterations
-            )
-        qdot = np.array(solution.x[:n])
-        error = task_error(state, qdot, xd)
+            message = f"failed: {solution.message}"
+            return Step(np.zeros(state.n), False, message, np.inf, elapsed, solution.iterations)
+        qdot = np.array(solution.x[: state.n])
+        error = strict.terms.task_error(qdot)
         elapsed = time.perf_counter() - start
-        return Step(qdot, True, status, error, elapsed, iterations)
+        return Step(qdot, True, status, error, elapsed, solution.iterations)

@@ -6,10 +6,14 @@ from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
 from dvqp.kinematics.state import KinematicState
+from dvqp.resolution.spec import StepSpec
+
+COMMAND_SIZE = 4
+"""Length of the operator's command ``[l̇, ż, ḣ, α̇]``."""
 
 
 @dataclass(frozen=True)
@@ -25,7 +29,7 @@ class Step:
     status : str
         ``"optimal"``, ``"relaxed"`` (task slack used), or the failure reason.
     task_error : float
-        ``‖J̄·Q̇ − ẋ‖∞`` (m/s or rad/s) of the tool DV task.
+        ``‖A·Q̇ − b‖∞`` of the hard tasks (m/s or rad/s).
     solve_time : float
         Wall time of the resolution (QP assembly + solve + check, or the pseudoinverse), s.
     iterations : int or None
@@ -40,50 +44,33 @@ class Step:
     iterations: int | None = None
 
 
-def step_inputs(
-    state: KinematicState, gradient: NDArray[np.float64], xdot: NDArray[np.float64]
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Check a resolver's inputs: ``gradient`` (n,) and ``xdot`` (m,), finite.
+def check_command(command: ArrayLike) -> NDArray[np.float64]:
+    """The operator's command as a finite vector of shape (4,).
 
     Raises
     ------
     ShapeError, ParameterError
         Wrong size or not finite.
     """
-    g = _validate.vector("gradient", gradient, state.n)
-    xd = _validate.vector("xdot", xdot, state.tool_jacobian.shape[0])
-    return g, xd
-
-
-def task_error(
-    state: KinematicState, qdot: NDArray[np.float64], xdot: NDArray[np.float64]
-) -> float:
-    """``‖J̄·Q̇ − ẋ‖∞`` of the tool's DV task."""
-    return float(np.abs(state.tool_jacobian @ qdot - xdot).max())
+    return _validate.vector("command", command, COMMAND_SIZE)
 
 
 class Resolver(Protocol):
-    """Chooses ``Q̇`` that tracks the tool's DV velocity and follows ``λ∇w`` in the rest."""
+    """Chooses ``Q̇`` for the tasks of a :class:`StepSpec`, following ``λ∇w`` in the rest."""
 
     name: str
+    spec: StepSpec
 
-    def resolve(
-        self,
-        state: KinematicState,
-        gradient: NDArray[np.float64],
-        xdot: NDArray[np.float64],
-        dt: float,
-    ) -> Step:
+    def resolve(self, state: KinematicState, command: ArrayLike, dt: float) -> Step:
         """One step.
 
         Parameters
         ----------
         state
             Kinematics at the current configuration.
-        gradient
-            ``λ·∂w/∂Q``, shape (n,).
-        xdot
-            Commanded tool DV velocity ``[l̇, ż, ḣ, α̇]`` (m/s, m/s, m/s, rad/s), shape (4,).
+        command
+            The operator's tool DV velocity ``[l̇, ż, ḣ, α̇]`` (m/s, m/s, m/s, rad/s),
+            shape (4,).
         dt
             Step length, s (used by position limits and dampers).
         """

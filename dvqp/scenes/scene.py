@@ -18,22 +18,25 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp.errors import SceneError
+from dvqp.geometry.obstacle import ObstacleSet
+from dvqp.kinematics.robot import Robot
+from dvqp.limits import Limit
+from dvqp.motion.jog import JogSegment
+from dvqp.motion.path import ToolPath
+from dvqp.objective import Objective
+from dvqp.resolution.spec import StepSpec
+from dvqp.scenes import robot_section, start
 from dvqp.scenes import sections as sec
 from dvqp.scenes.fields import Fields
-from dvqp.scenes.sections import PathMotion
-from dvqp.errors import SceneError
-from dvqp.limits import DamperParameters
-from dvqp.objective import Objective
-from dvqp.geometry.obstacle import Obstacle
-from dvqp.kinematics.robot import Robot
-from dvqp.motion.simulate import JogSegment
+from dvqp.tasks import ToolTask
 
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-__all__ = ["Environment", "PathMotion", "Scene", "environment", "load_scene", "loads"]
+__all__ = ["Environment", "Scene", "environment", "load_scene", "loads"]
 
 TOP_KEYS = ("name", "description", "pipe", "robot", "objective", "obstacles", "constraints",
             "motion")  # fmt: skip
@@ -62,15 +65,19 @@ class Scene:
         Start configuration, rad.
     weights : ndarray, shape (n,)
         Diagonal of ``W``.
+    orbital_level : float
+        ``h*``, m.
+    obstacles : ObstacleSet
+        The obstacle circles (shared by the objective, the dampers and the diagnostics).
     objective : Objective
-        ``w(Q)``, with the obstacles.
-    dampers : DamperParameters
-        The QP's inequality parameters.
+        ``w(Q)``: the paper's three terms.
+    limits : tuple of Limit
+        Joint position and velocity limits, obstacle dampers, surface height.
     dt : float
         Step, s.
     jog : tuple of JogSegment
         JOG segments (empty in path mode).
-    path : PathMotion or None
+    path : ToolPath or None
         The path to follow (None in JOG mode).
     """
 
@@ -83,16 +90,17 @@ class Scene:
     robot: Robot = field(repr=False)
     q0: NDArray[np.float64] = field(repr=False)
     weights: NDArray[np.float64] = field(repr=False)
+    orbital_level: float
+    obstacles: ObstacleSet = field(repr=False)
     objective: Objective = field(repr=False)
-    dampers: DamperParameters
+    limits: tuple[Limit, ...] = field(repr=False)
     dt: float
     jog: tuple[JogSegment, ...] = field(repr=False)
-    path: PathMotion | None = field(repr=False)
+    path: ToolPath | None = field(repr=False)
 
-    @property
-    def obstacles(self) -> tuple[Obstacle, ...]:
-        """The obstacle circles."""
-        return tuple(self.objective.obstacles)
+    def spec(self) -> StepSpec:
+        """The step of this scene: the tool's DV task, the objective, the limits, ``W``."""
+        return StepSpec((ToolTask(),), self.objective, self.limits, self.weights)
 
     @property
     def mode(self) -> str:
@@ -134,16 +142,18 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
     if base_dir is None:
         base_dir = Path.cwd() if source.startswith("<") else Path(source).parent
     radius, weld = sec.pipe(f, doc)
-    robot, q0, weights = sec.robot(f, doc, Path(base_dir))
-    objective = sec.objective(f, doc, robot.n_points, sec.obstacles(f, doc))
-    dampers = sec.dampers(f, doc)
+    robot, q0, weights = robot_section.robot(f, doc, Path(base_dir))
+    obstacles = sec.obstacles(f, doc)
+    objective = sec.objective(f, doc, robot.n_points, obstacles)
+    limits = sec.limits(f, doc, robot, obstacles)
     dt, jog, path = sec.motion(f, doc)
-    sec.check_start(f, robot, q0, radius, objective.obstacles)
+    start.check_start(f, robot, q0, radius, obstacles)
     stem = "scene" if source.startswith("<") else Path(source).stem
     return Scene(
         name=f.string(doc, "name", "", stem), description=f.string(doc, "description", "", ""),
         source=source, text=text, pipe_radius=radius, weld=weld, robot=robot, q0=q0,
-        weights=weights, objective=objective, dampers=dampers, dt=dt, jog=jog, path=path,
+        weights=weights, orbital_level=sec.orbital_level(f, doc), obstacles=obstacles,
+        objective=objective, limits=limits, dt=dt, jog=jog, path=path,
     )  # fmt: skip
 
 
@@ -154,7 +164,7 @@ class Environment:
     pipe_radius: float
     orbital_level: float
     weld: float | None
-    obstacles: tuple[Obstacle, ...]
+    obstacles: ObstacleSet
 
 
 def environment(text: str, source: str = "<string>") -> Environment:
@@ -165,9 +175,7 @@ def environment(text: str, source: str = "<string>") -> Environment:
     f = Fields(source)
     doc = _parse(f, text)
     radius, weld = sec.pipe(f, doc)
-    objective_t = f.table(doc, "objective", "", sec.OBJECTIVE_KEYS)
-    level = f.number(objective_t, "orbital_level", "objective")
-    return Environment(radius, level, weld, sec.obstacles(f, doc))
+    return Environment(radius, sec.orbital_level(f, doc), weld, sec.obstacles(f, doc))
 
 
 def _parse(f: Fields, text: str) -> dict[str, Any]:

@@ -1,8 +1,11 @@
-"""Shared machinery of the direct (stateful, warm-started) adapters.
+"""Base class of the stateful, warm-started adapters; subclass it to add a backend.
 
-Not part of the public API: a backend only has to satisfy
-:class:`solvers.Backend`; this base class merely gives the four direct
-adapters the same setup / update / retry-cold policy.
+A backend only has to satisfy :class:`solvers.Backend`. :class:`StatefulBackend`
+gives the direct adapters (``osqp``, ``clarabel``, ``daqp``, ``proxqp``) one
+set-up / update / retry-cold policy: a subclass builds the solver in
+:meth:`~StatefulBackend._setup`, pushes new data into it in
+:meth:`~StatefulBackend._update`, and returns a :class:`RawResult`, which is then
+judged by :meth:`Solution.checked <solvers.Solution.checked>`.
 """
 
 from __future__ import annotations
@@ -25,7 +28,23 @@ PROGRAMMING_ERRORS = (TypeError, AttributeError, NameError, ImportError, NotImpl
 
 @dataclass
 class RawResult:
-    """What a solver returned, multipliers already in the package sign convention."""
+    """What a solver returned, multipliers already in the package sign convention.
+
+    Attributes
+    ----------
+    x : ndarray, shape (n,), or None
+        Primal answer (None if the solver gave none).
+    status : str
+        The solver's own status word.
+    iterations : int or None
+        Solver iterations, when reported.
+    y : ndarray, shape (m,), or None
+        Equality multipliers.
+    z : ndarray, shape (p,), or None
+        Inequality multipliers.
+    z_box : ndarray, shape (n,), or None
+        Bound multipliers (see :mod:`solvers.residuals` for the signs).
+    """
 
     x: np.ndarray | None
     status: str
@@ -81,11 +100,22 @@ def solve_guarded(backend: Backend, problem: Problem, run: Callable[[], RawResul
 class StatefulBackend:
     """Set up once, then update data and warm-start while the structure holds.
 
-    Subclasses define ``name``, ``default_tolerance``, ``default_settings`` and
-    implement :meth:`_structure_of`, :meth:`_setup` (cold: build the solver
-    from scratch) and :meth:`_update` (warm: push new data into the existing
-    solver). If a warm answer fails :meth:`Solution.checked`, the problem is
-    solved once more cold and the solution is flagged ``retried``.
+    Subclass it to add a backend: define ``name``, ``default_tolerance`` and
+    ``default_settings``, and implement :meth:`_setup` (cold: build the solver
+    from scratch), :meth:`_update` (warm: push new data into the existing
+    solver), both returning a :class:`RawResult`, and :meth:`_release`;
+    override :meth:`_structure_of` when the solver needs more than the problem
+    sizes to stay unchanged. If a warm answer fails :meth:`Solution.checked`,
+    the problem is solved once more cold and the solution is flagged
+    ``retried``.
+
+    Parameters
+    ----------
+    tolerance : float, optional
+        Absolute tolerance of the residual check (default ``default_tolerance``).
+    **settings
+        Solver settings, merged over ``default_settings``; unknown names raise
+        :class:`SolverError`.
     """
 
     name: str
@@ -158,9 +188,11 @@ class StatefulBackend:
         return (problem.n, problem.n_eq, problem.n_in, problem.has_bounds)
 
     def _setup(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
+        """Build the solver for ``problem`` from scratch and solve (cold start)."""
         raise NotImplementedError
 
     def _update(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
+        """Push ``problem``'s data into the existing solver and solve (warm start)."""
         raise NotImplementedError
 
     def _release(self) -> None:

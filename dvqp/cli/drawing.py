@@ -1,0 +1,236 @@
+"""Drawing a trajectory: the developed view, the body, the pipe cross-section.
+
+The helpers draw on given :class:`matplotlib.axes.Axes` and import matplotlib only when called.
+In the developed view, l is shown wrapped into ``(−πR, πR]``; the strips just beyond the seam
+``l = ±πR`` (shaded) repeat the other side of the pipe, so obstacles, the tool path and the body
+stay continuous where they cross the seam.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from numbers import Real
+from typing import TYPE_CHECKING, Any, NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from dvqp.errors import ParameterError
+from dvqp.kinematics.developed_view import unwrap, wrap
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from dvqp import Obstacle, Trajectory
+
+SHIFTS = (-1, 0, 1)
+"""Copies of seam-periodic drawings, in periods ``2πR``."""
+
+
+class View(NamedTuple):
+    """A trajectory with what is drawn around it, checked by :func:`make_view`.
+
+    Attributes
+    ----------
+    traj
+        The trajectory.
+    radius
+        Pipe radius ``R``, m.
+    obstacles
+        Obstacle circles (l, z).
+    h_star
+        Orbital level ``h*``, m, or None.
+    weld
+        Axial position of the weld, m, or None.
+    limits
+        ``(l_min, l_max, z_min, z_max)`` of the developed-view axes, m.
+    """
+
+    traj: Trajectory
+    radius: float
+    obstacles: tuple[Obstacle, ...]
+    h_star: float | None
+    weld: float | None
+    limits: tuple[float, float, float, float]
+
+    @property
+    def aspect(self) -> float:
+        """Height over width of the developed-view axes."""
+        return (self.limits[3] - self.limits[2]) / (self.limits[1] - self.limits[0])
+
+
+def make_view(
+    traj: Trajectory,
+    obstacles: Sequence[Obstacle] = (),
+    orbital_level: float | None = None,
+    weld_z: float | None = None,
+) -> View:
+    """Check the inputs and fix the developed-view limits (z: everything drawn, padded).
+
+    Raises
+    ------
+    ParameterError
+        No valid pipe radius, no sample or non-finite points, a non-finite level or weld.
+    """
+    radius = float(traj.pipe_radius)
+    if not 0 < radius < math.inf:
+        raise ParameterError("pipe_radius", f"the trajectory has no valid pipe radius ({radius})")
+    finite = np.all(np.isfinite(traj.points)) and np.all(np.isfinite(traj.tool))
+    if traj.t.shape[0] < 1 or not finite:
+        raise ParameterError("trajectory", "needs at least one sample and finite points")
+    for name, value in (("orbital_level", orbital_level), ("weld_z", weld_z)):
+        if value is not None and not (isinstance(value, Real) and math.isfinite(value)):
+            raise ParameterError(name, f"must be a finite number, got {value!r}")
+    h = None if orbital_level is None else float(orbital_level)
+    weld = None if weld_z is None else float(weld_z)
+    limits = _limits(traj, radius, obstacles, weld)
+    return View(traj, radius, tuple(obstacles), h, weld, limits)
+
+
+def _limits(
+    traj: Trajectory, radius: float, obstacles: Sequence[Obstacle], weld: float | None
+) -> tuple[float, float, float, float]:
+    """Developed-view limits: l a little beyond the seams, z around everything drawn, m."""
+    z = [traj.points[..., 1].ravel(), traj.tool[:, 1]]
+    z += [np.array([o.center[1] - o.radius, o.center[1] + o.radius]) for o in obstacles]
+    zs = np.concatenate([*z, [] if weld is None else [weld]])
+    pad, edge = 0.08 * float(np.ptp(zs)) + 0.03, 1.12 * np.pi * radius
+    return (-edge, edge, float(zs.min()) - pad, float(zs.max()) + pad)
+
+
+def wrap_arc(l: NDArray[np.float64] | float, radius: float) -> NDArray[np.float64]:
+    """Arc length wrapped into ``(−πR, πR]`` (atan2's interval), m."""
+    return -wrap(-np.asarray(l, dtype=np.float64), radius)  # wrap() gives [−πR, πR)
+
+
+def body_at(traj: Trajectory, i: int) -> NDArray[np.float64]:
+    """Body points then the tool at sample i, shape (k+1, 3), ``[l, z, h]`` (m).
+
+    l is continuous along the body and starts in ``(−πR, πR]``.
+    """
+    body = np.vstack([traj.points[i], traj.tool[i, :3]])
+    body[:, 0] = unwrap(body[:, 0], 2.0 * np.pi * traj.pipe_radius)
+    body[:, 0] += wrap_arc(body[0, 0], traj.pipe_radius) - body[0, 0]
+    return body
+
+
+def body_copies(body: NDArray[np.float64], radius: float) -> list[tuple[NDArray, NDArray]]:
+    """The body polyline (l, z) and its copies one period left and right (the axes clip)."""
+    return [(body[:, 0] + s * 2.0 * np.pi * radius, body[:, 1]) for s in SHIFTS]
+
+
+def draw_developed_view(ax: Axes, view: View) -> None:
+    """Seam, shaded strips beyond it, weld, obstacles and the tool path in the (l, z) axes."""
+    half, weld = np.pi * view.radius, view.weld
+    for side in (-1, 1):
+        ax.axvspan(side * half, side * 2 * half, color="0.85", zorder=0)
+        ax.axvline(side * half, color="0.4", lw=1.0, label="seam l = ±πR" if side < 0 else None)
+    if weld is not None:
+        ax.axhline(weld, color="tab:orange", ls="--", lw=1.5, label=f"weld z = {weld:.3g} m")
+    _draw_obstacles(ax, view)
+    _draw_tool_path(ax, view)
+    ax.set(xlim=view.limits[:2], ylim=view.limits[2:], aspect="equal")
+    ax.set(xlabel="l, arc length around the pipe (m)", ylabel="z, along the pipe axis (m)")
+    ax.set_title("developed view (pipe unrolled; shaded: beyond the seam)")
+
+
+def _draw_obstacles(ax: Axes, view: View) -> None:
+    """Every obstacle circle, wrapped, with its copies one period left and right."""
+    from matplotlib.patches import Circle
+
+    period = 2.0 * np.pi * view.radius
+    style = {"fc": "tab:red", "ec": "darkred", "alpha": 0.3}
+    for j, o in enumerate(view.obstacles):
+        cl = float(wrap_arc(o.center[0], view.radius))
+        for s in SHIFTS:
+            label = "obstacle" if j == 0 and s == 0 else None
+            ax.add_patch(Circle((cl + s * period, o.center[1]), o.radius, **style, label=label))
+
+
+def _draw_tool_path(ax: Axes, view: View) -> None:
+    """The tool path, wrapped and broken where it crosses the seam, and its copies."""
+    traj, half = view.traj, np.pi * view.radius
+    lt = wrap_arc(traj.tool[:, 0], view.radius)
+    jumps = np.flatnonzero(np.abs(np.diff(lt)) > half) + 1
+    lt, zt = np.insert(lt, jumps, np.nan), np.insert(traj.tool[:, 1], jumps, np.nan)
+    for s in SHIFTS:
+        label = "tool path" if s == 0 else None
+        ax.plot(lt + s * 2.0 * half, zt, "k-", lw=1.0, zorder=3, label=label)
+
+
+def draw_body(
+    ax: Axes, body: NDArray[np.float64], radius: float, color: Any, legend: bool = True
+) -> list[Any]:
+    """The body polyline (points, then tool ▲) and its copies.
+
+    Parameters
+    ----------
+    ax
+        Developed-view axes.
+    body
+        ``[l, z, h]`` of the points then the tool, shape (k+1, 3), m (see :func:`body_at`).
+    radius
+        Pipe radius, m.
+    color
+        A matplotlib colour.
+    legend
+        Label the middle copy for the legend.
+
+    Returns
+    -------
+    list
+        ``[line, tool marker]`` per copy, in :data:`SHIFTS` order.
+    """
+    artists = []
+    for s, (lb, zb) in zip(SHIFTS, body_copies(body, radius), strict=True):
+        label = "body (points 1..k, tool ▲)" if s == 0 and legend else None
+        artists += ax.plot(lb, zb, "-o", color=color, lw=1.8, ms=3.5, label=label)
+        artists += ax.plot(lb[-1:], zb[-1:], "^", color=color, ms=7)
+    return artists
+
+
+def draw_section(ax: Axes, view: View, instants: Sequence[tuple[int, Any]]) -> None:
+    """Pipe cross-section (x, y): wall, orbital circle, obstacle extents, the body at instants.
+
+    ``instants`` holds ``(sample index, colour)`` pairs.
+    """
+    radius, h_star = view.radius, view.h_star
+    th = np.linspace(0.0, 2.0 * np.pi, 361)
+    circle = np.array([np.cos(th), np.sin(th)])
+    ax.plot(*(radius * circle), "k-", lw=1.5, label=f"pipe R = {radius:.3g} m")
+    if h_star is not None:
+        orbit = (radius + h_star) * circle
+        ax.plot(*orbit, color="0.3", ls="--", lw=1.0, label="orbital level R + h*")
+    for j, o in enumerate(view.obstacles):
+        arc = np.linspace(o.center[0] - o.radius, o.center[0] + o.radius, 50) / radius
+        label = "obstacle (l extent)" if j == 0 else None
+        xy = radius * np.cos(arc), radius * np.sin(arc)
+        ax.plot(*xy, color="tab:red", lw=5, alpha=0.5, solid_capstyle="butt", label=label)
+    for i, c in instants:
+        _draw_section_body(ax, view, i, c)
+    _finish_section(ax, view)
+
+
+def _draw_section_body(ax: Axes, view: View, i: int, color: Any) -> None:
+    """The body at sample i in the cross-section, tool ▲ at its end."""
+    traj, radius = view.traj, view.radius
+    body = np.vstack([traj.points[i], traj.tool[i, :3]])
+    rho, angle = radius + body[:, 2], body[:, 0] / radius
+    x, y = rho * np.cos(angle), rho * np.sin(angle)
+    ax.plot(x, y, "-o", color=color, lw=1.5, ms=3)
+    ax.plot(x[-1], y[-1], "^", color=color, ms=6)
+
+
+def _finish_section(ax: Axes, view: View) -> None:
+    """The seam mark, square limits around everything drawn, labels and legend."""
+    traj, radius = view.traj, view.radius
+    top = max(
+        float(traj.points[..., 2].max()), float(traj.tool[:, 2].max()), view.h_star or 0.0, 0.0
+    )
+    reach = radius + top + 0.05 * radius
+    ax.plot([-0.85 * radius, -reach], [0.0, 0.0], color="0.4", lw=1.0, label="seam (l = ±πR)")
+    ax.set(xlim=(-reach, reach), ylim=(-reach, reach), aspect="equal")
+    ax.set(xlabel="x (m)", ylabel="y (m)", title="cross-section (body coloured by time)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="x-small", loc="center", framealpha=0.6)  # the pipe's inside is empty

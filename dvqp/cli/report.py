@@ -1,0 +1,114 @@
+"""What the command line prints and writes: the comparison table, a run's summary, CSV.
+
+The rows are those of :func:`dvqp.cli.compare.summarize` (keys :data:`dvqp.cli.compare.FIELDS`);
+an undefined figure (None) is shown as ``-`` in the table and as an empty CSV cell.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from dvqp._files import atomic_file
+from dvqp.cli.compare import FIELDS, Row
+
+if TYPE_CHECKING:
+    from dvqp import Scene, Trajectory
+
+TABLE = (  # (row key, header, format)
+    ("scene", "scene", "{}"), ("backend", "backend", "{}"), ("success", "ok", "{}"),
+    ("steps", "steps", "{}"), ("median_step_us", "med us", "{:.0f}"),
+    ("p95_step_us", "p95 us", "{:.0f}"), ("ratio_to_pinv", "x pinv", "{:.2f}"),
+    ("max_task_error", "task err", "{:.1e}"), ("min_clearance", "clearance m", "{:+.4f}"),
+    ("max_joint_limit_violation", "q viol rad", "{:.3g}"),
+    ("max_velocity_limit_violation", "qd viol rad/s", "{:.3g}"), ("failures", "fails", "{}"),
+)  # fmt: skip
+"""Columns of :func:`format_table`: (row key, header, format of a defined value)."""
+
+
+def format_table(rows: Sequence[Row]) -> str:
+    """The comparison as an aligned text table, a header and a rule first (``-``: undefined)."""
+    table = [[h for _, h, _ in TABLE]] + [[_cell(r, k, f) for k, _, f in TABLE] for r in rows]
+    widths = [max(len(line[i]) for line in table) for i in range(len(TABLE))]
+    just = [str.ljust, str.ljust] + [str.rjust] * (len(TABLE) - 2)
+    lines = [
+        "  ".join(j(c, w) for j, c, w in zip(just, line, widths, strict=True)) for line in table
+    ]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def _cell(row: Row, key: str, fmt: str) -> str:
+    """One table cell: ``-`` for None, ``yes``/``NO`` for a flag, else ``fmt``."""
+    value = row.get(key)
+    if value is None:
+        return "-"
+    if isinstance(value, bool):
+        return "yes" if value else "NO"
+    return fmt.format(value)
+
+
+def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None) -> str:
+    """What ``dvqp plan`` prints about a run.
+
+    Parameters
+    ----------
+    scene
+        The scene that was run.
+    traj
+        Its trajectory.
+    row
+        Its figures, from :func:`dvqp.cli.compare.summarize`.
+    output
+        The file the trajectory was saved to, or None.
+    """
+    fails = row["failures"]
+    tool = traj.tool[-1]
+    lines = [
+        f"scene           {scene.name} ({scene.source}), {scene.mode} mode",
+        f"backend         {traj.backend}",
+        f"steps           {traj.n_steps}, " + ("all succeeded" if not fails else f"{fails} failed"),
+        f"max task error  {_num(row['max_task_error'], '{:.2e}')}",
+        f"min clearance   {_num(row['min_clearance'], '{:+.4f} m')}",
+        f"step time       median {_num(row['median_step_us'], '{:.0f}')} us, "
+        f"p95 {_num(row['p95_step_us'], '{:.0f}')} us",
+        f"final tool DV   l = {tool[0]:.4f} m, z = {tool[1]:.4f} m, h = {tool[2]:.4f} m, "
+        f"alpha = {tool[3]:.4f} rad",
+    ]
+    if row["final_tracking_error"] is not None:
+        lines.append(f"final tracking  {row['final_tracking_error'] * 1e3:.3g} mm")
+    if output is not None:
+        lines.append(f"saved           {output}")
+    return "\n".join(lines)
+
+
+def _num(value: float | None, fmt: str) -> str:
+    return "-" if value is None else fmt.format(value)
+
+
+def rows_to_csv(rows: Sequence[Row]) -> str:
+    """The rows as CSV text: a header of :data:`~dvqp.cli.compare.FIELDS`, then one line each.
+
+    Flags are written ``true``/``false``, undefined figures as empty cells.
+    """
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(FIELDS)
+    for row in rows:
+        writer.writerow([_csv_cell(row.get(key)) for key in FIELDS])
+    return buf.getvalue()
+
+
+def _csv_cell(value: Any) -> Any:
+    if value is None:
+        return ""
+    return str(value).lower() if isinstance(value, bool) else value
+
+
+def write_text(path: Path, text: str) -> None:
+    """Write ``text`` (UTF-8) atomically: a temporary file in the same folder, then renamed."""
+    with atomic_file(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")

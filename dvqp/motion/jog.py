@@ -1,0 +1,51 @@
+"""JOG commands: constant developed-view velocities held for a while, as the operator's keys."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from dvqp import _validate
+from dvqp.errors import ParameterError
+
+MAX_STEPS = 10_000_000
+"""Most steps a planned motion may take."""
+
+
+@dataclass(frozen=True)
+class JogSegment:
+    """A constant DV velocity held for a duration.
+
+    Parameters
+    ----------
+    duration
+        s, > 0.
+    velocity
+        ``[l̇, ż, ḣ, α̇]`` (m/s, m/s, m/s, rad/s), shape (4,).
+    """
+
+    duration: float
+    velocity: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "duration", _validate.positive("duration", self.duration))
+        v = _validate.readonly(_validate.vector("velocity", self.velocity, 4))
+        object.__setattr__(self, "velocity", v)
+
+
+def jog_step_count(segments: Sequence[JogSegment], dt: float) -> int:
+    """How many steps of ``dt`` the segments take (each at least one)."""
+    return sum(max(1, round(s.duration / dt)) for s in segments)
+
+
+def jog_commands(segments: Sequence[JogSegment], dt: float) -> NDArray[np.float64]:
+    """Sample JOG segments every ``dt`` seconds: the commands, shape (N, 4)."""
+    dt = _validate.positive("dt", dt)
+    counts = [max(1, round(s.duration / dt)) for s in segments]
+    if sum(counts) > MAX_STEPS:
+        raise ParameterError("dt", f"{sum(counts)} steps is too many (at most {MAX_STEPS})")
+    rows = [np.tile(s.velocity, (c, 1)) for s, c in zip(segments, counts, strict=True)]
+    return np.vstack(rows) if rows else np.zeros((0, 4))

@@ -1,0 +1,54 @@
+"""Repulsion of the links from the obstacle circles (paper eq. 13–15)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from dvqp.geometry.obstacle import ObstacleSet
+from dvqp.geometry.proximity import proximity
+from dvqp.kinematics.state import KinematicState
+from dvqp.objective.term import Term, per_point, point_gains
+
+
+class ObstacleLinks:
+    """``Σ_j ³w_j = Σ_j Σ_i ½ w_j k̂_i (D_ij² − R_j²)`` over the links ``[p_i, p_{i+1}]``.
+
+    ``k̂_i = k¹_i`` where the closest point of link i to centre j is interior and inside the
+    circle, else 0.
+
+    Parameters
+    ----------
+    obstacles
+        Circles in (l, z) with their weights ``w_j``.
+    k_obstacle
+        ``k¹``, scalar or one per body point (link i takes ``k¹_i``), >= 0.
+    """
+
+    name = "obstacle_links"
+
+    def __init__(self, obstacles: ObstacleSet, k_obstacle: ArrayLike = 1.0) -> None:
+        self.obstacles = ObstacleSet.of(obstacles)
+        self.k_obstacle = point_gains("k_obstacle", k_obstacle)
+
+    def evaluate(self, state: KinematicState) -> Term:
+        """Value and ``−Σ w k̂ (S − p̄)ᵀ ((1−t) ∂p_i + t ∂p_{i+1})`` (the ∂t term vanishes)."""
+        obstacles = self.obstacles
+        if not len(obstacles):
+            return Term(0.0, np.zeros(state.n))
+        near = proximity(state, obstacles)
+        t = near.link_t
+        excess = near.link_distance**2 - obstacles.radii[:, None] ** 2  # (J, k-1)
+        active = (excess < 0.0) & (t > 0.0) & (t < 1.0)
+        if not active.any():
+            return Term(0.0, np.zeros(state.n))
+        k = state.points.shape[0]
+        k1 = per_point("k_obstacle", self.k_obstacle, k)
+        coef = obstacles.weights[:, None] * k1[None, :-1] * active
+        value = 0.5 * float(np.sum(coef * excess))
+        a = coef[..., None] * near.link_offsets  # (J, k-1, 2)
+        at_points = np.zeros((k, 2))
+        at_points[:-1] += (a * (1.0 - t)[..., None]).sum(axis=0)
+        at_points[1:] += (a * t[..., None]).sum(axis=0)
+        grad = -np.einsum("kc,kcn->n", at_points, state.point_jacobians[:, :2, :])
+        return Term(value, grad)

@@ -1,0 +1,46 @@
+"""Repulsion of the body points from the obstacle circles (paper eq. 12)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from dvqp.geometry.obstacle import ObstacleSet
+from dvqp.geometry.proximity import proximity
+from dvqp.kinematics.state import KinematicState
+from dvqp.objective.term import Term, per_point, point_gains
+
+
+class ObstaclePoints:
+    """``Σ_j ²w_j = Σ_j Σ_i ½ w_j k̂_i (‖S_j − p_i‖² − R_j²)``, ``k̂_i = k¹_i`` inside circle j.
+
+    Parameters
+    ----------
+    obstacles
+        Circles in (l, z) with their weights ``w_j``.
+    k_obstacle
+        ``k¹``, scalar or one per body point, >= 0.
+    """
+
+    name = "obstacle_points"
+
+    def __init__(self, obstacles: ObstacleSet, k_obstacle: ArrayLike = 1.0) -> None:
+        self.obstacles = ObstacleSet.of(obstacles)
+        self.k_obstacle = point_gains("k_obstacle", k_obstacle)
+
+    def evaluate(self, state: KinematicState) -> Term:
+        """Value and ``−Σ w k̂ (S − p)ᵀ ∂p/∂Q`` (point Jacobian rows l, z)."""
+        obstacles = self.obstacles
+        if not len(obstacles):
+            return Term(0.0, np.zeros(state.n))
+        near = proximity(state, obstacles)
+        excess = near.point_distance**2 - obstacles.radii[:, None] ** 2  # (J, k)
+        inside = excess < 0.0
+        if not inside.any():
+            return Term(0.0, np.zeros(state.n))
+        k1 = per_point("k_obstacle", self.k_obstacle, excess.shape[1])
+        coef = obstacles.weights[:, None] * k1[None, :] * inside
+        value = 0.5 * float(np.sum(coef * excess))
+        v = (coef[..., None] * near.point_offsets).sum(axis=0)  # (k, 2)
+        grad = -np.einsum("kc,kcn->n", v, state.point_jacobians[:, :2, :])
+        return Term(value, grad)

@@ -1,0 +1,101 @@
+"""Resolver names, resolved in one place: the ``pinv`` baseline beside every QP backend.
+
+Every name a user types (``dvqp plan --backend``, :func:`dvqp.plan`, ``dvqp compare``) goes
+through :func:`make_resolver`; an unknown one raises :class:`~dvqp.errors.BackendError`
+listing what is installed and the extra that installs more.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import solvers
+from dvqp.errors import BackendError
+from dvqp.resolution.pinv import PseudoinverseResolver
+from dvqp.resolution.qp_resolver import QPResolver
+from dvqp.resolution.spec import StepSpec
+from dvqp.resolution.step import Resolver
+
+PINV = "pinv"
+"""Name of the paper's pseudoinverse baseline (eq. 18)."""
+
+EXTRA_HINT = "pip install 'dvqp[solvers]' for proxqp, quadprog, piqp and highs"
+
+
+@dataclass(frozen=True)
+class ResolverInfo:
+    """What ``dvqp backends`` prints about one name.
+
+    Attributes
+    ----------
+    name : str
+        The name to pass to :func:`make_resolver`.
+    distribution : str
+        The Python distribution that provides it.
+    version : str
+        Its installed version (``"?"`` if unknown).
+    note : str
+        How it is reached, e.g. ``"via qpsolvers 4.13.0"`` or ``"pseudoinverse baseline"``.
+    """
+
+    name: str
+    distribution: str
+    version: str
+    note: str
+
+
+def available_resolvers() -> list[str]:
+    """Every name :func:`make_resolver` accepts here: ``pinv`` first, then the QP backends."""
+    return [PINV, *solvers.available_backends()]
+
+
+def default_resolvers() -> list[str]:
+    """``pinv`` and every installed plain QP backend name (no ``qpsolvers:`` prefix)."""
+    return [PINV, *(b for b in solvers.available_backends() if ":" not in b)]
+
+
+def describe_resolvers() -> list[ResolverInfo]:
+    """One :class:`ResolverInfo` per name of :func:`available_resolvers`, in that order."""
+    from dvqp import __version__
+
+    infos = [ResolverInfo(PINV, "dvqp", __version__, "pseudoinverse baseline, paper eq. 18")]
+    for b in solvers.describe_backends():
+        infos.append(ResolverInfo(b.name, b.distribution, b.version, b.note))
+    return infos
+
+
+def check_name(name: str) -> str:
+    """``name`` if :func:`make_resolver` knows it.
+
+    Raises
+    ------
+    BackendError
+        Unknown or not installed: the message lists the installed names and the extra.
+    """
+    known = available_resolvers()
+    if name not in known:
+        raise BackendError(
+            f"unknown backend {name!r}; installed: {', '.join(known)} ({EXTRA_HINT})"
+        )
+    return name
+
+
+def make_resolver(name: str, spec: StepSpec) -> Resolver:
+    """A fresh resolver of ``spec`` by name.
+
+    Parameters
+    ----------
+    name
+        ``"pinv"`` or a QP backend name of :func:`solvers.available_backends`.
+    spec
+        The tasks, objective, limits and weights of the step.
+
+    Raises
+    ------
+    BackendError
+        Unknown or not installed (see :func:`check_name`).
+    """
+    check_name(name)
+    if name == PINV:
+        return PseudoinverseResolver(spec)
+    return QPResolver(spec, name)

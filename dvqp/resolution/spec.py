@@ -1,0 +1,93 @@
+"""What one resolution step is made of: tasks, the objective, limits and the metric ``W``."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from dvqp import _validate
+from dvqp.errors import ParameterError, ShapeError
+from dvqp.limits.limit import Limit
+from dvqp.objective.objective import Objective
+from dvqp.tasks.task import Task
+
+DEFAULT_TASK_WEIGHT = 1e4
+"""``ρ`` of the hard tasks' slack (dimensionless relative to W): large, so a task is given
+up last."""
+
+
+@dataclass(frozen=True)
+class StepSpec:
+    """The ingredients of a step, shared by the QP and the pseudoinverse baseline.
+
+    Parameters
+    ----------
+    tasks
+        At least one hard task (e.g. :class:`~dvqp.tasks.ToolTask`), any soft tasks.
+    objective
+        ``w(Q)``, followed as ``g = λ ∂w/∂Q`` in the hard tasks' null space.
+    limits
+        Hard limits of the QP (ignored by the baseline), in row order.
+    weights
+        Diagonal of ``W`` (> 0), scalar or shape (n,).
+    task_weight
+        ``ρ`` of the hard tasks' slack in the relaxed problem, > 0.
+    """
+
+    tasks: tuple[Task, ...]
+    objective: Objective = field(default_factory=Objective)
+    limits: tuple[Limit, ...] = ()
+    weights: ArrayLike = 1.0
+    task_weight: float = DEFAULT_TASK_WEIGHT
+    # diag(W) under n, W under -n: built once per number of joints
+    _diagonal: dict[int, NDArray[np.float64]] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "tasks", tuple(self.tasks))
+        object.__setattr__(self, "limits", tuple(self.limits))
+        if not any(getattr(t, "hard", False) for t in self.tasks):
+            raise ParameterError("tasks", "need at least one hard task (e.g. ToolTask())")
+        _check_methods("tasks", self.tasks, "compute")
+        _check_methods("limits", self.limits, "compute")
+        w = np.asarray(self.weights, dtype=np.float64)
+        if w.ndim > 1:
+            raise ShapeError("weights", (-1,), w.shape)
+        if not np.isfinite(w).all() or np.any(w <= 0):
+            raise ParameterError("weights", "must be finite and > 0")
+        object.__setattr__(self, "weights", _validate.readonly(w.copy()))
+        tw = _validate.positive("task_weight", self.task_weight)
+        object.__setattr__(self, "task_weight", tw)
+
+    def diagonal(self, n: int) -> NDArray[np.float64]:
+        """The diagonal of ``W`` for n joints, shape (n,) (read-only, built once)."""
+        found = self._diagonal.get(n)
+        if found is None:
+            found = _validate.readonly(_validate.broadcast("weights", self.weights, n))
+            self._diagonal[n] = found
+        return found
+
+    def hessian(self, n: int) -> NDArray[np.float64]:
+        """``W = diag(weights)`` for n joints, shape (n, n) (read-only, built once)."""
+        found = self._diagonal.get(-n)
+        if found is None:
+            found = _validate.readonly(np.diag(self.diagonal(n)))
+            self._diagonal[-n] = found
+        return found
+
+    def with_extra(self, tasks: Sequence[Task] = (), limits: Sequence[Limit] = ()) -> StepSpec:
+        """A copy with more tasks and limits appended."""
+        return StepSpec(
+            (*self.tasks, *tasks), self.objective, (*self.limits, *limits), self.weights,
+            self.task_weight,
+        )  # fmt: skip
+
+
+def _check_methods(name: str, items: Sequence[object], method: str) -> None:
+    for i, item in enumerate(items):
+        if not callable(getattr(item, method, None)) or not hasattr(item, "name"):
+            raise ParameterError(f"{name}[{i}]", f"needs a name and a {method}(state, ...) method")

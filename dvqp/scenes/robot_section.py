@@ -1,0 +1,88 @@
+"""Reader of a scene file's ``[robot]`` table: the arm, its limits, q0 and the weights."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from dvqp import _validate
+from dvqp.errors import DvqpError, ParameterError
+from dvqp.kinematics.robot import Robot
+from dvqp.scenes.fields import Fields, join
+
+ROBOT_KEYS = ("model", "link_lengths", "urdf", "points", "tool", "q0", "q_min", "q_max", "qd_max",
+              "weights")  # fmt: skip
+MODELS = ("ndt13",)
+
+
+def robot(
+    f: Fields, doc: dict[str, Any], base_dir: Path
+) -> tuple[Robot, NDArray[np.float64], NDArray[np.float64]]:
+    """The arm, its start configuration (rad) and the diagonal of W, each checked."""
+    t = f.table(doc, "robot", "", ROBOT_KEYS)
+    arm = _arm(f, t, base_dir)
+    q0 = f.vector(t, "q0", "robot", arm.n)
+    _check_limits(f, arm, q0)
+    weights = f.vector(t, "weights", "robot", arm.n, scalar=True, default=1.0)
+    if np.any(weights <= 0):
+        f.fail("robot.weights", "must be > 0")
+    return arm, _validate.readonly(q0), _validate.readonly(weights)
+
+
+def _arm(f: Fields, t: dict[str, Any], base_dir: Path) -> Robot:
+    if ("model" in t) == ("urdf" in t):
+        f.fail("robot", "give exactly one of 'model' (built in) or 'urdf' (a file)")
+    if "model" in t:
+        model = f.string(t, "model", "robot")
+        if model not in MODELS:
+            f.fail("robot.model", f"unknown model {model!r} (known: {', '.join(MODELS)})")
+        for key in ("points", "tool"):
+            if key in t:
+                f.fail(join("robot", key), "only with 'urdf'")
+        lengths = f.vector(t, "link_lengths", "robot", 7)
+        limits = _limits(f, t, 13)
+        with f.mapped("robot"):
+            return Robot.ndt13(lengths, **{k: v for k, v in limits.items() if v is not None})
+    if "link_lengths" in t:
+        f.fail("robot.link_lengths", "only with model = 'ndt13'")
+    urdf = base_dir / f.string(t, "urdf", "robot")
+    points, tool = f.strings(t, "points", "robot"), f.string(t, "tool", "robot")
+    if not urdf.is_file():
+        f.fail("robot.urdf", f"no such file: {urdf}")
+    try:
+        loaded = Robot.from_urdf(urdf, points, tool)
+    except ParameterError as exc:
+        _frame_error(f, exc, tool)
+    except DvqpError as exc:
+        f.fail("robot.urdf", str(exc))
+    limits = _limits(f, t, loaded.n)
+    if limits["qd_max"] is None:
+        limits["qd_max"] = loaded.qd_max
+    with f.mapped("robot"):
+        return Robot(loaded.model, points, tool, name=loaded.name, **limits)
+
+
+def _limits(f: Fields, t: dict[str, Any], n: int) -> dict[str, NDArray[np.float64] | None]:
+    """q_min, q_max (±inf allowed: no limit) and qd_max as given, or None."""
+    return {
+        key: f.vector(t, key, "robot", n, scalar=True, infinite=key != "qd_max")
+        if key in t
+        else None
+        for key in ("q_min", "q_max", "qd_max")
+    }
+
+
+def _frame_error(f: Fields, exc: ParameterError, tool: str) -> None:
+    if exc.name != "frames":
+        f.fail(join("robot", exc.name), exc.reason)
+    key = "tool" if exc.reason.startswith(f"no frame named {tool!r}") else "points"
+    f.fail(join("robot", key), exc.reason)
+
+
+def _check_limits(f: Fields, robot: Robot, q0: NDArray[np.float64]) -> None:
+    for i, (q, lo, hi) in enumerate(zip(q0, robot.q_min, robot.q_max, strict=True)):
+        if not lo - 1e-12 <= q <= hi + 1e-12:
+            f.fail(f"robot.q0[{i}]", f"{q:g} rad is outside [q_min, q_max] = [{lo:g}, {hi:g}] rad")
