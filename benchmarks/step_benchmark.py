@@ -21,7 +21,7 @@ import numpy as np
 
 import dvqp
 import solvers
-from dvqp.planning import default_backends
+from dvqp.resolution.registry import default_resolvers
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -37,7 +37,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.backends:
         backends = args.backends.split(",")
     else:
-        plain = default_backends()
+        plain = default_resolvers()
         direct = [f"qpsolvers:{b}" for b in ("osqp", "clarabel", "daqp", "proxqp") if b in plain]
         backends = [*plain, *(b for b in direct if b in solvers.available_backends())]
     step: dict[str, list[np.ndarray]] = {b: [] for b in backends}
