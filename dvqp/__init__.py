@@ -16,6 +16,7 @@ The pieces, in the order a step uses them (one subpackage each):
 from dvqp.errors import (
     BackendError,
     DvqpError,
+    LimitViolationError,
     ParameterError,
     SceneError,
     ShapeError,
@@ -50,6 +51,7 @@ __all__ = [
     "JogSegment",
     "KinematicState",
     "Limit",
+    "LimitViolationError",
     "Objective",
     "ObjectiveTerm",
     "Obstacle",

@@ -1,14 +1,15 @@
-"""Output files: checked before any work, written atomically (private)."""
+"""Output files: checked before any work, written atomically; C output captured (private)."""
 
 from __future__ import annotations
 
 import contextlib
 import os
+import sys
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-from dvqp.errors import ParameterError
+from dvqp.errors import OutputError, ParameterError
 
 
 def output_path(path: str | Path, suffixes: Sequence[str]) -> Path:
@@ -17,7 +18,8 @@ def output_path(path: str | Path, suffixes: Sequence[str]) -> Path:
     Raises
     ------
     ParameterError
-        ``output: <path>: unknown format '.txt' (use .npz, .csv)`` or ``… no such directory``.
+        ``output: <path>: unknown format '.txt' (use .npz, .csv)``, ``… no such directory``,
+        ``… is a directory``.
     """
     target = Path(path)
     suffix = target.suffix.lower()
@@ -27,6 +29,8 @@ def output_path(path: str | Path, suffixes: Sequence[str]) -> Path:
         )
     if not target.parent.is_dir():
         raise ParameterError("output", f"{target.parent}: no such directory")
+    if target.is_dir():
+        raise ParameterError("output", f"{target}: is a directory")
     try:  # find out now, not after a long run, that the folder cannot take the file
         with tempfile.TemporaryFile(dir=target.parent):
             pass
@@ -41,18 +45,75 @@ def output_path(path: str | Path, suffixes: Sequence[str]) -> Path:
 def atomic_file(target: Path) -> Iterator[Path]:
     """Yield a temporary path beside ``target``; on success it replaces ``target``.
 
-    The file appears complete or not at all: on any error the temporary file is removed and an
-    existing ``target`` is left as it was. The new file gets the usual mode (``0o666 & ~umask``),
-    not ``mkstemp``'s 0600.
+    The file appears complete or not at all: on any error (a full disk, Ctrl-C) the temporary
+    file is removed and an existing ``target`` is left as it was. The new file gets the usual
+    mode (``0o666 & ~umask``), not ``mkstemp``'s 0600.
+
+    Raises
+    ------
+    OutputError
+        ``output: <target>: cannot write: <reason>`` for an operating-system error while
+        creating, writing or renaming the file (e.g. ``No space left on device``).
     """
-    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=target.suffix)
-    os.close(fd)
+    try:
+        fd, tmp = tempfile.mkstemp(
+            dir=target.parent, prefix=f".{target.name}.", suffix=target.suffix
+        )
+        os.close(fd)
+    except OSError as exc:
+        raise _output_error(target, exc) from exc
     try:
         yield Path(tmp)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, target)
-    except BaseException:
+        _finish(Path(tmp), target)
+    except BaseException as exc:
         Path(tmp).unlink(missing_ok=True)
+        if isinstance(exc, OSError) and not isinstance(exc, OutputError):
+            raise _output_error(target, exc) from exc
         raise
+
+
+def _finish(tmp: Path, target: Path) -> None:
+    """Flush ``tmp`` to the disk (a full disk may only show here), set its mode, rename it."""
+    fd = os.open(tmp, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)
+    os.replace(tmp, target)
+
+
+def _output_error(target: Path, exc: OSError) -> OutputError:
+    return OutputError(target, exc.strerror or str(exc) or type(exc).__name__, exc.errno)
+
+
+@contextlib.contextmanager
+def c_output_captured(lines: list[str]) -> Iterator[None]:
+    """Send what C/C++ code writes to the file descriptors 1 and 2 into ``lines``.
+
+    For libraries that print to the terminal themselves (Pinocchio's URDF parser): their
+    output is kept off the terminal, and the caller may quote it. The non-empty lines, with
+    runs of white space collapsed, are appended to ``lines`` when the block ends, also on an
+    error. Python's ``sys.stdout`` and ``sys.stderr`` are flushed first; a descriptor that is
+    not open is left alone.
+    """
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(AttributeError, OSError, ValueError):
+            stream.flush()
+    with tempfile.TemporaryFile() as sink:
+        saved: list[tuple[int, int]] = []
+        try:
+            for fd in (1, 2):
+                with contextlib.suppress(OSError):
+                    saved.append((fd, os.dup(fd)))
+                    os.dup2(sink.fileno(), fd)
+            yield
+        finally:
+            for fd, copy in saved:
+                os.dup2(copy, fd)
+                os.close(copy)
+            sink.seek(0)
+            text = sink.read().decode("utf-8", errors="replace")
+            lines.extend(" ".join(line.split()) for line in text.splitlines() if line.strip())

@@ -26,6 +26,19 @@ def broadcast(name: str, value: ArrayLike, n: int) -> NDArray[np.float64]:
     return vector(name, arr, n)
 
 
+def limit(name: str, value: ArrayLike, n: int) -> NDArray[np.float64]:
+    """Return a scalar or length-``n`` limit as a float64 vector of length ``n``; ±inf allowed
+    (no limit), NaN not."""
+    arr = np.asarray(value, dtype=np.float64)
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,):
+        raise ShapeError(name, (n,), arr.shape)
+    if np.any(np.isnan(arr)):
+        raise ParameterError(name, "must not be NaN")
+    return arr.copy()
+
+
 def positive(name: str, value: float, *, strict: bool = True) -> float:
     """Return ``value`` as a float, checking it is finite and > 0 (>= 0 if not strict)."""
     v = float(value)

@@ -11,6 +11,15 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 
+def one_line(text: str) -> str:
+    """``text`` with line breaks and other unprintable characters escaped (``\\n``).
+
+    Messages quote what the user wrote (keys, file names, parser output): this keeps each on
+    one line.
+    """
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
+
+
 class DvqpError(Exception):
     """Base class of every error raised by dvqp."""
 
@@ -104,5 +113,54 @@ class SceneError(DvqpError, ValueError):
         self.path = path
         self.field = field
         self.reason = reason
-        where = f"{field}: " if field else ""
-        super().__init__(f"{path}: {where}{reason}")
+        where = f"{one_line(field)}: " if field else ""
+        super().__init__(f"{one_line(path)}: {where}{one_line(reason)}")
+
+
+class OutputError(DvqpError, OSError):
+    """An output file could not be written (a directory in the way, a full disk, ...).
+
+    Nothing is left behind: the file is written to a temporary name and renamed only when
+    complete. Also an :class:`OSError`, so code that catches those still does.
+
+    Parameters
+    ----------
+    path
+        The file that was to be written.
+    reason
+        Why it could not be, e.g. ``"No space left on device"``.
+    errno
+        The operating system's error number, if there was one.
+    """
+
+    def __init__(self, path: object, reason: str, errno: int | None = None) -> None:
+        self.path = str(path)
+        self.reason = reason
+        super().__init__(f"output: {one_line(self.path)}: cannot write: {one_line(reason)}")
+        self.errno = errno
+
+    def __reduce__(self) -> tuple[type[OutputError], tuple[str, str, int | None]]:
+        return (OutputError, (self.path, self.reason, self.errno))
+
+    def __str__(self) -> str:  # OSError's own __str__ would show its errno fields
+        return str(self.args[0])
+
+
+class LimitViolationError(DvqpError):
+    """A planned motion breaks a limit (the baseline holds none; a QP run that could not keep
+    one fails its step instead).
+
+    Parameters
+    ----------
+    message
+        One line naming the limit, the part and the amount.
+    sample
+        Index of the worst sample.
+    excess
+        How far past the limit, in its unit (m or rad).
+    """
+
+    def __init__(self, message: str, sample: int, excess: float) -> None:
+        self.sample = sample
+        self.excess = excess
+        super().__init__(message)

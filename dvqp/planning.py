@@ -15,9 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp.errors import UnreachableTargetError
+from dvqp.errors import LimitViolationError, UnreachableTargetError
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits import Limit
+from dvqp.limits import Excess, Limit, worst_excess
 from dvqp.motion.jog import jog_commands
 from dvqp.motion.simulate import dv_error, simulate
 from dvqp.motion.trajectory import Trajectory
@@ -101,12 +101,32 @@ def plan(
 
 
 def check_run(scene: Scene, traj: Trajectory) -> None:
-    """Raise if a planned run failed: steps that failed, or a path's end not reached.
+    """Raise if a planned run failed: steps that failed, a broken limit, a path's end missed.
 
     The path's end counts as reached when the final position error is within
     ``path.tolerance`` (m) and the heading error within ``path.heading_tolerance`` (rad).
+
+    Raises
+    ------
+    UnreachableTargetError
+        A step failed, or the path's end was not reached.
+    LimitViolationError
+        A saved sample breaks a limit by more than its tolerance (the baseline holds none).
     """
     where = f"{scene.source}: {traj.backend}"
+    if traj.limits_kept.shape[0] and not traj.limits_kept.all():
+        worst = worst_sample_excess(scene, traj)
+        sample = int(np.argmin(traj.limits_kept)) if worst is None else worst[0]
+        detail = (
+            ""
+            if worst is None
+            else f": worst at t = {traj.t[worst[0]]:.3f} s, {worst[1].describe()}"
+        )
+        count = int(np.sum(~traj.limits_kept))
+        raise LimitViolationError(
+            f"{where}: {count} of {traj.t.shape[0]} samples break a limit{detail}",
+            sample, float(traj.limit_excess[sample]),
+        )  # fmt: skip
     if not traj.ok:
         first = int(np.argmin(traj.success))
         count = int(np.sum(~traj.success))
@@ -126,6 +146,25 @@ def check_run(scene: Scene, traj: Trajectory) -> None:
             step=traj.n_steps,
             error=position,
         )
+
+
+def worst_sample_excess(scene: Scene, traj: Trajectory) -> tuple[int, Excess] | None:
+    """The sample whose limit excess is worst relative to its tolerance, and that excess.
+
+    None if the trajectory has no sample or records no excess (a file from before 0.2).
+    """
+    if traj.limit_excess.shape[0] == 0:
+        return None
+    limits = scene.spec().limits
+    start = KinematicState.compute(scene.robot, traj.q[0], scene.pipe_radius)
+    candidates = np.flatnonzero(traj.limit_excess > 0.0)
+    if candidates.shape[0] == 0:
+        return None
+    found = []
+    for k in candidates[np.argsort(traj.limit_excess[candidates])[-20:]]:
+        state = KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius)
+        found.append((int(k), worst_excess(limits, start, state)))
+    return max(found, key=lambda item: item[1].ratio)
 
 
 def final_errors(traj: Trajectory) -> tuple[float, float]:

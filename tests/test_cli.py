@@ -55,7 +55,8 @@ def test_plan_writes_the_trajectory_and_prints_a_summary(
     assert main(["plan", scene, "--backend", "pinv", "-o", str(out)]) == 0
     captured = capsys.readouterr()
     labels = [
-        "steps           20, all succeeded",
+        "steps           20: 20 optimal, 0 relaxed, 0 failed",
+        "result          safe to send: every limit kept",
         "max task error",
         "min clearance",
         "step time       median",
@@ -124,7 +125,7 @@ def test_plan_of_an_unreachable_path_exits_1_with_one_line(
     assert len(lines) == 1 and no_traceback(captured.err)
     assert lines[0].startswith(f"dvqp: {scene}: daqp: target not reached at t = 0.215 s: ")
     assert out.exists()  # the failed run is kept, to look at
-    assert "final tracking" in captured.out
+    assert "final deviation" in captured.out
 
 
 def test_compare_prints_one_table_and_writes_json_and_csv(
@@ -140,8 +141,9 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
     captured = capsys.readouterr()
     lines = captured.out.splitlines()
     assert lines[0].split() == ["scene", "backend", "ok", "steps", "med", "us", "p95", "us", "x",
-                                "pinv", "task", "err", "clearance", "m", "q", "viol", "rad",
-                                "qd", "viol", "rad/s", "fails"]  # fmt: skip
+                                "pinv", "task", "err", "clearance", "m", "closest", "excess", "q",
+                                "viol", "rad", "qd", "viol", "rad/s", "relaxed", "split",
+                                "fails"]  # fmt: skip
     assert [line.split()[:4] for line in lines[2:6]] == [
         ["one", "pinv", "yes", "20"], ["one", "daqp", "yes", "20"],
         ["two", "pinv", "yes", "20"], ["two", "daqp", "yes", "20"],
@@ -154,7 +156,8 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
     first = doc["results"][0]
     assert first["ratio_to_pinv"] == 1.0 and first["success"] is True and first["steps"] == 20
     keys = ["median_step_us", "p95_step_us", "max_task_error", "min_clearance",
-            "max_joint_limit_violation", "max_velocity_limit_violation", "failures"]  # fmt: skip
+            "min_probe_clearance", "min_tilt", "max_limit_excess", "max_joint_limit_violation",
+            "max_velocity_limit_violation", "failures", "relaxed", "substepped"]  # fmt: skip
     for key in keys:
         assert isinstance(first[key], (int, float)), key
     header = cs.read_text(encoding="utf-8").splitlines()[0].split(",")

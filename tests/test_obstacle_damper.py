@@ -30,6 +30,10 @@ def clearance_of(robot: Robot, q: np.ndarray, obstacles: ObstacleSet, label: str
     near = proximity(state, obstacles)
     kind, j = label.split("/obstacle")
     j = int(j) - 1
+    if kind == "probe":
+        return float(near.point_clearance[j, state.k])
+    if kind == "holder":
+        return float(near.link_clearance[j, state.k - 1])
     if kind.startswith("point"):
         return float(near.point_clearance[j, int(kind[5:]) - 1])
     return float(near.link_clearance[j, int(kind[4:]) - 1])
@@ -40,6 +44,7 @@ def test_damper_rows_are_minus_the_clearance_gradient(robot: Robot, q0: np.ndarr
     obstacles = near_obstacles(state)
     rows = ObstacleDamper(obstacles, influence=0.2).compute(state, DT)
     assert any(lab.startswith("link") for lab in rows.labels)
+    assert any(lab.startswith("probe") for lab in rows.labels)
     for row, label in zip(rows.G, rows.labels, strict=True):
         fd = central_difference(
             lambda v, lab=label: clearance_of(robot, v, obstacles, lab), q0, 1e-7
@@ -54,15 +59,19 @@ def test_right_hand_side_is_the_damped_clearance_above_the_margin(
     damper = ObstacleDamper(obstacles, margin=0.01, influence=0.2, gain=0.3)
     d = damper.distances(state0)
     rows = damper.compute(state0, DT)
-    np.testing.assert_allclose(rows.h, np.maximum(0.3 / DT * (d.value - 0.01), 0.0))
+    np.testing.assert_allclose(rows.h, 0.3 / DT * np.maximum(d.value - 0.01, -1e-4))
     np.testing.assert_array_equal(rows.G, -d.gradient)
 
 
-def test_right_hand_side_is_clipped_for_pairs_inside_the_margin(state0: KinematicState) -> None:
+def test_pairs_deep_inside_the_margin_are_pushed_out_at_a_bounded_rate(
+    state0: KinematicState,
+) -> None:
     p = state0.points[2, :2]
     inside = ObstacleSet([Obstacle(p + np.array([0.0, 0.01]), 0.03)])
-    rows = ObstacleDamper(inside).compute(state0, DT)
-    assert rows.rows > 0 and np.all(rows.h >= 0.0) and np.any(rows.h == 0.0)
+    damper = ObstacleDamper(inside, gain=0.5)
+    rows = damper.compute(state0, DT)
+    floor = -0.5 / DT * damper.tolerance
+    assert rows.rows > 0 and np.all(rows.h >= floor - 1e-15) and np.any(rows.h == floor)
 
 
 def test_constructor_validates_its_parameters() -> None:

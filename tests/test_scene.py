@@ -12,7 +12,9 @@ from dvqp.limits import (
     JointPositionLimit,
     JointVelocityLimit,
     ObstacleDamper,
+    ProbeHeight,
     SurfaceHeight,
+    TiltLimit,
 )
 from dvqp.scenes.scene import environment, loads
 from tests.common import LINK_LENGTHS, ORBITAL_LEVEL, PIPE_RADIUS, Q0
@@ -74,11 +76,13 @@ def test_a_valid_scene_becomes_typed_objects() -> None:
     np.testing.assert_array_equal(scene.obstacles[0].center, [0.20, 0.45])
     assert scene.orbital_level == ORBITAL_LEVEL and scene.objective.gain == 1.0
     assert scene.objective.terms[0].level == ORBITAL_LEVEL
-    kinds = (JointPositionLimit, JointVelocityLimit, ObstacleDamper, SurfaceHeight)
+    kinds = (JointPositionLimit, JointVelocityLimit, ObstacleDamper, SurfaceHeight, ProbeHeight,
+             TiltLimit)  # fmt: skip
     assert [type(limit) for limit in scene.limits] == list(kinds)
-    damper, height = scene.limits[2], scene.limits[3]
+    damper, height, probe, tilt = scene.limits[2:]
     assert (damper.margin, damper.influence, damper.gain) == (0.01, 0.06, 0.5)
     assert (height.min_height, height.gain) == (0.0, 0.5)
+    assert (probe.floor, probe.gain, tilt.min_tilt, tilt.gain) == (0.0, 0.5, 0.2, 0.5)
     assert damper.obstacles is scene.obstacles is scene.objective.terms[1].obstacles
     assert scene.dt == 0.005 and len(scene.jog) == 1 and scene.path is None
     np.testing.assert_array_equal(scene.weights, np.ones(13))
@@ -162,14 +166,15 @@ INVALID = [
     ("limits crossed", ("q0 = [", "q_min = 2.0\nq_max = 1.0\nq0 = ["),
      "robot.q_min: must be <= q_max for every joint"),
     ("zero velocity limit", ("q0 = [", "qd_max = 0\nq0 = ["),
-     "robot.qd_max: must be > 0 for every joint"),
-    ("zero weight", ("q0 = [", "weights = 0.0\nq0 = ["), "robot.weights: must be > 0"),
-    ("negative link", ("[0.334,", "[-0.334,"), "robot.link_lengths: must be >= 0"),
+     "robot.qd_max: must be > 0, got 0.0"),
+    ("zero weight", ("q0 = [", "weights = 0.0\nq0 = ["),
+     "robot.weights: must be >= 1e-06, got 0.0"),
+    ("negative link", ("[0.334,", "[-0.334,"), "robot.link_lengths[0]: must be >= 0, got -0.334"),
     ("unknown model", ('"ndt13"', '"ndt12"'), "robot.model: unknown model 'ndt12' (known: ndt13)"),
     ("model and urdf", ('model = "ndt13"', 'model = "ndt13"\nurdf = "a.urdf"'),
      "robot: give exactly one of 'model' (built in) or 'urdf' (a file)"),
     ("negative objective weight", ("k_height = 1.0", "k_height = -1.0"),
-     "objective.k_height: must be >= 0"),
+     "objective.k_height: must be >= 0, got -1.0"),
     ("damper gain", ("damper_gain = 0.5", "damper_gain = 2"),
      "constraints.damper_gain: must be in (0, 1], got 2.0"),
     ("influence below margin", ("influence = 0.06", "influence = 0.005"),
@@ -187,6 +192,58 @@ INVALID = [
     ("obstacle swallows the tool", ("center = [0.20, 0.45]", "center = [0.2973, 0.40]"),
      "obstacles[0]: covers the tool's start point [l, z] = [0.2973, 0.35] m "
      "(distance 0.04999 m < radius 0.06 m)"),
+    # sane bounds of physical quantities, the bound in the message
+    ("huge pipe", ("radius = 0.254", "radius = 1e300"),
+     "pipe.radius: must be <= 100 m, got 1e+300"),
+    ("tiny pipe", ("radius = 0.254", "radius = 1e-9"),
+     "pipe.radius: must be >= 0.001 m, got 1e-09"),
+    ("far weld", ("radius = 0.254", "radius = 0.254\nweld = -1e9"),
+     "pipe.weld: must be >= -1000 m, got -1000000000.0"),
+    ("long link", ("[0.334,", "[1e3,"), "robot.link_lengths[0]: must be <= 10 m, got 1000.0"),
+    ("far start angle", ("q0 = [1.5708", "q_min = -inf\nq_max = inf\nq0 = [1e300"),
+     "robot.q0[0]: must be <= 1000 rad, got 1e+300"),
+    ("huge finite limit", ("q0 = [", "q_max = 1e300\nq0 = ["),
+     "robot.q_max: must be <= 1000 rad, got 1e+300"),
+    ("fast joint", ("q0 = [", "qd_max = 1e9\nq0 = ["),
+     "robot.qd_max: must be <= 1000 rad/s, got 1000000000.0"),
+    ("heavy joint", ("q0 = [", "weights = 1e300\nq0 = ["),
+     "robot.weights: must be <= 1e+06, got 1e+300"),
+    ("far obstacle", ("center = [0.10, 0.20]", "center = [0.10, 1e300]"),
+     "obstacles[1].center[1]: must be <= 1000 m, got 1e+300"),
+    ("huge obstacle", ("radius = 0.05", "radius = 1e3"),
+     "obstacles[1].radius: must be <= 100 m, got 1000.0"),
+    ("heavy obstacle", ("weight = 10.0", "weight = 1e300"),
+     "obstacles[0].weight: must be <= 1e+06, got 1e+300"),
+    ("high orbit", ("orbital_level = 0.08", "orbital_level = 1e300"),
+     "objective.orbital_level: must be <= 10 m, got 1e+300"),
+    ("orbit inside", ("orbital_level = 0.08", "orbital_level = -0.1"),
+     "objective.orbital_level: must be >= 0, got -0.1"),
+    ("huge objective weight", ("k_height = 1.0", "k_height = [1, 1, 1e300, 1, 1]"),
+     "objective.k_height[2]: must be <= 1e+06, got 1e+300"),
+    ("huge gain", ("k_height = 1.0", "k_height = 1.0\ngain = 1e300"),
+     "objective.gain: must be <= 1e+06, got 1e+300"),
+    ("long dt", ("dt = 0.005", "dt = 5"), "motion.dt: must be <= 1 s, got 5.0"),
+    ("longest duration", ("duration = 0.1", "duration = 1.7976931348623157e308"),
+     "motion.jog[0].duration: must be <= 1e+06 s, got 1.7976931348623157e+308"),
+    ("fast jog", ("[0.05, 0.0, 0.0, 0.0]", "[0.05, 0.0, 0.0, 1e300]"),
+     "motion.jog[0].velocity[3]: must be <= 10 rad/s, got 1e+300"),
+    ("too many jog steps", ("duration = 0.1", "duration = 1e6"),
+     "motion: about 2e+08 steps of dt: too many (at most 1e+07)"),
+    ("any other number", ("margin = 0.01", "margin = 1e300"),
+     "constraints.margin: must be <= 1e+06, got 1e+300"),
+    # what the parser itself cannot take
+    ("deep arrays", ("radius = 0.254", "radius = 0.254\nweld = " + "[" * 1000 + "]" * 1000),
+     "invalid TOML: values nested too deeply"),
+    ("deep tables", ("radius = 0.254",
+     "radius = 0.254\nweld = " + "{a = " * 1000 + "1" + "}" * 1000),
+     "invalid TOML: values nested too deeply"),
+    ("nested but parsed", ("radius = 0.254", "radius = 0.254\nweld = " + "[" * 100 + "]" * 100),
+     "pipe.weld: expected a number, got an array"),
+    ("5000 digits", ("radius = 0.254", "radius = " + "1" * 5000),
+     "invalid TOML: Exceeds the limit (4300 digits) for integer string conversion: "
+     "value has 5000 digits"),
+    ("line break in a key", ("[pipe]", '[pipe]\n"a\\nb" = 1'),
+     "pipe.a\\nb: unknown key (allowed: radius, weld)"),
 ]  # fmt: skip
 
 
@@ -212,7 +269,7 @@ INVALID_PATHS = [
     ("zero-length path", ("[0.35, 0.35, 0.082, 0.0]", "[0.30, 0.35, 0.082, 0.0]"),
      "motion.path.waypoints: the waypoints are all the same: nothing to follow"),
     ("number out of range", ("speed = 0.05", "speed = 1" + "0" * 400),
-     "motion.path.speed: out of range"),
+     "motion.path.speed: must be <= 10 m/s, got 1.000e+400"),
     ("too many steps", ("speed = 0.05", "speed = 1e-300"),
      "motion: about 1e+301 steps of dt: too many (at most 1e+07)"),
     ("missing speed", ("speed = 0.05", ""), "motion.path.speed: required field is missing"),
@@ -319,3 +376,47 @@ def test_environment_reads_what_a_plot_needs_without_building_the_robot() -> Non
     env = environment(text)
     assert (env.pipe_radius, env.orbital_level, env.weld) == (0.254, 0.08, 0.35)
     assert [o.radius for o in env.obstacles] == [0.06, 0.05]
+
+
+def _write_urdf_scene(folder: Path, urdf: str) -> Path:
+    (folder / "arm.urdf").write_text(urdf, encoding="utf-8")
+    text = edit(BASE, 'model = "ndt13"', 'urdf = "arm.urdf"\npoints = ["p2", "p4"]\ntool = "tool"')
+    text = edit(text, "link_lengths = [0.334, 0.10, 0.15, 0.15, 0.15, 0.15, 0.06]\n", "")
+    text = edit(text, f"q0 = {Q0}", "q0 = [0.0, 0.1, 0.4, -0.2, -0.5, 0.3]")
+    text = edit(text, "center = [0.20, 0.45]", "center = [0.20, 0.95]")
+    scene = folder / "arm.toml"
+    scene.write_text(text, encoding="utf-8")
+    return scene
+
+
+def test_a_continuous_urdf_joint_is_a_revolute_joint_without_limits(tmp_path: Path) -> None:
+    urdf = _urdf_arm().replace('name="j1" type="revolute"', 'name="j1" type="continuous"')
+    scene = load_scene(_write_urdf_scene(tmp_path, urdf))
+    assert scene.robot.n == 6 and scene.robot.q_min[0] == -np.inf and scene.robot.q_max[0] == np.inf
+    np.testing.assert_array_equal(scene.robot.q_max[1:], 3.0)
+    assert plan(scene, "pinv").ok
+
+
+def test_urdf_errors_name_robot_urdf_and_keep_the_parser_quiet(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    floating = _urdf_arm().replace('name="j3" type="revolute"', 'name="j3" type="floating"')
+    with pytest.raises(SceneError) as info:
+        load_scene(_write_urdf_scene(tmp_path, floating))
+    assert str(info.value).endswith(
+        "robot.urdf: joint 'j3' is a FreeFlyer joint: only revolute, continuous and prismatic "
+        "joints are supported"
+    )
+    with pytest.raises(SceneError) as info:
+        load_scene(_write_urdf_scene(tmp_path, "this is <not> XML"))
+    message = str(info.value)
+    assert message.startswith(f"{tmp_path / 'arm.toml'}: robot.urdf: {tmp_path / 'arm.urdf'}: ")
+    assert "cannot load URDF" in message and "XML_ERROR" in message and "\n" not in message
+    assert capfd.readouterr() == ("", "")  # the C++ parser's own lines are kept off fd 1 and 2
+
+
+def test_the_bundled_urdf_scene_runs_as_the_paper_scene() -> None:
+    urdf, paper = load_scene(SCENES / "urdf-arm.toml"), load_scene(SCENES / "paper-two-inlets.toml")
+    assert urdf.robot.n == 13 and urdf.robot.frame_names[-1] == "probe"
+    assert urdf.robot.q_min[0] == -np.inf  # the carriage is a continuous joint
+    np.testing.assert_allclose(plan(urdf, "pinv").q, plan(paper, "pinv").q, rtol=0, atol=1e-12)

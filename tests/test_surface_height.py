@@ -21,15 +21,20 @@ def test_height_rows_are_minus_the_height_gradient(robot: Robot, q0: np.ndarray)
     assert rows.labels == tuple(f"point{i}/height" for i in range(1, 6))
 
 
-def test_a_point_below_the_minimum_may_not_descend(state0: KinematicState) -> None:
+def test_a_point_below_the_minimum_is_pushed_back_at_a_bounded_rate(
+    state0: KinematicState,
+) -> None:
     above = float(state0.points[:, 2].max()) + 0.01
-    rows = SurfaceHeight(min_height=above).compute(state0, DT)
-    np.testing.assert_array_equal(rows.h, 0.0)
+    limit = SurfaceHeight(min_height=above, gain=0.5)
+    rows = limit.compute(state0, DT)
+    np.testing.assert_allclose(rows.h, -0.5 / DT * limit.tolerance)
 
 
-def test_damper_rhs_is_the_clipped_geometric_decay() -> None:
-    d = np.array([0.05, 0.01, -0.02])
-    np.testing.assert_allclose(damper_rhs(d, 0.01, 0.5, 0.1), [0.2, 0.0, 0.0])
+def test_damper_rhs_is_the_geometric_decay_with_a_bounded_return() -> None:
+    d = np.array([0.05, 0.01, 0.00995, -0.02])
+    np.testing.assert_allclose(
+        damper_rhs(d, 0.01, 0.5, 0.1, 1e-4), [0.2, 0.0, -0.00025, -0.0005], atol=1e-15
+    )
 
 
 def test_constructor_validates_its_parameters() -> None:

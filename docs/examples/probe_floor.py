@@ -1,7 +1,7 @@
 """A user-written limit: the probe (the tool point) stays above a floor over the pipe surface.
 
 It derives from :class:`dvqp.VelocityDamper`, which owns the damper's right-hand side
-``max(γ/dt (d − d_safe), 0)``: the subclass only says which distance it keeps (the tool's
+``γ/dt · max(d − d_safe, −δ)``: the subclass only says which distance it keeps (the tool's
 height h, with gradient the third row of the DV task Jacobian) and its safe value.
 """
 

@@ -18,17 +18,20 @@ import numpy as np
 
 import solvers
 from dvqp import load_scene, plan
-from dvqp.errors import DvqpError, UnreachableTargetError
-from dvqp.planning import check_run, final_errors
+from dvqp.errors import DvqpError
+from dvqp.geometry import proximity
+from dvqp.kinematics import KinematicState
+from dvqp.planning import check_run, final_errors, worst_sample_excess
 from dvqp.resolution.registry import PINV
 
 if TYPE_CHECKING:
     from dvqp import Scene, Trajectory
 
 FIELDS = (
-    "scene", "file", "backend", "success", "steps", "failures", "median_step_us", "p95_step_us",
-    "ratio_to_pinv", "max_task_error", "min_clearance", "max_joint_limit_violation",
-    "max_velocity_limit_violation", "final_tracking_error", "error",
+    "scene", "file", "backend", "success", "steps", "failures", "relaxed", "substepped",
+    "median_step_us", "p95_step_us", "ratio_to_pinv", "max_task_error", "min_clearance",
+    "closest", "min_probe_clearance", "min_tilt", "max_limit_excess", "worst_limit",
+    "max_joint_limit_violation", "max_velocity_limit_violation", "final_tracking_error", "error",
 )  # fmt: skip
 """Keys of a result row, in table / CSV order."""
 
@@ -54,39 +57,73 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
     Returns
     -------
     dict
-        ``steps``; ``failures`` (steps not succeeded); ``success`` (no failure and, for a
-        path, its end reached); median and 95th-percentile full step time (µs); the largest
-        task error ``‖J̄Q̇ − ẋ‖∞`` of the succeeded steps; the smallest obstacle clearance (m);
-        the largest joint-limit violation (rad) of ``q`` and velocity-limit violation
-        (rad/s) of ``Q̇``; the final tracking error (m, path mode); and ``final_tool``
-        ``[l, z, h, α]``; ``error``, why the run failed. Undefined figures are None.
+        ``success``: the run can be sent to the arm — no step failed, every saved sample
+        keeps every limit to its tolerance, and a path's end was reached
+        (:func:`dvqp.planning.check_run`); ``error`` says why not. ``steps``; ``failures``
+        (steps not solved or that broke a limit even in substeps); ``relaxed`` (steps whose
+        task gave way to a limit); ``substepped`` (steps split to keep a limit); median and
+        95th-percentile full step time (µs); the largest task error ``‖J̄Q̇ − ẋ‖∞`` of the
+        succeeded steps; the smallest clearance of any guarded part (m), the part and
+        obstacle that have it (``closest``), the probe's own smallest clearance (m), the
+        smallest probe tilt from radial (rad); ``max_limit_excess`` of the worst limit (in
+        its unit, see ``worst_limit``); the largest joint-limit violation (rad) of ``q`` and
+        velocity-limit violation (rad/s) of ``Q̇``; the final tracking error (m) against the
+        commanded motion; ``final_tool`` ``[l, z, h, α]``. Undefined figures are None.
     """
-    robot = scene.robot
     ok = traj.success
-    why = run_error(scene, traj)
     steps_us = traj.step_time * 1e6
-    q_out = np.maximum(robot.q_min - traj.q, traj.q - robot.q_max)
-    qd_out = np.abs(traj.qdot) - robot.qd_max
-    tracking = (
-        final_errors(traj)[0] if scene.path is not None and traj.tracking_error.size else None
-    )
     return {
         "scene": scene.name,
         "file": scene.source,
         "backend": traj.backend,
-        "success": why is None,
+        "success": (why := run_error(scene, traj)) is None,
         "steps": traj.n_steps,
         "failures": int(np.sum(~ok)),
+        "relaxed": int(np.sum(traj.status == "relaxed")),
+        "substepped": int(np.sum(traj.substeps > 1)) if traj.substeps.size else None,
         "median_step_us": _finite(np.median(steps_us)) if traj.n_steps else None,
         "p95_step_us": _finite(np.percentile(steps_us, 95)) if traj.n_steps else None,
         "ratio_to_pinv": None,
         "max_task_error": _finite(np.max(traj.task_error[ok])) if np.any(ok) else None,
-        "min_clearance": _finite(np.min(traj.min_clearance)),
-        "max_joint_limit_violation": float(max(0.0, np.max(q_out))),
-        "max_velocity_limit_violation": float(max(0.0, np.max(qd_out, initial=0.0))),
-        "final_tracking_error": tracking,
+        **_clearances(scene, traj),
+        **_limit_figures(scene, traj),
+        "final_tracking_error": final_errors(traj)[0] if traj.tracking_error.size else None,
         "final_tool": [float(v) for v in traj.tool[-1]],
         "error": why,
+    }
+
+
+def _clearances(scene: Scene, traj: Trajectory) -> Row:
+    """``min_clearance``, ``closest``, ``min_probe_clearance`` and ``min_tilt``."""
+    closest = None
+    if len(scene.obstacles) and np.isfinite(traj.min_clearance).any():
+        k = int(np.argmin(traj.min_clearance))
+        state = KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius)
+        _, part, j = proximity(state, scene.obstacles).closest()
+        closest = f"{part}/obstacle{j + 1}"
+    return {
+        "min_clearance": _finite(np.min(traj.min_clearance)),
+        "closest": closest,
+        "min_probe_clearance": _finite(np.min(traj.probe_clearance))
+        if traj.probe_clearance.size
+        else None,
+        "min_tilt": _finite(np.min(traj.tilt)) if traj.tilt.size else None,
+    }
+
+
+def _limit_figures(scene: Scene, traj: Trajectory) -> Row:
+    """The worst exact limit excess, and the joint position and velocity violations."""
+    robot = scene.robot
+    q_out = np.maximum(robot.q_min - traj.q, traj.q - robot.q_max)
+    qd_out = np.abs(traj.qdot) - robot.qd_max
+    worst = worst_sample_excess(scene, traj)
+    return {
+        "max_limit_excess": float(worst[1].value) if worst is not None else 0.0,
+        "worst_limit": (
+            f"{worst[1].label} {worst[1].quantity} ({worst[1].unit})" if worst is not None else None
+        ),
+        "max_joint_limit_violation": float(max(0.0, np.max(q_out))),
+        "max_velocity_limit_violation": float(max(0.0, np.max(qd_out, initial=0.0))),
     }
 
 
@@ -94,7 +131,7 @@ def run_error(scene: Scene, traj: Trajectory) -> str | None:
     """Why a planned run failed (the message of :func:`dvqp.planning.check_run`), or None."""
     try:
         check_run(scene, traj)
-    except UnreachableTargetError as exc:
+    except DvqpError as exc:
         return str(exc)
     return None
 

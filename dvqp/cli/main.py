@@ -1,8 +1,10 @@
 """The ``dvqp`` command line: ``plan``, ``compare``, ``plot`` and ``backends``.
 
 Exit codes: 0 success; 1 a run failed (failed steps, a path's end not reached, a singular
-configuration); 2 bad input (scene, backend, file names), reported as ``dvqp: <message>``
-without a traceback and with nothing written. See ``docs/cli.md``.
+configuration); 2 bad input (scene, backend, file names, an output that cannot be written),
+reported as ``dvqp: <message>`` without a traceback and with nothing written; 130 interrupted
+(Ctrl-C), nothing half-written. Warnings of the numerical code are summed up in one line.
+See ``docs/cli.md``.
 """
 
 from __future__ import annotations
@@ -15,13 +17,20 @@ import sys
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
-from dvqp import Trajectory, load_scene, plan
+import numpy as np
+
+from dvqp import Trajectory, __version__, load_scene, plan
 from dvqp._files import output_path
 from dvqp.cli import compare as cmp
 from dvqp.cli.figures import FIGURE_FORMATS
-from dvqp.cli.progress import ProgressBar
+from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
 from dvqp.cli.report import format_summary, format_table, rows_to_csv, write_text
-from dvqp.errors import DvqpError, SingularConfigurationError, UnreachableTargetError
+from dvqp.errors import (
+    DvqpError,
+    LimitViolationError,
+    SingularConfigurationError,
+    UnreachableTargetError,
+)
 from dvqp.planning import check_run
 from dvqp.resolution.registry import (
     ResolverInfo,
@@ -42,20 +51,31 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = _parser()
     try:
         args = parser.parse_args(argv)
-    except SystemExit as exc:  # --help or a usage error (argparse printed it)
-        return int(exc.code or 0)
+    except SystemExit as exc:  # --help, --version or a usage error (argparse printed it)
+        return exc.code if isinstance(exc.code, int) else 2 if exc.code else 0
     if not hasattr(args, "run"):
         parser.print_help(sys.stderr)
         return 2
+    try:
+        with interruptible(), warnings_summed_up() as code:
+            code.append(_run(args))
+        return code[0]
+    except KeyboardInterrupt:
+        print("dvqp: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # stdout piped into a reader that stopped early (``| head``)
+        with contextlib.suppress(OSError, ValueError, AttributeError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
+
+
+def _run(args: argparse.Namespace) -> int:
+    """Run the subcommand; a dvqp error is its one line on stderr and exit code 2."""
     try:
         return int(args.run(args))
     except DvqpError as exc:
         print(f"dvqp: {exc}", file=sys.stderr)
         return 2
-    except BrokenPipeError:  # stdout piped into a reader that stopped early (``| head``)
-        with contextlib.suppress(OSError, ValueError, AttributeError):
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 1
 
 
 # -- arguments --------------------------------------------------------------------------------
@@ -65,8 +85,10 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="dvqp",
         description="Plan, compare and plot arm motions in a pipe's developed view.",
-        epilog="exit codes: 0 success, 1 a run failed, 2 bad input (nothing written)",
+        epilog="exit codes: 0 success, 1 a run failed, 2 bad input (nothing written), "
+        "130 interrupted",
     )
+    parser.add_argument("--version", action="version", version=f"dvqp {__version__}")
     sub = parser.add_subparsers(title="commands", metavar="COMMAND")
     _add_plan(sub)
     _add_compare(sub)
@@ -120,6 +142,7 @@ def _plan(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     output = output_path(args.output, (".npz", ".csv")) if args.output else None
     check_name(args.backend)  # unknown backend: exit 2 before any work
+    check_size([scene], 1)
     try:
         traj = _run_with_bar(scene, args.backend)
     except SingularConfigurationError as exc:
@@ -130,7 +153,7 @@ def _plan(args: argparse.Namespace) -> int:
     print(format_summary(scene, traj, cmp.summarize(scene, traj), output))
     try:
         check_run(scene, traj)
-    except UnreachableTargetError as exc:
+    except (UnreachableTargetError, LimitViolationError) as exc:
         print(f"dvqp: {exc}", file=sys.stderr)
         return 1
     return 0
@@ -151,8 +174,8 @@ def _run_with_bar(scene: Scene, backend: str) -> Trajectory:
 def _compare(args: argparse.Namespace) -> int:
     names = [b.strip() for b in args.backends.split(",")] if args.backends else None
     backends = [check_name(name) for name in names or default_resolvers()]
-    for path in args.scenes:
-        load_scene(path)  # every scene valid before any run
+    scenes = [load_scene(path) for path in args.scenes]  # every scene valid before any run
+    check_size(scenes, len(backends))
     json_out = output_path(args.json, (".json",)) if args.json else None
     csv_out = output_path(args.csv, (".csv",)) if args.csv else None
     plot_out = output_path(args.plot, FIGURE_FORMATS) if args.plot else None
@@ -189,7 +212,7 @@ def _comparison_json(
 
 
 def _plot(args: argparse.Namespace) -> int:
-    traj = Trajectory.load(args.trajectory)
+    traj = _load_trajectory(args.trajectory)
     drawn_with = _stored_environment(traj, args.trajectory)
     try:
         from dvqp.cli import plot
@@ -199,6 +222,44 @@ def _plot(args: argparse.Namespace) -> int:
     written = draw(traj, args.output, **drawn_with)
     print(f"wrote {written}")
     return 0
+
+
+def _load_trajectory(path: str) -> Trajectory:
+    """A trajectory file, checked enough to be drawn.
+
+    Raises
+    ------
+    DvqpError
+        ``<path>: cannot read: <reason>`` or ``<path>: not a dvqp trajectory (<reason>)``.
+    """
+    try:
+        with open(path, "rb") as fh:
+            zipped = fh.read(4) == b"PK\x03\x04"
+    except OSError as exc:
+        raise DvqpError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+    if not zipped:
+        raise DvqpError(f"{path}: not a dvqp trajectory (not an .npz file)")
+    try:
+        traj = Trajectory.load(path)
+    except DvqpError as exc:  # dvqp reads arrays only, never pickled objects
+        raise DvqpError(f"{path}: not a dvqp trajectory (not written by 'dvqp plan')") from exc
+    if not _drawable(traj):
+        raise DvqpError(f"{path}: not a dvqp trajectory (arrays of unexpected shapes)")
+    return traj
+
+
+def _drawable(traj: Trajectory) -> bool:
+    """The arrays a plot reads are float arrays of consistent shapes."""
+    t, q, qdot, tool, points = traj.t, traj.q, traj.qdot, traj.tool, traj.points
+    arrays = (t, q, qdot, tool, points, traj.w, traj.min_clearance)
+    if not all(np.asarray(a).dtype.kind == "f" for a in arrays) or t.ndim != 1 or q.ndim != 2:
+        return False
+    n1 = t.shape[0]
+    return (
+        n1 >= 1 and q.shape[0] == n1 and qdot.shape == (n1 - 1, q.shape[1])
+        and tool.shape == (n1, 4) and points.ndim == 3 and points.shape[0] == n1
+        and points.shape[2] == 3 and traj.w.shape == (n1,) and traj.min_clearance.shape == (n1,)
+    )  # fmt: skip
 
 
 def _stored_environment(traj: Trajectory, source: str) -> dict[str, Any]:

@@ -1,12 +1,168 @@
-"""A one-line progress bar for long runs, drawn only on a terminal."""
+"""Long runs: their size estimated before they start, a progress bar, Ctrl-C and warnings.
+
+What the command line wraps around a run: :func:`check_size` refuses a run whose arrays would
+not fit in memory and announces a long one; :class:`ProgressBar` shows how far it is and how
+long it still takes; :func:`interruptible` makes Ctrl-C a clean stop; :func:`warnings_summed_up`
+keeps warnings of the numerical code off the terminal but for one line.
+"""
 
 from __future__ import annotations
 
-from typing import TextIO
+import contextlib
+import multiprocessing
+import os
+import signal
+import sys
+import threading
+import time
+import warnings
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, TextIO
+
+from dvqp.errors import SceneError
+from dvqp.motion.jog import jog_step_count
+
+if TYPE_CHECKING:
+    from dvqp import Scene
+
+STEP_SECONDS = 6e-4
+"""Typical time of one step (kinematics, objective and a QP), s: the estimate's rate."""
+LONG_RUN_SECONDS = 120.0
+"""Runs estimated to take longer than this are announced before they start, s."""
+MEMORY_SHARE = 0.8
+"""Runs whose arrays would need more than this share of the machine's memory are refused."""
+
+
+@dataclass(frozen=True)
+class RunEstimate:
+    """How big a planned run will be, from its scene alone (before any step).
+
+    Attributes
+    ----------
+    steps : int
+        Steps N of one run (a path's approach to its first waypoint not counted).
+    seconds : float
+        Rough duration of one run at :data:`STEP_SECONDS` a step, s.
+    nbytes : int
+        Memory of its trajectory's arrays, bytes.
+    """
+
+    steps: int
+    seconds: float
+    nbytes: int
+
+    @classmethod
+    def of(cls, scene: Scene) -> RunEstimate:
+        """The estimate of one run of ``scene``."""
+        if scene.path is None:
+            steps = jog_step_count(scene.jog, scene.dt)
+        else:
+            steps = int(scene.path.step_count(scene.dt)) + 1
+        n, k = scene.robot.n, scene.robot.n_points
+        per_step = 8 * (2 * n + 3 * k + 24) + 80  # q, qdot, points, DV, figures, status
+        return cls(steps, steps * STEP_SECONDS, steps * per_step)
+
+    def describe(self, runs: int = 1) -> str:
+        """``about 8e+06 steps: roughly 1.3 h and 4.4 GB`` (for ``runs`` runs)."""
+        runs_text = f" in {runs} runs" if runs > 1 else ""
+        return (
+            f"about {self.steps:.3g} steps{runs_text}: roughly "
+            f"{duration(self.seconds * runs)} and {self.nbytes / 1e9:.2g} GB"
+        )
+
+
+@contextlib.contextmanager
+def interruptible() -> Iterator[None]:
+    """Ctrl-C raises KeyboardInterrupt here, and ends forked worker processes quietly.
+
+    Workers of ``compare --jobs`` are forked with this handler: in them it exits at once
+    (code 130) instead of printing a traceback each. An interrupt sent to this process alone
+    (``kill -INT``) is passed on to them, so none is left running. Only in the main thread
+    (signals are delivered there); elsewhere nothing changes.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    parent = os.getpid()
+
+    def handler(signum: int, frame: object) -> None:
+        if os.getpid() != parent:
+            os._exit(130)
+        for child in multiprocessing.active_children():
+            with contextlib.suppress(OSError, TypeError):
+                os.kill(child.pid, signal.SIGINT)  # type: ignore[arg-type]
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+@contextlib.contextmanager
+def warnings_summed_up() -> Iterator[list[int]]:
+    """Keep warnings (NumPy's ``overflow encountered``, a solver's notes) off the terminal.
+
+    The block appends its exit code to the yielded list. After a run (exit 0 or 1) they are
+    summed up in one line, ``dvqp: warning: …``; after bad input (exit 2) only the error
+    line is printed.
+    """
+    code: list[int] = []
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        yield code
+    if caught and code and code[0] != 2:
+        first = caught[0]
+        more = f" ({len(caught) - 1} more)" if len(caught) > 1 else ""
+        print(f"dvqp: warning: {first.category.__name__}: {first.message}{more}", file=sys.stderr)
+
+
+def check_size(scenes: Sequence[Scene], runs: int) -> None:
+    """Refuse runs whose arrays would not fit in memory; announce those that take long.
+
+    ``runs`` is how many times each scene is run (backends). The announcement is one line on
+    stderr, ``dvqp: note: <file>: about 8e+06 steps: roughly 1.3 h and 4.4 GB``.
+
+    Raises
+    ------
+    SceneError
+        ``<file>: motion: about 8e+06 steps: roughly … GB, more than … of this machine``.
+    """
+    memory = physical_memory()
+    for scene in scenes:
+        estimate = RunEstimate.of(scene)
+        if memory and estimate.nbytes > MEMORY_SHARE * memory:
+            raise SceneError(
+                scene.source, "motion", f"{estimate.describe()}, more than this machine's "
+                f"{memory / 1e9:.2g} GB allow: use a larger dt or a shorter motion",
+            )  # fmt: skip
+        if estimate.seconds * runs > LONG_RUN_SECONDS:
+            print(f"dvqp: note: {scene.source}: {estimate.describe(runs)}", file=sys.stderr)
+
+
+def physical_memory() -> int | None:
+    """The machine's memory, bytes (None where the system does not say)."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def duration(seconds: float) -> str:
+    """``42 s``, ``3.5 min``, ``1.3 h``."""
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.2g} min"
+    return f"{seconds / 3600:.2g} h"
 
 
 class ProgressBar:
     """A one-line progress bar on a terminal (silent when the stream is not a TTY).
+
+    After a second it also shows the time left, from the rate so far.
 
     Parameters
     ----------
@@ -20,6 +176,7 @@ class ProgressBar:
         self.stream, self.width = stream, width
         self.enabled = bool(getattr(stream, "isatty", lambda: False)())
         self._last = -1
+        self._started = time.perf_counter()
 
     def show(self, done: int, total: int, label: str = "") -> None:
         """Draw ``done`` of ``total`` with a label (redrawn at most every 1 %)."""
@@ -31,11 +188,15 @@ class ProgressBar:
         self._last = percent
         filled = self.width * done // total
         bar = "#" * filled + "." * (self.width - filled)
-        self.stream.write(f"\r[{bar}] {done}/{total} {label[:40]:<40}")
+        elapsed = time.perf_counter() - self._started
+        left = ""
+        if 0 < done < total and elapsed > 1.0:
+            left = f" {duration(elapsed * (total - done) / done)} left"
+        self.stream.write(f"\r[{bar}] {done}/{total}{left} {label[:40]:<40}")
         self.stream.flush()
 
     def close(self) -> None:
         """Erase the bar (if one was drawn)."""
         if self.enabled and self._last >= 0:
-            self.stream.write("\r" + " " * (self.width + 60) + "\r")
+            self.stream.write("\r" + " " * (self.width + 80) + "\r")
             self.stream.flush()

@@ -2,8 +2,8 @@
 
 A :class:`Robot` is built from a DH table (:meth:`Robot.from_dh`), from the paper's 13-DOF
 arm (:meth:`Robot.ndt13`) or from a URDF file (:meth:`Robot.from_urdf`). The method is not
-limited to 13 DOF: any serial chain with ``n`` revolute joints, ``k`` point frames and a tool
-frame works.
+limited to 13 DOF: any serial chain with ``n`` revolute (or prismatic) joints, ``k`` point
+frames and a tool frame works. The base frame's z axis is the pipe axis.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
+from dvqp._files import c_output_captured
 from dvqp.errors import DvqpError, ParameterError
 from dvqp.kinematics.dh import DHRow, check_transform, fixed_part, ndt13_table
 
@@ -76,8 +77,8 @@ class Robot:
         self.frame_ids: tuple[int, ...] = tuple(ids)
         lo = model.lowerPositionLimit if q_min is None else q_min
         hi = model.upperPositionLimit if q_max is None else q_max
-        self.q_min = _validate.readonly(_broadcast_limit("q_min", lo, n))
-        self.q_max = _validate.readonly(_broadcast_limit("q_max", hi, n))
+        self.q_min = _validate.readonly(_validate.limit("q_min", lo, n))
+        self.q_max = _validate.readonly(_validate.limit("q_max", hi, n))
         if np.any(self.q_min > self.q_max):
             raise ParameterError("q_min", "must be <= q_max for every joint")
         qd = _validate.broadcast("qd_max", qd_max, n)
@@ -141,8 +142,8 @@ class Robot:
         for j in point_joints:
             if not 1 <= int(j) <= n:
                 raise ParameterError("point_joints", f"joint {j} is not in 1..{n}")
-        lo = _broadcast_limit("q_min", q_min, n)
-        hi = _broadcast_limit("q_max", q_max, n)
+        lo = _validate.limit("q_min", q_min, n)
+        hi = _validate.limit("q_max", q_max, n)
         model = pin.Model()
         model.name = name
         parent = 0
@@ -214,27 +215,74 @@ class Robot:
     ) -> Robot:
         """Load a serial arm from a URDF file; ``points`` and ``tool`` are frame (link) names.
 
-        Velocity limits default to the URDF's, or :data:`DEFAULT_QD_MAX` where it gives none.
+        The URDF's base frame is the pipe's frame: its z axis is the pipe axis. ``continuous``
+        joints become revolute joints without position limits (``±inf``); ``revolute`` and
+        ``prismatic`` joints keep their limits; other joint types (``floating``, ``planar``)
+        are refused. Velocity limits default to the URDF's, or :data:`DEFAULT_QD_MAX` where it
+        gives none. What the C++ URDF parser prints is kept off the terminal; its first
+        complaint is part of the error.
+
+        Raises
+        ------
+        DvqpError
+            ``<path>: cannot load URDF: <reason>`` for a file that is not a valid URDF.
+        ParameterError
+            ``urdf``: a joint of a type other than the above; ``frames``: no such frame.
         """
+        noise: list[str] = []
         try:
-            model = pin.buildModelFromUrdf(str(path))
+            with c_output_captured(noise):
+                model = pin.buildModelFromUrdf(str(path))
         except (RuntimeError, ValueError) as exc:
-            raise DvqpError(f"{path}: cannot load URDF: {exc}") from exc
+            detail = f" ({noise[0]})" if noise else ""
+            raise DvqpError(f"{path}: cannot load URDF: {exc}{detail}") from exc
+        model = _bounded_revolute(model)
         if qd_max is None:
             vel = np.asarray(model.velocityLimit, dtype=float)
             qd_max = np.where(np.isfinite(vel) & (vel > 0), vel, DEFAULT_QD_MAX)
         return cls(model, points, tool, q_min=q_min, q_max=q_max, qd_max=qd_max, name=model.name)
 
 
-def _broadcast_limit(name: str, value: ArrayLike, n: int) -> NDArray[np.float64]:
-    """Scalar or (n,) limit vector; ±inf allowed, NaN not."""
-    arr = np.asarray(value, dtype=np.float64)
-    if arr.ndim == 0:
-        arr = np.full(n, float(arr))
-    if arr.shape != (n,):
-        from dvqp.errors import ShapeError
+UNBOUNDED_REVOLUTE = {"JointModelRUBX": pin.JointModelRX, "JointModelRUBY": pin.JointModelRY,
+                      "JointModelRUBZ": pin.JointModelRZ}  # fmt: skip
+"""Pinocchio's joints for a URDF ``continuous`` joint (nq = 2: cos, sin) and their nq = 1 twin
+(an unaligned axis: ``JointModelRevoluteUnboundedUnaligned``, twin ``…RevoluteUnaligned``)."""
 
-        raise ShapeError(name, (n,), arr.shape)
-    if np.any(np.isnan(arr)):
-        raise ParameterError(name, "must not be NaN")
-    return arr.copy()
+
+def _bounded_revolute(model: pin.Model) -> pin.Model:
+    """``model`` with each continuous joint (nq = 2) as a revolute one without limits (nq = 1).
+
+    The joints, bodies and frames keep their names, placements, inertias and order; any other
+    joint with ``nq != nv`` is refused.
+    """
+    kinds = [model.joints[i].shortname() for i in range(1, model.njoints)]
+    unaligned = "JointModelRevoluteUnboundedUnaligned"
+    for name, kind, joint in zip(model.names[1:], kinds, model.joints[1:], strict=True):
+        if joint.nq != joint.nv and kind not in UNBOUNDED_REVOLUTE and kind != unaligned:
+            raise ParameterError(
+                "urdf", f"joint {name!r} is a {kind.removeprefix('JointModel')} joint: only "
+                "revolute, continuous and prismatic joints are supported"
+            )  # fmt: skip
+    if not any(k in UNBOUNDED_REVOLUTE or k == unaligned for k in kinds):
+        return model
+    out = pin.Model()
+    out.name = model.name
+    for i in range(1, model.njoints):
+        joint, kind = model.joints[i], kinds[i - 1]
+        q, v = (
+            slice(joint.idx_q, joint.idx_q + joint.nq),
+            slice(joint.idx_v, joint.idx_v + joint.nv),
+        )
+        lo, hi = model.lowerPositionLimit[q], model.upperPositionLimit[q]
+        if kind in UNBOUNDED_REVOLUTE or kind == unaligned:
+            new = (UNBOUNDED_REVOLUTE[kind]() if kind != unaligned
+                   else pin.JointModelRevoluteUnaligned(joint.extract().axis))  # fmt: skip
+            lo, hi = np.array([-np.inf]), np.array([np.inf])
+        else:
+            new = joint.extract()
+        out.addJoint(model.parents[i], new, model.jointPlacements[i], model.names[i],
+                     model.effortLimit[v], model.velocityLimit[v], lo, hi)  # fmt: skip
+        out.appendBodyToJoint(i, model.inertias[i], pin.SE3.Identity())
+    for frame in list(model.frames)[1:]:
+        out.addFrame(pin.Frame(frame), False)
+    return out

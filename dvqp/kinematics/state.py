@@ -38,10 +38,16 @@ class KinematicState:
     frame_jacobians : ndarray, shape (k+1, 6, n)
         ``[J_v; J_ω]`` of the same frames in the base orientation (Pinocchio's
         LOCAL_WORLD_ALIGNED): ``ȯ = J_v Q̇``, ``ω = J_ω Q̇``; a user task reads these.
+    guarded : ndarray, shape (k+1, 3)
+        DV positions ``[l, z, h]`` (m) of every guarded point: the k body points, then the
+        probe (the tool point). Consecutive points bound the guarded links: the k−1 body links,
+        then the probe holder (last body point to the tool).
+    guarded_jacobians : ndarray, shape (k+1, 3, n)
+        ``∂[l, z, h]/∂Q`` of the same points, m/rad.
     points : ndarray, shape (k, 3)
-        Body points in DV, ``[l, z, h]`` (m).
+        Body points in DV, ``[l, z, h]`` (m): ``guarded[:-1]``.
     point_jacobians : ndarray, shape (k, 3, n)
-        ``∂[l, z, h]/∂Q`` of each body point, m/rad.
+        ``∂[l, z, h]/∂Q`` of each body point, m/rad: ``guarded_jacobians[:-1]``.
     tool : ndarray, shape (4,)
         Tool DV coordinates ``[l, z, h, α]`` (m, m, m, rad).
     tool_jacobian : ndarray, shape (4, n)
@@ -56,6 +62,8 @@ class KinematicState:
     origins: NDArray[np.float64]
     axes: NDArray[np.float64]
     frame_jacobians: NDArray[np.float64]
+    guarded: NDArray[np.float64]
+    guarded_jacobians: NDArray[np.float64]
     points: NDArray[np.float64]
     point_jacobians: NDArray[np.float64]
     tool: NDArray[np.float64]
@@ -66,6 +74,11 @@ class KinematicState:
     def n(self) -> int:
         """Number of joints."""
         return int(self.q.shape[0])
+
+    @property
+    def k(self) -> int:
+        """Number of body points."""
+        return int(self.points.shape[0])
 
     @classmethod
     def compute(cls, robot: Robot, q: ArrayLike, radius: float) -> KinematicState:
@@ -106,14 +119,17 @@ class KinematicState:
         tool_jac[:3] = lin[-1]
         tool_jac[3] = alpha_row
         ro = _validate.readonly
+        pos, lin = ro(pos), ro(lin)
         return cls(
             q=ro(qv),
             radius=float(radius),
             origins=ro(origins),
             axes=ro(axes),
             frame_jacobians=ro(jac),
-            points=ro(pos[:-1]),
-            point_jacobians=ro(lin[:-1]),
+            guarded=pos,
+            guarded_jacobians=lin,
+            points=pos[:-1],
+            point_jacobians=lin[:-1],
             tool=ro(tool),
             tool_jacobian=ro(tool_jac),
         )

@@ -6,21 +6,33 @@ Each limit has a ``name`` and ``compute(state, dt)`` returning a :class:`Constra
 """
 
 from dvqp.limits.damper import Distances, VelocityDamper, damper_rhs
+from dvqp.limits.excess import NO_EXCESS, Excess, VerifiedLimit, worst_excess
 from dvqp.limits.joint_position import JointPositionLimit
 from dvqp.limits.joint_velocity import JointVelocityLimit
 from dvqp.limits.limit import Bounds, Constraint, Limit
 from dvqp.limits.obstacle_damper import ObstacleDamper
+from dvqp.limits.probe_height import ProbeHeight
 from dvqp.limits.surface_height import SurfaceHeight
+from dvqp.limits.tilt import TiltLimit, tilt, tilt_cosine, tilt_sine
 
 __all__ = [
+    "NO_EXCESS",
     "Bounds",
     "Constraint",
     "Distances",
+    "Excess",
     "JointPositionLimit",
     "JointVelocityLimit",
     "Limit",
     "ObstacleDamper",
+    "ProbeHeight",
     "SurfaceHeight",
+    "TiltLimit",
     "VelocityDamper",
+    "VerifiedLimit",
     "damper_rhs",
+    "tilt",
+    "tilt_cosine",
+    "tilt_sine",
+    "worst_excess",
 ]

@@ -2,13 +2,16 @@
 
 For a distance ``d(Q)`` (m) with safe value ``d_safe``, a damper adds the row::
 
-    ∇d · Q̇ ≥ −γ (d − d_safe) / dt          written as   −∇d · Q̇ ≤ γ (d − d_safe) / dt
+    ∇d · Q̇ ≥ −γ/dt · max(d − d_safe, −δ)      written as   −∇d · Q̇ ≤ γ/dt · max(d − d_safe, −δ)
 
-so ``d`` decays at most geometrically toward ``d_safe`` and does not cross it at first order.
-A pair already closer than ``d_safe`` gets the right-hand side 0: it may not approach further
-(a demanded escape speed ``γ (d_safe − d)/dt`` could exceed the velocity limits and make the
-QP infeasible). A subclass implements :meth:`VelocityDamper.distances`; the base owns the
-right-hand side.
+Above ``d_safe``, ``d`` decays at most geometrically toward it and does not cross it at first
+order. Below it (the linearisation's second-order error, or a part that started there), the row
+asks ``d`` to come back at ``γ (d_safe − d)/dt``, capped at ``γ δ/dt``: a drift below ``d_safe``
+is corrected instead of accumulating step after step (its steady state is about ``|ε|/γ`` for a
+second-order error ``ε`` per step), and a part that starts deep inside is pushed out at a
+bounded rate (``δ`` is the damper's verification tolerance, 0.1 mm) rather than asked for an
+escape speed the velocity limits could not give. A subclass implements
+:meth:`VelocityDamper.distances`; the base owns the right-hand side.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ from numpy.typing import NDArray
 
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
+from dvqp.limits.excess import NO_EXCESS, Excess
 from dvqp.limits.limit import Constraint
 
 
@@ -32,8 +36,8 @@ class Distances:
     ----------
     value : ndarray, shape (p,)
         ``d``, m.
-    gradient : ndarray, shape (p, n)
-        ``∂d/∂Q``, m/rad.
+    gradient : ndarray, shape (p, n), or None
+        ``∂d/∂Q``, m/rad (None where only the values are wanted, for verification).
     safe : float or ndarray of shape (p,)
         ``d_safe``, m.
     describe : callable, optional
@@ -41,16 +45,20 @@ class Distances:
     """
 
     value: NDArray[np.float64]
-    gradient: NDArray[np.float64]
+    gradient: NDArray[np.float64] | None
     safe: float | NDArray[np.float64]
     describe: Callable[[], tuple[str, ...]] | None = field(default=None, repr=False)
 
 
 def damper_rhs(
-    distance: NDArray[np.float64], safe: float | NDArray[np.float64], gain: float, dt: float
+    distance: NDArray[np.float64],
+    safe: float | NDArray[np.float64],
+    gain: float,
+    dt: float,
+    depth: float,
 ) -> NDArray[np.float64]:
-    """``max(γ/dt · (d − d_safe), 0)``, m/s, the right-hand side of every damper row."""
-    return np.maximum(gain / dt * (distance - safe), 0.0)
+    """``γ/dt · max(d − d_safe, −δ)``, m/s, the right-hand side of every damper row."""
+    return gain / dt * np.maximum(distance - safe, -depth)
 
 
 class VelocityDamper:
@@ -64,6 +72,10 @@ class VelocityDamper:
     """
 
     name = "damper"
+    quantity = "distance"
+    """What the distance is, for reports (``"clearance"``, ``"height"``)."""
+    tolerance = 1e-4
+    """m: how far below ``min(d_safe, d at the start)`` an integrated step may end."""
 
     def __init__(self, gain: float = 0.5) -> None:
         if not 0.0 < float(gain) <= 1.0:
@@ -71,10 +83,36 @@ class VelocityDamper:
         self.gain = float(gain)
 
     def distances(self, state: KinematicState) -> Distances:
-        """The distances this damper keeps, at ``state``."""
+        """The distances this damper keeps at ``state``, with their gradients (the rows)."""
         raise NotImplementedError
 
+    def all_distances(self, state: KinematicState) -> Distances:
+        """Every distance the damper guards, in a fixed order, gradients not needed.
+
+        The default is :meth:`distances`; a damper that adds rows only for nearby pairs
+        returns all pairs here, so a pair that jumps from far to inside its margin in one
+        step is caught.
+        """
+        return self.distances(state)
+
     def compute(self, state: KinematicState, dt: float) -> Constraint:
-        """``−∂d/∂Q · Q̇ ≤ max(γ/dt (d − d_safe), 0)``, one row per distance."""
+        """``−∂d/∂Q · Q̇ ≤ γ/dt · max(d − d_safe, −δ)``, one row per distance."""
         d = self.distances(state)
-        return Constraint(-d.gradient, damper_rhs(d.value, d.safe, self.gain, dt), d.describe)
+        if d.gradient is None:
+            raise ValueError(f"{type(self).__name__}.distances must return gradients")
+        rhs = damper_rhs(d.value, d.safe, self.gain, dt, self.tolerance)
+        return Constraint(-d.gradient, rhs, d.describe)
+
+    def excess(self, start: KinematicState, state: KinematicState) -> Excess:
+        """How far ``state`` is below ``min(d_safe, d(start))``, m, for the worst distance."""
+        b, a = self.all_distances(start), self.all_distances(state)
+        if a.value.shape[0] == 0:
+            return NO_EXCESS
+        floor = np.minimum(b.safe, b.value)
+        over = floor - a.value
+        i = int(np.argmax(over))
+        label = a.describe()[i] if a.describe is not None and over[i] > 0.0 else ""
+        return Excess(
+            float(over[i]), self.tolerance, label, self.quantity, "m",
+            float(a.value[i]), float(floor[i]),
+        )  # fmt: skip

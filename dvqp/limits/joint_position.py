@@ -6,6 +6,7 @@ import numpy as np
 
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
+from dvqp.limits.excess import Excess
 from dvqp.limits.limit import Bounds
 
 
@@ -22,6 +23,8 @@ class JointPositionLimit:
     """
 
     name = "joint_position"
+    tolerance = 1e-6
+    """rad: how far past a limit an integrated step may end (the QP holds it exactly)."""
 
     def __init__(self, robot: Robot) -> None:
         self.q_min = robot.q_min
@@ -32,3 +35,16 @@ class JointPositionLimit:
         lb = np.minimum((self.q_min - state.q) / dt, 0.0)
         ub = np.maximum((self.q_max - state.q) / dt, 0.0)
         return Bounds(lb, ub)
+
+    def excess(self, start: KinematicState, state: KinematicState) -> Excess:
+        """How far ``state.q`` is past the limits (or past ``start.q`` if that was out)."""
+        upper = np.maximum(self.q_max, start.q)
+        lower = np.minimum(self.q_min, start.q)
+        over = np.maximum(state.q - upper, lower - state.q)
+        i = int(np.argmax(over))
+        bound = upper[i] if state.q[i] > upper[i] else lower[i]
+        label = f"joint{i + 1}" if over[i] > 0.0 else ""
+        return Excess(
+            float(over[i]), self.tolerance, label, "joint position", "rad", float(state.q[i]),
+            float(bound),
+        )  # fmt: skip

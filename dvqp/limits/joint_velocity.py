@@ -8,7 +8,11 @@ from dvqp.limits.limit import Bounds
 
 
 class JointVelocityLimit:
-    """``−q̇_max ≤ Q̇ ≤ q̇_max`` (rad/s), from the robot's ``qd_max``, shape (n,)."""
+    """``−q̇_max ≤ Q̇ ≤ q̇_max`` (rad/s), from the robot's ``qd_max``, shape (n,).
+
+    A bound of the QP held exactly by every accepted solution (the solution check recomputes
+    it), so it needs no exact verification of the integrated motion.
+    """
 
     name = "joint_velocity"
 

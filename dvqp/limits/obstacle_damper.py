@@ -1,9 +1,10 @@
-"""Velocity dampers that keep body points and links out of the obstacle circles.
+"""Velocity dampers that keep every guarded part out of the obstacle circles.
 
-For a pair (body point or link, obstacle j) with signed clearance ``d = ‖S_j − p‖ − R_j`` (m)
-below the influence distance ``d_i``, one damper row (see :mod:`dvqp.limits.damper`) keeps
-``d ≥ d_safe``. A link row is added only where its closest point is interior; at an end the
-point's own row holds.
+The guarded parts are the body points and the probe (the tool point), the body links and the
+probe holder (last body point to the tool). For a pair (part, obstacle j) with signed
+clearance ``d = ‖S_j − p‖ − R_j`` (m) below the influence distance ``d_i``, one damper row
+(see :mod:`dvqp.limits.damper`) keeps ``d ≥ d_safe``. A link row is added only where its
+closest point is interior; at an end the point's own row holds.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import numpy as np
 from dvqp import _validate
 from dvqp.errors import ParameterError
 from dvqp.geometry.obstacle import ObstacleSet
-from dvqp.geometry.proximity import proximity
+from dvqp.geometry.proximity import link_label, point_label, proximity
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import Distances, VelocityDamper
 
@@ -23,7 +24,7 @@ _TINY = 1e-12
 
 
 class ObstacleDamper(VelocityDamper):
-    """Keeps every body point and link at least ``margin`` from every obstacle.
+    """Keeps every guarded point and link at least ``margin`` from every obstacle.
 
     Parameters
     ----------
@@ -39,6 +40,7 @@ class ObstacleDamper(VelocityDamper):
     """
 
     name = "obstacles"
+    quantity = "clearance"
     SCENE_KEYS: ClassVar[dict[str, str]] = {
         "margin": "margin",
         "influence": "influence",
@@ -62,7 +64,7 @@ class ObstacleDamper(VelocityDamper):
         if not len(self.obstacles):
             return Distances(np.zeros(0), np.zeros((0, state.n)), self.margin)
         near = proximity(state, self.obstacles)
-        jac = state.point_jacobians[:, :2, :]  # (k, 2, n)
+        jac = state.guarded_jacobians[:, :2, :]  # (k+1, 2, n)
         # Points: ∇d = −(S − p)ᵀ/‖S − p‖ · ∂p/∂Q
         dist, clearance = near.point_distance, near.point_clearance
         pj, pi = np.nonzero((clearance < self.influence) & (dist > _TINY))
@@ -76,10 +78,30 @@ class ObstacleDamper(VelocityDamper):
         tt = t[lj, li, None, None]
         link_rows = (unit[:, :, None] * ((1.0 - tt) * jac[li] + tt * jac[li + 1])).sum(axis=1)
 
+        k = state.k
+
         def describe() -> tuple[str, ...]:
-            points = [f"point{i + 1}/obstacle{j + 1}" for j, i in zip(pj, pi, strict=True)]
-            links = [f"link{i + 1}/obstacle{j + 1}" for j, i in zip(lj, li, strict=True)]
+            points = [f"{point_label(i, k)}/obstacle{j + 1}" for j, i in zip(pj, pi, strict=True)]
+            links = [f"{link_label(i, k)}/obstacle{j + 1}" for j, i in zip(lj, li, strict=True)]
             return (*points, *links)
 
         value = np.concatenate([clearance[pj, pi], link_clearance[lj, li]])
         return Distances(value, -np.concatenate([point_rows, link_rows]), self.margin, describe)
+
+    def all_distances(self, state: KinematicState) -> Distances:
+        """Clearance (m) of every guarded point, then every guarded link, to every obstacle."""
+        if not len(self.obstacles):
+            return Distances(np.zeros(0), None, self.margin)
+        near = proximity(state, self.obstacles)
+        points, links = near.point_clearance, near.link_clearance  # (J, k+1), (J, k)
+        k, count = state.k, len(self.obstacles)
+
+        def describe() -> tuple[str, ...]:
+            obstacles = range(count)
+            return (
+                *(f"{point_label(i, k)}/obstacle{j + 1}" for j in obstacles for i in range(k + 1)),
+                *(f"{link_label(i, k)}/obstacle{j + 1}" for j in obstacles for i in range(k)),
+            )
+
+        values = np.concatenate([points.ravel(), links.ravel()])
+        return Distances(values, None, self.margin, describe)

@@ -23,6 +23,7 @@ class SurfaceHeight(VelocityDamper):
     """
 
     name = "height"
+    quantity = "height"
     SCENE_KEYS: ClassVar[dict[str, str]] = {"min_height": "min_height", "damper_gain": "gain"}
     """Keys of the scene file's ``[constraints]`` table -> constructor arguments."""
 

@@ -2,11 +2,20 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from dvqp.geometry.obstacle import ObstacleSet
+from dvqp.geometry.proximity import proximity
 from dvqp.kinematics.state import KinematicState
+from dvqp.limits.excess import Excess
+from dvqp.limits.tilt import tilt
+from dvqp.motion.advance import Advance
 from dvqp.motion.trajectory import Trajectory
-from dvqp.resolution.step import Step
+
+PER_SAMPLE = ("w", "min_clearance", "probe_clearance", "tilt", "limit_excess")
+PER_STEP = ("solve_time", "step_time", "task_error")
 
 
 class TrajectoryRecorder:
@@ -20,44 +29,57 @@ class TrajectoryRecorder:
         n.
     n_points
         Number of body points k.
+    obstacles
+        The obstacles whose clearances are recorded.
     """
 
-    def __init__(self, n_steps: int, n_joints: int, n_points: int) -> None:
-        self.n_steps = n_steps
-        self.q = np.empty((n_steps + 1, n_joints))
-        self.qdot = np.zeros((n_steps, n_joints))
-        self.tool = np.empty((n_steps + 1, 4))
-        self.points = np.empty((n_steps + 1, n_points, 3))
-        self.w = np.empty(n_steps + 1)
-        self.min_clearance = np.empty(n_steps + 1)
-        self.solve_time = np.zeros(n_steps)
-        self.step_time = np.zeros(n_steps)
-        self.task_error = np.zeros(n_steps)
-        self.iterations = np.full(n_steps, -1, dtype=np.int64)
-        self.success = np.zeros(n_steps, dtype=bool)
+    def __init__(self, n_steps: int, n_joints: int, n_points: int, obstacles: ObstacleSet) -> None:
+        self.obstacles = obstacles
+        self.arrays: dict[str, np.ndarray] = {
+            "q": np.empty((n_steps + 1, n_joints)),
+            "qdot": np.zeros((n_steps, n_joints)),
+            "tool": np.empty((n_steps + 1, 4)),
+            "points": np.empty((n_steps + 1, n_points, 3)),
+            **{name: np.empty(n_steps + 1) for name in PER_SAMPLE},
+            **{name: np.zeros(n_steps) for name in PER_STEP},
+            "iterations": np.full(n_steps, -1, dtype=np.int64),
+            "substeps": np.ones(n_steps, dtype=np.int64),
+            "success": np.zeros(n_steps, dtype=bool),
+            "limits_kept": np.ones(n_steps + 1, dtype=bool),
+        }
         self.status: list[str] = []
 
-    def sample(self, k: int, state: KinematicState, w: float, clearance: float) -> None:
-        """Sample k: configuration, tool and body points, objective value, clearance (m)."""
-        self.q[k], self.tool[k], self.points[k] = state.q, state.tool, state.points
-        self.w[k] = w
-        self.min_clearance[k] = clearance
+    def sample(self, k: int, state: KinematicState, w: float, excess: Excess) -> None:
+        """Sample k: configuration, tool and body points, objective value, clearances, tilt,
+        and the worst exact limit excess there."""
+        a = self.arrays
+        a["q"][k], a["tool"][k], a["points"][k] = state.q, state.tool, state.points
+        a["w"][k] = w
+        a["limit_excess"][k] = max(excess.value, 0.0)
+        a["limits_kept"][k] = not excess.broken
+        a["tilt"][k] = tilt(state)
+        if len(self.obstacles):
+            near = proximity(state, self.obstacles)
+            a["min_clearance"][k], a["probe_clearance"][k] = (
+                near.min_clearance(),
+                near.probe_clearance(),
+            )
+        else:
+            a["min_clearance"][k] = a["probe_clearance"][k] = math.inf
 
-    def step(self, k: int, step: Step, step_time: float) -> None:
+    def step(self, k: int, advance: Advance, step_time: float) -> None:
         """Step k (from sample k to k + 1) and its full wall time, s."""
-        self.solve_time[k], self.step_time[k] = step.solve_time, step_time
-        self.task_error[k], self.success[k] = step.task_error, step.success
-        self.iterations[k] = -1 if step.iterations is None else step.iterations
+        a, step = self.arrays, advance.step
+        a["solve_time"][k], a["step_time"][k] = step.solve_time, step_time
+        a["task_error"][k], a["success"][k] = step.task_error, step.success
+        a["iterations"][k] = -1 if step.iterations is None else step.iterations
+        a["substeps"][k] = advance.substeps
         self.status.append(step.status)
         if step.success:
-            self.qdot[k] = step.qdot
+            a["qdot"][k] = step.qdot
 
     def trajectory(self, dt: float, pipe_radius: float, backend: str) -> Trajectory:
         """The recorded run (l and α unwrapped)."""
         return Trajectory.from_samples(
-            dt=dt, q=self.q, qdot=self.qdot, tool=self.tool, points=self.points,
-            pipe_radius=pipe_radius, w=self.w, min_clearance=self.min_clearance,
-            solve_time=self.solve_time, step_time=self.step_time, task_error=self.task_error,
-            iterations=self.iterations, success=self.success, status=self.status,
-            backend=backend,
-        )  # fmt: skip
+            dt=dt, pipe_radius=pipe_radius, backend=backend, status=self.status, **self.arrays
+        )

@@ -16,10 +16,11 @@ from numpy.typing import ArrayLike, NDArray
 from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry.obstacle import ObstacleSet
-from dvqp.geometry.proximity import min_clearance
 from dvqp.kinematics.developed_view import wrap, wrap_angle
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
+from dvqp.limits.excess import NO_EXCESS
+from dvqp.motion.advance import MAX_HALVINGS, advance
 from dvqp.motion.recorder import TrajectoryRecorder
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.step import Resolver
@@ -62,6 +63,8 @@ def simulate(
     obstacles: ObstacleSet | None = None,
     reference: ArrayLike | None = None,
     feedback_gain: float = 0.0,
+    verify: bool | None = None,
+    max_halvings: int = MAX_HALVINGS,
     progress: Callable[[int, int], None] | None = None,
 ) -> Trajectory:
     """Run the commands from ``q0`` and return the trajectory.
@@ -82,39 +85,50 @@ def simulate(
         Optional DV positions ``x_d(t_k)``, shape (N, 4), for position feedback.
     feedback_gain
         ``K`` (1/s) of the feedback, >= 0.
+    verify
+        Check every limit of the resolver's spec exactly after each step, splitting or failing
+        steps that break one (:func:`dvqp.motion.advance.advance`). Default: if the resolver
+        holds limits (the QP); the baseline's excess is measured and recorded only.
+    max_halvings
+        Most times a step is halved to keep the limits.
     progress
         Called as ``progress(k, N)`` after each step.
 
     Notes
     -----
-    A step whose resolver reports failure holds the arm still (``Q̇ = 0``) for that step and
-    is recorded as failed in the trajectory's diagnostics.
+    A step whose resolver reports failure, or that still breaks a limit after
+    ``max_halvings`` halvings, holds the arm still (``Q̇ = 0``) for that step and is recorded
+    as failed, its status naming the reason.
     """
     dt = _validate.positive("dt", dt)
     gain = _validate.positive("feedback_gain", feedback_gain, strict=False)
     radius = _validate.positive("pipe_radius", pipe_radius)
     cmd, ref = _check_commands(commands, reference)
     obstacles = ObstacleSet() if obstacles is None else obstacles
+    check = getattr(resolver, "holds_limits", True) if verify is None else verify
     objective = resolver.spec.objective
-    q = robot.check_q(q0, "q0").copy()
+    state = start = KinematicState.compute(robot, robot.check_q(q0, "q0"), radius)
     resolver.reset()
     n_steps = cmd.shape[0]
-    record = TrajectoryRecorder(n_steps, robot.n, robot.n_points)
+    record = TrajectoryRecorder(n_steps, robot.n, robot.n_points, obstacles)
+    started = time.perf_counter()
+    excess = NO_EXCESS
     for i in range(n_steps + 1):
-        started = time.perf_counter()
-        state = KinematicState.compute(robot, q, radius)
-        w = objective.evaluate(state).value
-        if i < n_steps:
-            xdot = cmd[i]
-            if ref is not None and gain > 0.0:
-                xdot = xdot + gain * dv_error(ref[i], state.tool, radius)
-            result = resolver.resolve(state, xdot, dt)
-            record.step(i, result, time.perf_counter() - started)
-        record.sample(i, state, w, min_clearance(state, obstacles))
+        record.sample(i, state, objective.evaluate(state).value, excess)
         if i == n_steps:
             break
-        if result.success:
-            q = q + dt * result.qdot
+        xdot = cmd[i]
+        if ref is not None and gain > 0.0:
+            xdot = xdot + gain * dv_error(ref[i], state.tool, radius)
+        moved = advance(
+            robot, radius, resolver, state, xdot, dt, start=start, verify=check,
+            max_halvings=max_halvings,
+        )  # fmt: skip
+        now = time.perf_counter()
+        record.step(i, moved, now - started)
+        started, state = now, moved.state
+        if moved.step.success:
+            excess = moved.excess
         if progress is not None:
             progress(i + 1, n_steps)
     return record.trajectory(dt, radius, getattr(resolver, "name", type(resolver).__name__))

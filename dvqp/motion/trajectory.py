@@ -29,6 +29,10 @@ ARRAYS = (
     "success",
     "status",
 )
+"""The arrays every trajectory file holds."""
+
+DIAGNOSTICS = ("probe_clearance", "tilt", "limit_excess", "limits_kept", "substeps")
+"""Arrays added in dvqp 0.2; files written before hold none of them (loaded as empty)."""
 
 
 @dataclass(frozen=True)
@@ -50,7 +54,8 @@ class Trajectory:
     w : ndarray, shape (N+1,)
         Objective value.
     min_clearance : ndarray, shape (N+1,)
-        Smallest clearance of body points and links to the obstacles, m (inf: no obstacle).
+        Smallest clearance of any guarded part (body points and links, the probe and its
+        holder) to the obstacles, m (inf: no obstacle).
     solve_time : ndarray, shape (N,)
         Resolver time per step (QP assembly + solve + check, or the pseudoinverse), s.
     step_time : ndarray, shape (N,)
@@ -72,6 +77,19 @@ class Trajectory:
     tracking_error : ndarray, shape (N+1, 4) or (0, 4)
         ``x_d − x`` of the tool per sample (m, m, m, rad; l and α wrapped) against the planned
         reference (a path, or the integrated JOG commands); empty if there was none.
+    probe_clearance : ndarray, shape (N+1,)
+        Smallest clearance of the probe and its holder, m (inf: no obstacle).
+    tilt : ndarray, shape (N+1,)
+        Angle of the probe axis from the pipe's radial direction, rad, in [0, π].
+    limit_excess : ndarray, shape (N+1,)
+        Exact excess of the worst limit at each sample, in that limit's unit (m for
+        clearances and heights, rad for tilt and joint positions), against
+        ``min(bound, value at the start)``; 0 where every limit is kept. "Worst" is the
+        largest excess relative to the limit's tolerance.
+    limits_kept : ndarray of bool, shape (N+1,)
+        Every limit is kept at the sample to within its tolerance (0.1 mm, 1 mrad, 1 µrad).
+    substeps : ndarray of int, shape (N,)
+        Substeps the step was split into to keep every limit (1: not split).
     """
 
     t: NDArray[np.float64]
@@ -91,28 +109,28 @@ class Trajectory:
     pipe_radius: float = 0.0
     scene_text: str = field(default="", repr=False)
     tracking_error: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 4)))
+    probe_clearance: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    tilt: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    limit_excess: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    limits_kept: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    substeps: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
     @classmethod
     def from_samples(
         cls,
         *,
         dt: float,
-        q: NDArray[np.float64],
-        qdot: NDArray[np.float64],
+        pipe_radius: float,
+        backend: str,
         tool: NDArray[np.float64],
         points: NDArray[np.float64],
-        pipe_radius: float,
-        w: NDArray[np.float64],
-        min_clearance: NDArray[np.float64],
-        solve_time: NDArray[np.float64],
-        step_time: NDArray[np.float64],
-        task_error: NDArray[np.float64],
-        iterations: NDArray[np.int64],
-        success: NDArray[np.bool_],
         status: Sequence[str],
-        backend: str,
+        **arrays: NDArray[np.float64],
     ) -> Trajectory:
-        """Build from raw samples, unwrapping l (period 2πR) and α (period 2π)."""
+        """Build from raw samples, unwrapping l (period 2πR) and α (period 2π).
+
+        ``arrays`` are the other fields (``q``, ``qdot``, ``w``, ...), taken as they are.
+        """
         period = 2.0 * np.pi * pipe_radius
         # l continuous along the body (points then tool) at the first sample, then in time.
         first = unwrap(np.append(points[0, :, 0], tool[0, 0]), period)
@@ -124,21 +142,13 @@ class Trajectory:
         unwrapped[:, 0] = unwrap(unwrapped[:, 0], period)
         unwrapped[:, 3] = unwrap(tool[:, 3], 2.0 * np.pi)
         return cls(
-            t=dt * np.arange(q.shape[0]),
-            q=q,
-            qdot=qdot,
+            t=dt * np.arange(tool.shape[0]),
             tool=unwrapped,
             points=pts,
-            w=w,
-            min_clearance=min_clearance,
-            solve_time=solve_time,
-            step_time=step_time,
-            task_error=task_error,
-            iterations=iterations,
-            success=success,
             status=np.asarray(list(status), dtype=np.str_),
             backend=backend,
             pipe_radius=float(pipe_radius),
+            **arrays,  # type: ignore[arg-type]
         )
 
     @property
@@ -163,7 +173,7 @@ class Trajectory:
         target = output_path(path, (".npz", ".csv"))
         with atomic_file(target) as tmp, open(tmp, "wb") as fh:
             if target.suffix.lower() == ".npz":
-                arrays = {name: getattr(self, name) for name in ARRAYS}
+                arrays = {name: getattr(self, name) for name in (*ARRAYS, *DIAGNOSTICS)}
                 np.savez_compressed(
                     fh,
                     **arrays,
@@ -195,6 +205,7 @@ class Trajectory:
                 arrays = {
                     name: data["dv" if name == "tool" and "dv" in data else name] for name in ARRAYS
                 }
+                arrays.update({name: data[name] for name in DIAGNOSTICS if name in data})
                 return cls(
                     **arrays,
                     backend=str(data["backend"]),

@@ -37,16 +37,16 @@ class ObstacleLinks:
         if not len(obstacles):
             return Term(0.0, np.zeros(state.n))
         near = proximity(state, obstacles)
-        t = near.link_t
-        excess = near.link_distance**2 - obstacles.radii[:, None] ** 2  # (J, k-1)
+        k = state.k  # the body links; the holder (last guarded link) is left to the dampers
+        t = near.link_t[:, : k - 1]
+        excess = near.link_distance[:, : k - 1] ** 2 - obstacles.radii[:, None] ** 2  # (J, k-1)
         active = (excess < 0.0) & (t > 0.0) & (t < 1.0)
         if not active.any():
             return Term(0.0, np.zeros(state.n))
-        k = state.points.shape[0]
         k1 = per_point("k_obstacle", self.k_obstacle, k)
         coef = obstacles.weights[:, None] * k1[None, :-1] * active
         value = 0.5 * float(np.sum(coef * excess))
-        a = coef[..., None] * near.link_offsets  # (J, k-1, 2)
+        a = coef[..., None] * near.link_offsets[:, : k - 1]  # (J, k-1, 2)
         at_points = np.zeros((k, 2))
         at_points[:-1] += (a * (1.0 - t)[..., None]).sum(axis=0)
         at_points[1:] += (a * t[..., None]).sum(axis=0)

@@ -34,13 +34,14 @@ class ObstaclePoints:
         if not len(obstacles):
             return Term(0.0, np.zeros(state.n))
         near = proximity(state, obstacles)
-        excess = near.point_distance**2 - obstacles.radii[:, None] ** 2  # (J, k)
+        k = state.k  # the body points; the probe (last guarded point) is the task's
+        excess = near.point_distance[:, :k] ** 2 - obstacles.radii[:, None] ** 2  # (J, k)
         inside = excess < 0.0
         if not inside.any():
             return Term(0.0, np.zeros(state.n))
-        k1 = per_point("k_obstacle", self.k_obstacle, excess.shape[1])
+        k1 = per_point("k_obstacle", self.k_obstacle, k)
         coef = obstacles.weights[:, None] * k1[None, :] * inside
         value = 0.5 * float(np.sum(coef * excess))
-        v = (coef[..., None] * near.point_offsets).sum(axis=0)  # (k, 2)
+        v = (coef[..., None] * near.point_offsets[:, :k]).sum(axis=0)  # (k, 2)
         grad = -np.einsum("kc,kcn->n", v, state.point_jacobians[:, :2, :])
         return Term(value, grad)

@@ -126,6 +126,8 @@ class PseudoinverseResolver:
     """
 
     name = "pinv"
+    holds_limits = False
+    """The baseline holds no limit: runs with it are measured, not verified."""
 
     def __init__(self, spec: StepSpec, damping: float = 0.0) -> None:
         self.spec = spec

@@ -50,6 +50,9 @@ class QPResolver:
         relaxed problem keep their own warm starts).
     """
 
+    holds_limits = True
+    """Every limit of the spec is a hard constraint: runs are verified against them."""
+
     def __init__(self, spec: StepSpec, backend: str | Callable[[], solvers.Backend]) -> None:
         self.spec = spec
         factory = (lambda: make_backend(backend)) if isinstance(backend, str) else backend

@@ -60,6 +60,8 @@ class Resolver(Protocol):
 
     name: str
     spec: StepSpec
+    holds_limits: bool
+    """True if the resolver keeps ``spec.limits`` (then runs are verified against them)."""
 
     def resolve(self, state: KinematicState, command: ArrayLike, dt: float) -> Step:
         """One step.

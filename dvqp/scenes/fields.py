@@ -2,24 +2,68 @@
 
 Every reader takes the table, the key and the dotted path of the table (``"robot"``,
 ``"obstacles[1]"``) and raises :class:`~dvqp.errors.SceneError` naming the full field on a
-missing, mistyped or unknown entry.
+missing, mistyped, unknown or out-of-range entry. A number's sane range is a :class:`Bound`
+given where the field is read (:data:`ANY` if none is given); :meth:`Fields.guard` turns what
+still escapes the checks (an overflow, a NumPy floating-point error, a constructor's
+complaint) into the same one-line error.
 """
 
 from __future__ import annotations
 
 import difflib
 import math
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
+from dataclasses import dataclass
+from decimal import Decimal
 from typing import Any, NoReturn
 
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp.errors import ParameterError, SceneError, ShapeError
+from dvqp.errors import DvqpError, ParameterError, SceneError, ShapeError
 
 REQUIRED: Any = object()
 """Sentinel default: the field must be present."""
+
+
+@dataclass(frozen=True)
+class Bound:
+    """The sane range of a physical quantity: ``low <= x <= high`` (``low < x`` if strict).
+
+    Attributes
+    ----------
+    low, high : float
+        The range.
+    unit : str
+        Shown in messages after a non-zero bound (``"m"``, ``"rad/s"``).
+    strict : bool
+        ``low`` itself is excluded.
+    """
+
+    low: float
+    high: float
+    unit: str = ""
+    strict: bool = False
+
+    def reason(self, value: float) -> str | None:
+        """Why ``value`` is out of range (``"must be <= 100 m, got 1e+300"``), or None.
+
+        ``value`` may be an integer too large for a float.
+        """
+        got = repr(value) if isinstance(value, float) else f"{Decimal(value):.4g}"
+        if value < self.low or (self.strict and value == self.low):
+            return f"must be {'>' if self.strict else '>='} {self._show(self.low)}, got {got}"
+        if value > self.high:
+            return f"must be <= {self._show(self.high)}, got {got}"
+        return None
+
+    def _show(self, bound: float) -> str:
+        return f"{bound:g} {self.unit}" if bound and self.unit else f"{bound:g}"
+
+
+ANY = Bound(-1e6, 1e6)
+"""The range of a number whose field declares none."""
 
 
 def join(prefix: str, key: str | int) -> str:
@@ -76,6 +120,24 @@ class Fields:
         except ParameterError as exc:
             self.fail(join(prefix, exc.name), exc.reason)
 
+    @contextmanager
+    def guard(self, prefix: str) -> Iterator[None]:
+        """Report anything that escapes the field checks while reading ``prefix`` as SceneError.
+
+        Constructor errors are mapped as in :meth:`mapped`, any other dvqp error keeps its
+        message; an overflow, a NumPy floating-point error (raised here, not warned), a
+        recursion too deep or a stray ``ValueError`` becomes ``cannot be used (<reason>)``.
+        """
+        try:
+            with np.errstate(over="raise", divide="raise", invalid="raise"), self.mapped(prefix):
+                yield
+        except SceneError:
+            raise
+        except DvqpError as exc:
+            self.fail(prefix, str(exc))
+        except (ArithmeticError, RecursionError, ValueError, MemoryError) as exc:
+            self.fail(prefix, f"cannot be used ({type(exc).__name__}: {exc})")
+
     def check_keys(self, table: dict[str, Any], prefix: str, allowed: Iterable[str]) -> None:
         """Reject keys of ``table`` not in ``allowed`` (typos), suggesting the closest one."""
         names = list(allowed)
@@ -118,11 +180,12 @@ class Fields:
         return value
 
     def number(
-        self, table: dict[str, Any], key: str, prefix: str, default: Any = REQUIRED
-    ) -> float:
-        """A finite number (int or float), m / s / rad as documented per field."""
+        self, table: dict[str, Any], key: str, prefix: str, default: Any = REQUIRED, *,
+        within: Bound = ANY,
+    ) -> float:  # fmt: skip
+        """A finite number (int or float) in ``within``, m / s / rad as documented per field."""
         value = self.get(table, key, prefix, default)
-        return self._finite(join(prefix, key), value)
+        return self._finite(join(prefix, key), value, within)
 
     def string(self, table: dict[str, Any], key: str, prefix: str, default: Any = REQUIRED) -> str:
         """A string."""
@@ -141,34 +204,49 @@ class Fields:
     def vector(
         self, table: dict[str, Any], key: str, prefix: str, n: int, *,
         scalar: bool = False, default: Any = REQUIRED, infinite: bool = False,
+        within: Bound | Sequence[Bound] = ANY,
     ) -> NDArray[np.float64]:  # fmt: skip
         """``n`` numbers (or one number broadcast to ``n`` if ``scalar``), shape (n,).
 
-        They must be finite unless ``infinite`` (then ``±inf`` pass, ``nan`` does not).
+        Each lies in ``within`` (one bound, or one per element). They must be finite unless
+        ``infinite`` (then ``±inf`` pass as "no limit", ``nan`` does not).
         """
         value = self.get(table, key, prefix, default)
-        return self.vector_value(join(prefix, key), value, n, scalar=scalar, infinite=infinite)
+        return self.vector_value(
+            join(prefix, key), value, n, scalar=scalar, infinite=infinite, within=within
+        )
 
     def vector_value(
-        self, field: str, value: Any, n: int, *, scalar: bool = False, infinite: bool = False
-    ) -> NDArray[np.float64]:
+        self, field: str, value: Any, n: int, *, scalar: bool = False, infinite: bool = False,
+        within: Bound | Sequence[Bound] = ANY,
+    ) -> NDArray[np.float64]:  # fmt: skip
         """Check an already fetched value as in :meth:`vector`."""
+        bounds = [within] * n if isinstance(within, Bound) else list(within)
         if scalar and is_number(value):
-            return np.full(n, self._finite(field, value, infinite))
+            return np.full(n, self._finite(field, value, bounds[0], infinite))
         want = f"a number or an array of {n} numbers" if scalar else f"an array of {n} numbers"
         if not isinstance(value, list):
             self.fail(field, f"expected {want}, got {kind(value)}")
         if len(value) != n:
             self.fail(field, f"expected {want}, got {len(value)} values")
-        return np.array([self._finite(join(field, i), v, infinite) for i, v in enumerate(value)])
+        return np.array(
+            [
+                self._finite(join(field, i), v, b, infinite)
+                for i, (v, b) in enumerate(zip(value, bounds, strict=True))
+            ]
+        )
 
-    def _finite(self, field: str, value: Any, infinite: bool = False) -> float:
+    def _finite(self, field: str, value: Any, within: Bound, infinite: bool = False) -> float:
+        """``value`` as a float: a number, not NaN, finite unless ``infinite``, in ``within``."""
         if not is_number(value):
             self.fail(field, f"expected a number, got {kind(value)}")
         try:
             number = float(value)
-        except OverflowError:
-            self.fail(field, "out of range")
+        except OverflowError:  # an integer beyond 1.8e308
+            self.fail(field, within.reason(value) or "out of range")
         if math.isnan(number) or (not infinite and math.isinf(number)):
             self.fail(field, f"must be finite, got {value!r}")
+        reason = None if math.isinf(number) else within.reason(number)
+        if reason is not None:
+            self.fail(field, reason)
         return number

@@ -11,8 +11,13 @@ from numpy.typing import NDArray
 from dvqp import _validate
 from dvqp.errors import DvqpError, ParameterError
 from dvqp.kinematics.robot import Robot
-from dvqp.scenes.fields import Fields, join
+from dvqp.scenes.fields import Bound, Fields, join
 
+LINK_LENGTH = Bound(0.0, 10.0, "m")
+ANGLE = Bound(-1000.0, 1000.0, "rad")
+"""A joint angle or a finite joint limit (``±inf``: no limit)."""
+JOINT_SPEED = Bound(0.0, 1000.0, "rad/s", strict=True)
+JOINT_WEIGHT = Bound(1e-6, 1e6)
 ROBOT_KEYS = ("model", "link_lengths", "urdf", "points", "tool", "q0", "q_min", "q_max", "qd_max",
               "weights")  # fmt: skip
 MODELS = ("ndt13",)
@@ -24,11 +29,9 @@ def robot(
     """The arm, its start configuration (rad) and the diagonal of W, each checked."""
     t = f.table(doc, "robot", "", ROBOT_KEYS)
     arm = _arm(f, t, base_dir)
-    q0 = f.vector(t, "q0", "robot", arm.n)
+    q0 = f.vector(t, "q0", "robot", arm.n, within=ANGLE)
     _check_limits(f, arm, q0)
-    weights = f.vector(t, "weights", "robot", arm.n, scalar=True, default=1.0)
-    if np.any(weights <= 0):
-        f.fail("robot.weights", "must be > 0")
+    weights = f.vector(t, "weights", "robot", arm.n, scalar=True, default=1.0, within=JOINT_WEIGHT)
     return arm, _validate.readonly(q0), _validate.readonly(weights)
 
 
@@ -42,7 +45,7 @@ def _arm(f: Fields, t: dict[str, Any], base_dir: Path) -> Robot:
         for key in ("points", "tool"):
             if key in t:
                 f.fail(join("robot", key), "only with 'urdf'")
-        lengths = f.vector(t, "link_lengths", "robot", 7)
+        lengths = f.vector(t, "link_lengths", "robot", 7, within=LINK_LENGTH)
         limits = _limits(f, t, 13)
         with f.mapped("robot"):
             return Robot.ndt13(lengths, **{k: v for k, v in limits.items() if v is not None})
@@ -58,6 +61,8 @@ def _arm(f: Fields, t: dict[str, Any], base_dir: Path) -> Robot:
         _frame_error(f, exc, tool)
     except DvqpError as exc:
         f.fail("robot.urdf", str(exc))
+    except (ArithmeticError, ValueError, RuntimeError) as exc:  # Pinocchio on a strange model
+        f.fail("robot.urdf", f"{urdf}: cannot use this model ({exc})")
     limits = _limits(f, t, loaded.n)
     if limits["qd_max"] is None:
         limits["qd_max"] = loaded.qd_max
@@ -67,15 +72,19 @@ def _arm(f: Fields, t: dict[str, Any], base_dir: Path) -> Robot:
 
 def _limits(f: Fields, t: dict[str, Any], n: int) -> dict[str, NDArray[np.float64] | None]:
     """q_min, q_max (±inf allowed: no limit) and qd_max as given, or None."""
+    bounds = {"q_min": ANGLE, "q_max": ANGLE, "qd_max": JOINT_SPEED}
     return {
-        key: f.vector(t, key, "robot", n, scalar=True, infinite=key != "qd_max")
+        key: f.vector(t, key, "robot", n, scalar=True, infinite=key != "qd_max", within=bound)
         if key in t
         else None
-        for key in ("q_min", "q_max", "qd_max")
+        for key, bound in bounds.items()
     }
 
 
 def _frame_error(f: Fields, exc: ParameterError, tool: str) -> None:
+    """A URDF robot's complaint, named by the scene key it is about (model: ``robot.urdf``)."""
+    if exc.name in ("model", "urdf"):
+        f.fail("robot.urdf", exc.reason)
     if exc.name != "frames":
         f.fail(join("robot", exc.name), exc.reason)
     key = "tool" if exc.reason.startswith(f"no frame named {tool!r}") else "points"

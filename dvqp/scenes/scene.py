@@ -3,9 +3,12 @@
 :func:`load_scene` reads a ``.toml`` file with the standard library (``tomllib``, or ``tomli``
 on Python 3.10) and validates it into a :class:`Scene` of typed objects. Anything wrong — a
 missing or mistyped field, a wrong length, an unknown key, a value a constructor rejects, an
-obstacle over the tool's start point — raises :class:`~dvqp.errors.SceneError` with the
-one-line message ``<file>: <field>: <reason>``; fields are dotted TOML paths with 0-based
-array indices (``obstacles[1].radius``). The format is documented in ``docs/scenes.md``.
+obstacle over the tool's start point, a number out of its sane range, a start inside the
+pipe — raises :class:`~dvqp.errors.SceneError` with the one-line message
+``<file>: <field>: <reason>``; fields are dotted TOML paths with 0-based array indices
+(``obstacles[1].radius``). Whatever else escapes the checks (a parser's recursion limit, an
+overflow) is turned into the same error by :meth:`~dvqp.scenes.fields.Fields.guard`, one
+section at a time. The format is documented in ``docs/scenes.md``.
 """
 
 from __future__ import annotations
@@ -118,7 +121,7 @@ def load_scene(path: str | Path) -> Scene:
     """
     try:
         text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
+    except (OSError, ValueError) as exc:  # ValueError: not UTF-8, a NUL in the name
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
         raise SceneError(str(path), "", f"cannot read: {reason}") from exc
     return loads(text, source=str(path), base_dir=Path(path).parent)
@@ -141,18 +144,26 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
     doc = _parse(f, text)
     if base_dir is None:
         base_dir = Path.cwd() if source.startswith("<") else Path(source).parent
-    radius, weld = sec.pipe(f, doc)
-    robot, q0, weights = robot_section.robot(f, doc, Path(base_dir))
-    obstacles = sec.obstacles(f, doc)
-    objective = sec.objective(f, doc, robot.n_points, obstacles)
-    limits = sec.limits(f, doc, robot, obstacles)
-    dt, jog, path = sec.motion(f, doc)
-    start.check_start(f, robot, q0, radius, obstacles)
+    with f.guard("pipe"):
+        radius, weld = sec.pipe(f, doc)
+    with f.guard("robot"):
+        robot, q0, weights = robot_section.robot(f, doc, Path(base_dir))
+    with f.guard("obstacles"):
+        obstacles = sec.obstacles(f, doc)
+    with f.guard("objective"):
+        objective = sec.objective(f, doc, robot.n_points, obstacles)
+        level = sec.orbital_level(f, doc)
+    with f.guard("constraints"):
+        limits = sec.limits(f, doc, robot, obstacles)
+    with f.guard("motion"):
+        dt, jog, path = sec.motion(f, doc)
+    with f.guard("robot.q0"):
+        start.check_start(f, robot, q0, radius, obstacles)
     stem = "scene" if source.startswith("<") else Path(source).stem
     return Scene(
         name=f.string(doc, "name", "", stem), description=f.string(doc, "description", "", ""),
         source=source, text=text, pipe_radius=radius, weld=weld, robot=robot, q0=q0,
-        weights=weights, orbital_level=sec.orbital_level(f, doc), obstacles=obstacles,
+        weights=weights, orbital_level=level, obstacles=obstacles,
         objective=objective, limits=limits, dt=dt, jog=jog, path=path,
     )  # fmt: skip
 
@@ -174,14 +185,23 @@ def environment(text: str, source: str = "<string>") -> Environment:
     """
     f = Fields(source)
     doc = _parse(f, text)
-    radius, weld = sec.pipe(f, doc)
-    return Environment(radius, sec.orbital_level(f, doc), weld, sec.obstacles(f, doc))
+    with f.guard("pipe"):
+        radius, weld = sec.pipe(f, doc)
+    with f.guard("objective"):
+        level = sec.orbital_level(f, doc)
+    with f.guard("obstacles"):
+        return Environment(radius, level, weld, sec.obstacles(f, doc))
 
 
 def _parse(f: Fields, text: str) -> dict[str, Any]:
+    """The TOML document; whatever the parser raises becomes ``invalid TOML: <reason>``."""
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         f.fail("", f"invalid TOML: {exc}")
+    except RecursionError:  # arrays or inline tables nested some hundreds of levels deep
+        f.fail("", "invalid TOML: values nested too deeply")
+    except ValueError as exc:  # e.g. an integer of more than 4300 digits
+        f.fail("", f"invalid TOML: {str(exc).split(';')[0]}")
     f.check_keys(doc, "", TOP_KEYS)
     return doc

@@ -15,15 +15,39 @@ from dvqp import _validate
 from dvqp.errors import ParameterError
 from dvqp.geometry.obstacle import Obstacle, ObstacleSet
 from dvqp.kinematics.robot import Robot
-from dvqp.limits import JointPositionLimit, JointVelocityLimit, Limit, ObstacleDamper, SurfaceHeight
+from dvqp.limits import (
+    JointPositionLimit,
+    JointVelocityLimit,
+    Limit,
+    ObstacleDamper,
+    ProbeHeight,
+    SurfaceHeight,
+    TiltLimit,
+)
 from dvqp.motion.jog import MAX_STEPS, JogSegment, jog_step_count
 from dvqp.motion.path import ToolPath
 from dvqp.objective import Objective
-from dvqp.scenes.fields import Fields, join
+from dvqp.scenes.fields import Bound, Fields, join
 
+PIPE_RADIUS = Bound(0.001, 100.0, "m")
+POSITION = Bound(-1000.0, 1000.0, "m")
+"""l or z of anything in the developed view (obstacles, the weld, waypoints)."""
+HEADING = Bound(-1000.0, 1000.0, "rad")
+HEIGHT = Bound(0.0, 10.0, "m")
+SIZE = Bound(0.0, 100.0, "m", strict=True)
+"""An obstacle's radius."""
+WEIGHT = Bound(0.0, 1e6)
+"""A weight or gain of the objective."""
+GAIN = Bound(0.0, 1000.0, "1/s")
+DT = Bound(0.0, 1.0, "s", strict=True)
+DURATION = Bound(0.0, 1e6, "s", strict=True)
+SPEED = Bound(-10.0, 10.0, "m/s")
+TURN_RATE = Bound(-10.0, 10.0, "rad/s")
+TOLERANCE = Bound(0.0, 10.0, "m", strict=True)
+HEADING_TOLERANCE = Bound(0.0, 10.0, "rad", strict=True)
 OBJECTIVE_KEYS = ("orbital_level", "k_height", "k_obstacle", "gain")
 PATH_KEYS = ("waypoints", "speed", "gain", "tolerance", "heading_tolerance")
-SCENE_LIMITS = (ObstacleDamper, SurfaceHeight)
+SCENE_LIMITS = (ObstacleDamper, SurfaceHeight, ProbeHeight, TiltLimit)
 """The limits configured by the ``[constraints]`` table, in row order."""
 CONSTRAINT_KEYS = tuple(dict.fromkeys(key for cls in SCENE_LIMITS for key in cls.SCENE_KEYS))
 
@@ -31,9 +55,8 @@ CONSTRAINT_KEYS = tuple(dict.fromkeys(key for cls in SCENE_LIMITS for key in cls
 def pipe(f: Fields, doc: dict[str, Any]) -> tuple[float, float | None]:
     """``[pipe]``: the radius (m, > 0) and the optional weld z (m)."""
     pipe = f.table(doc, "pipe", "", ("radius", "weld"))
-    with f.mapped("pipe"):
-        radius = _validate.positive("radius", f.number(pipe, "radius", "pipe"))
-    return radius, f.number(pipe, "weld", "pipe", None) if "weld" in pipe else None
+    radius = f.number(pipe, "radius", "pipe", within=PIPE_RADIUS)
+    return radius, f.number(pipe, "weld", "pipe", within=POSITION) if "weld" in pipe else None
 
 
 def obstacles(f: Fields, doc: dict[str, Any]) -> ObstacleSet:
@@ -41,8 +64,9 @@ def obstacles(f: Fields, doc: dict[str, Any]) -> ObstacleSet:
     out = []
     for i, t in enumerate(f.tables(doc, "obstacles", "", ("center", "radius", "weight"))):
         prefix = join("obstacles", i)
-        center = f.vector(t, "center", prefix, 2)
-        radius, weight = f.number(t, "radius", prefix), f.number(t, "weight", prefix, 1.0)
+        center = f.vector(t, "center", prefix, 2, within=POSITION)
+        radius = f.number(t, "radius", prefix, within=SIZE)
+        weight = f.number(t, "weight", prefix, 1.0, within=WEIGHT)
         with f.mapped(prefix):
             out.append(Obstacle(center, radius, weight))
     return ObstacleSet(out)
@@ -51,16 +75,16 @@ def obstacles(f: Fields, doc: dict[str, Any]) -> ObstacleSet:
 def orbital_level(f: Fields, doc: dict[str, Any]) -> float:
     """``objective.orbital_level``, m."""
     t = f.table(doc, "objective", "", OBJECTIVE_KEYS)
-    return f.number(t, "orbital_level", "objective")
+    return f.number(t, "orbital_level", "objective", within=HEIGHT)
 
 
 def objective(f: Fields, doc: dict[str, Any], k: int, obstacles: ObstacleSet) -> Objective:
     """``[objective]`` for ``k`` body points: the paper's three terms with the obstacles."""
     t = f.table(doc, "objective", "", OBJECTIVE_KEYS)
-    level = f.number(t, "orbital_level", "objective")
-    kh = f.vector(t, "k_height", "objective", k, scalar=True, default=1.0)
-    ko = f.vector(t, "k_obstacle", "objective", k, scalar=True, default=1.0)
-    gain = f.number(t, "gain", "objective", 1.0)
+    level = f.number(t, "orbital_level", "objective", within=HEIGHT)
+    kh = f.vector(t, "k_height", "objective", k, scalar=True, default=1.0, within=WEIGHT)
+    ko = f.vector(t, "k_obstacle", "objective", k, scalar=True, default=1.0, within=WEIGHT)
+    gain = f.number(t, "gain", "objective", 1.0, within=WEIGHT)
     with f.mapped("objective"):
         return Objective.paper(level, obstacles, k_height=kh, k_obstacle=ko, gain=gain)
 
@@ -73,7 +97,8 @@ def limits(
     values = {key: f.number(t, key, "constraints") for key in CONSTRAINT_KEYS if key in t}
     damper = _configured(f, ObstacleDamper, values, obstacles)
     height = _configured(f, SurfaceHeight, values)
-    return (JointPositionLimit(robot), JointVelocityLimit(robot), damper, height)
+    probe, tilt = _configured(f, ProbeHeight, values), _configured(f, TiltLimit, values)
+    return (JointPositionLimit(robot), JointVelocityLimit(robot), damper, height, probe, tilt)
 
 
 def _configured(f: Fields, cls: Any, values: dict[str, float], *args: Any) -> Any:
@@ -89,10 +114,11 @@ def _configured(f: Fields, cls: Any, values: dict[str, float], *args: Any) -> An
 def motion(f: Fields, doc: dict[str, Any]) -> tuple[float, tuple[JogSegment, ...], ToolPath | None]:
     """``dt`` (s), and the JOG segments or the path."""
     motion = f.table(doc, "motion", "", ("dt", "jog", "path"))
-    with f.mapped("motion"):
-        dt = _validate.positive("dt", f.number(motion, "dt", "motion"))
+    dt = f.number(motion, "dt", "motion", within=DT)
     jog, path = _motion(f, motion)
-    steps = jog_step_count(jog, dt) if path is None else path.step_count(dt)
+    steps = sum(s.duration for s in jog) / dt if path is None else path.step_count(dt)
+    if steps <= MAX_STEPS and path is None:  # now the exact count cannot overflow
+        steps = jog_step_count(jog, dt)
     if steps > MAX_STEPS:
         f.fail("motion", f"about {steps:.3g} steps of dt: too many (at most {MAX_STEPS:.0e})")
     return dt, jog, path
@@ -108,7 +134,8 @@ def _motion(f: Fields, motion: dict[str, Any]) -> tuple[tuple[JogSegment, ...], 
             f.fail("motion.jog", "needs at least one segment")
         for i, t in enumerate(tables):
             prefix = join("motion.jog", i)
-            duration, velocity = f.number(t, "duration", prefix), f.vector(t, "velocity", prefix, 4)
+            duration = f.number(t, "duration", prefix, within=DURATION)
+            velocity = f.vector(t, "velocity", prefix, 4, within=(SPEED, SPEED, SPEED, TURN_RATE))
             with f.mapped(prefix):
                 segments.append(JogSegment(duration, velocity))
         return tuple(segments), None
@@ -116,21 +143,20 @@ def _motion(f: Fields, motion: dict[str, Any]) -> tuple[tuple[JogSegment, ...], 
     raw = f.get(t, "waypoints", "motion.path")
     if not isinstance(raw, list) or len(raw) < 2:
         f.fail("motion.path.waypoints", "expected an array of at least 2 waypoints [l, z, h, α]")
+    bounds = (POSITION, POSITION, Bound(-1000.0, HEIGHT.high, "m"), HEADING)  # h < 0: below
     points = np.array(
-        [f.vector_value(join("motion.path.waypoints", i), w, 4) for i, w in enumerate(raw)]
+        [
+            f.vector_value(join("motion.path.waypoints", i), w, 4, within=bounds)
+            for i, w in enumerate(raw)
+        ]
     )
     for i, h in enumerate(points[:, 2]):
         if h < 0:
             f.fail(f"motion.path.waypoints[{i}]", f"h = {h:g} m is inside the pipe (must be >= 0)")
     if not np.any(np.diff(points, axis=0) != 0.0):
         f.fail("motion.path.waypoints", "the waypoints are all the same: nothing to follow")
-    speed = f.number(t, "speed", "motion.path")
-    gain = f.number(t, "gain", "motion.path", 5.0)
-    tol = f.number(t, "tolerance", "motion.path", 0.005)
-    heading_tol = f.number(t, "heading_tolerance", "motion.path", 0.05)
-    with f.mapped("motion.path"):
-        _validate.positive("speed", speed)
-        _validate.positive("gain", gain, strict=False)
-        _validate.positive("tolerance", tol)
-        _validate.positive("heading_tolerance", heading_tol)
+    speed = f.number(t, "speed", "motion.path", within=Bound(0.0, SPEED.high, "m/s", True))
+    gain = f.number(t, "gain", "motion.path", 5.0, within=GAIN)
+    tol = f.number(t, "tolerance", "motion.path", 0.005, within=TOLERANCE)
+    heading_tol = f.number(t, "heading_tolerance", "motion.path", 0.05, within=HEADING_TOLERANCE)
     return (), ToolPath(_validate.readonly(points), speed, gain, tol, heading_tol)

@@ -1,4 +1,10 @@
-"""Checks of a scene's start configuration."""
+"""Checks of a scene's start configuration.
+
+A start that puts a body point or the tool inside the pipe (h < 0), or the tool inside an
+obstacle, is refused. A body point below ``[constraints] min_height`` or within an obstacle's
+margin is allowed: the QP's dampers then forbid it to get worse and the objective pushes it
+out (``docs/scenes.md``).
+"""
 
 from __future__ import annotations
 
@@ -15,11 +21,20 @@ from dvqp.scenes.fields import Fields, join
 def check_start(
     f: Fields, robot: Robot, q0: NDArray[np.float64], radius: float, obstacles: ObstacleSet
 ) -> None:
-    """The tool's start point must be regular and outside every obstacle."""
+    """Every point of the arm must start outside the pipe, the tool also outside the obstacles.
+
+    The configuration must be regular (no point on the pipe axis).
+    """
     try:
-        tool = KinematicState.compute(robot, q0, radius).tool
+        state = KinematicState.compute(robot, q0, radius)
     except DvqpError as exc:
         f.fail("robot.q0", str(exc))
+    tool = state.tool
+    heights = [*state.points[:, 2], tool[2]]
+    for i, (frame, h) in enumerate(zip(robot.frame_names, heights, strict=True)):
+        if h < 0.0:
+            part = "the tool" if i == robot.n_points else f"body point {i + 1}"
+            f.fail("robot.q0", f"{part} (frame {frame!r}) starts inside the pipe: h = {h:.4g} m")
     for i, o in enumerate(obstacles):
         d = float(np.linalg.norm(offsets(tool[None, :2], o.center[None], radius)))
         if d < o.radius:
