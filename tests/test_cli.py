@@ -2,8 +2,13 @@
 
 from __future__ import annotations
 
+import errno
 import io
 import json
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -255,3 +260,146 @@ def test_usage_errors_exit_2_and_help_exits_0(capsys: pytest.CaptureFixture[str]
     assert main(["compare", "x.toml", "--jobs", "0"]) == 2
     assert main(["--help"]) == 0
     assert "plan" in capsys.readouterr().out
+
+
+def test_version_prints_the_package_version(capsys: pytest.CaptureFixture[str]) -> None:
+    from dvqp import __version__
+
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out == f"dvqp {__version__}\n"
+
+
+def test_an_output_that_is_a_directory_exits_2_before_the_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = write_scene(tmp_path)
+    (tmp_path / "out.npz").mkdir()
+    assert main(["plan", scene, "--backend", "pinv", "-o", str(tmp_path / "out.npz")]) == 2
+    captured = capsys.readouterr()
+    assert captured.err == f"dvqp: output: {tmp_path / 'out.npz'}: is a directory\n"
+    assert captured.out == ""
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.npz", "small.toml"]
+
+
+@pytest.mark.parametrize("suffix", [".npz", ".csv"])
+def test_a_full_disk_while_saving_is_one_line_and_leaves_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+    suffix: str,
+) -> None:  # fmt: skip
+    def full(fh, *args: object, **kwargs: object) -> None:  # type: ignore[no-untyped-def]
+        fh.write(b"half a file")
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr("dvqp.motion.trajectory.np.savez_compressed", full)
+    monkeypatch.setattr("dvqp.motion.trajectory.np.savetxt", full)
+    out = tmp_path / f"traj{suffix}"
+    assert main(["plan", write_scene(tmp_path), "--backend", "pinv", "-o", str(out)]) == 2
+    captured = capsys.readouterr()
+    assert captured.err == f"dvqp: output: {out}: cannot write: No space left on device\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["small.toml"]  # no temporary file either
+
+
+def test_plot_of_a_missing_or_foreign_file_says_so_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    png = tmp_path / "fig.png"
+    pickled = tmp_path / "objects.npz"
+    np.savez(pickled, t=np.array([{"a": 1}], dtype=object))
+    shapes = tmp_path / "shapes.npz"
+    assert main(["plan", write_scene(tmp_path), "--backend", "pinv", "-o", str(shapes)]) == 0
+    with np.load(shapes) as data:
+        arrays = {key: data[key] for key in data.files}
+    np.savez(shapes, **{**arrays, "tool": arrays["tool"][:, :2]})
+    capsys.readouterr()
+    cases = {
+        tmp_path / "missing.npz": "cannot read: No such file or directory",
+        tmp_path / "small.toml": "not a dvqp trajectory (not an .npz file)",
+        pickled: "not a dvqp trajectory (not written by 'dvqp plan')",
+        shapes: "not a dvqp trajectory (arrays of unexpected shapes)",
+    }
+    for path, reason in cases.items():
+        assert main(["plot", str(path), "-o", str(png)]) == 2
+        assert capsys.readouterr().err == f"dvqp: {path}: {reason}\n"
+    assert not png.exists()
+
+
+def test_ctrl_c_in_a_run_exits_130_with_one_line_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def interrupted(*args: object, **kwargs: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sys.modules["dvqp.cli.main"], "plan", interrupted)
+    out = tmp_path / "traj.npz"
+    assert main(["plan", write_scene(tmp_path), "--backend", "pinv", "-o", str(out)]) == 130
+    assert capsys.readouterr() == ("", "dvqp: interrupted\n")
+    assert [p.name for p in tmp_path.iterdir()] == ["small.toml"]
+
+
+def test_ctrl_c_while_saving_leaves_no_half_written_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def interrupted(fh, *args: object, **kwargs: object) -> None:  # type: ignore[no-untyped-def]
+        fh.write(b"half a file")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("dvqp.motion.trajectory.np.savez_compressed", interrupted)
+    assert main(["plan", write_scene(tmp_path), "--backend", "pinv", "-o", str(tmp_path / "t.npz")])
+    assert capsys.readouterr().err == "dvqp: interrupted\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["small.toml"]
+
+
+LONG = "[[motion.jog]]\nduration = 1500.0\nvelocity = [0.0, 0.0, 0.0, 0.0]"  # 3e5 steps, ~3 min
+
+
+@pytest.mark.parametrize(
+    "args", [["plan", "{scene}", "--backend", "pinv", "-o", "{tmp}/t.npz"],
+             ["compare", "{scene}", "{tmp}/two.toml", "--backends", "pinv,daqp", "--jobs", "2",
+              "--json", "{tmp}/c.json"]],
+    ids=["plan", "compare --jobs 2"],
+)  # fmt: skip
+def test_a_real_sigint_stops_cleanly_with_exit_130(tmp_path: Path, args: list[str]) -> None:
+    scene = write_scene(tmp_path, motion=LONG)
+    write_scene(tmp_path, "two", motion=LONG)
+    argv = [a.format(scene=scene, tmp=tmp_path) for a in args]
+    proc = subprocess.Popen([sys.executable, "-m", "dvqp", *argv], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    assert proc.stderr is not None
+    note = proc.stderr.readline()  # announced before the run starts
+    assert note.startswith(f"dvqp: note: {scene}: about 3e+05 steps"), note
+    time.sleep(0.3)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and out == ""
+    assert err.splitlines()[-1] == "dvqp: interrupted" and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml", "two.toml"]
+
+
+def test_a_run_too_big_for_the_memory_is_refused_before_it_starts(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr("dvqp.cli.progress.physical_memory", lambda: 100_000_000)
+    scene = write_scene(tmp_path, motion=LONG)
+    assert main(["plan", scene, "--backend", "pinv", "-o", str(tmp_path / "t.npz")]) == 2
+    assert capsys.readouterr().err == (
+        f"dvqp: {scene}: motion: about 3e+05 steps: roughly 3 min and 0.18 GB, more than this "
+        "machine's 0.1 GB allow: use a larger dt or a shorter motion\n"
+    )
+    assert [p.name for p in tmp_path.iterdir()] == ["small.toml"]
+
+
+def test_numerical_warnings_are_summed_up_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from dvqp import plan
+
+    def noisy(*args: object, **kwargs: object) -> Trajectory:
+        for _ in range(17):
+            np.float64(1e308) * np.float64(10.0)
+        return plan(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(sys.modules["dvqp.cli.main"], "plan", noisy)
+    assert main(["plan", write_scene(tmp_path), "--backend", "pinv"]) == 0
+    assert capsys.readouterr().err == (  # once per place in the code
+        "dvqp: warning: RuntimeWarning: overflow encountered in scalar multiply\n"
+    )

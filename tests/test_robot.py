@@ -1,6 +1,7 @@
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 from dvqp import KinematicState, Robot
@@ -60,3 +61,59 @@ def test_limits_are_validated() -> None:
         Robot.ndt13(LINK_LENGTHS, q_min=1.0, q_max=0.0)
     with pytest.raises(ParameterError, match="qd_max"):
         Robot.ndt13(LINK_LENGTHS, qd_max=0.0)
+
+
+SCENES = Path(__file__).resolve().parent.parent / "scenes"
+
+
+def frames_at(robot: Robot, q: np.ndarray) -> list[np.ndarray]:
+    pin.framesForwardKinematics(robot.model, robot.data, q)
+    return [robot.data.oMf[i].homogeneous.copy() for i in robot.frame_ids]
+
+
+def test_the_bundled_urdf_is_the_ndt13_arm(robot: Robot) -> None:
+    points = [f"point{k}" for k in range(1, 6)]
+    urdf = Robot.from_urdf(SCENES / "ndt13.urdf", points, "probe")
+    assert urdf.n == 13 and urdf.name == "ndt13-urdf"
+    np.testing.assert_array_equal(urdf.q_min, robot.q_min)  # joint 1 continuous: unlimited
+    np.testing.assert_allclose(urdf.q_max, robot.q_max, rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(urdf.qd_max, robot.qd_max)
+    for q in np.random.default_rng(1).uniform(-4.0, 4.0, size=(20, 13)):
+        for mine, theirs in zip(frames_at(urdf, q), frames_at(robot, q), strict=True):
+            np.testing.assert_allclose(mine, theirs, rtol=0, atol=1e-12)
+
+
+def test_continuous_joints_on_any_axis_become_unlimited_revolute_joints(tmp_path: Path) -> None:
+    text = (
+        URDF.replace('name="j1" type="revolute"', 'name="j1" type="continuous"')
+        .replace('name="j3" type="revolute"', 'name="j3" type="continuous"')
+        .replace(
+            '<origin xyz="0 0 0.1"/><axis xyz="1 0 0"/>',
+            '<origin xyz="0 0 0.1"/><axis xyz="0.6 0.8 0"/>',
+        )
+    )
+    (tmp_path / "c.urdf").write_text(text)
+    (tmp_path / "r.urdf").write_text(URDF.replace('<axis xyz="1 0 0"/>', '<axis xyz="0.6 0.8 0"/>'))
+    cont = Robot.from_urdf(tmp_path / "c.urdf", points=["l2", "l3"], tool="probe")
+    rev = Robot.from_urdf(tmp_path / "r.urdf", points=["l2", "l3"], tool="probe")
+    assert cont.n == 3 and cont.model.nq == cont.model.nv == 3
+    np.testing.assert_array_equal(cont.q_min, [-np.inf, -1.0, -np.inf])
+    np.testing.assert_array_equal(cont.q_max, [np.inf, 1.0, np.inf])
+    np.testing.assert_allclose(cont.qd_max, [2.0, 1.0, 0.5])
+    assert [f.name for f in cont.model.frames] == [f.name for f in rev.model.frames]
+    for q in ([0.0, 0.0, 0.0], [5.0, 0.5, -4.0], [-7.0, -0.9, 2.5]):
+        for a, b in zip(frames_at(cont, np.array(q)), frames_at(rev, np.array(q)), strict=True):
+            np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
+
+
+def test_other_joints_are_refused_and_the_parser_stays_quiet(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "planar.urdf"
+    path.write_text(URDF.replace('name="j2" type="revolute"', 'name="j2" type="planar"'))
+    with pytest.raises(ParameterError, match=r"^urdf: joint 'j2' is a Planar joint: only "):
+        Robot.from_urdf(path, points=["l2", "l3"], tool="probe")
+    path.write_text("<robot name='x'><link name='a'/><joint name='j'/></robot>")
+    with pytest.raises(DvqpError, match=r"planar\.urdf: cannot load URDF: .*\(Error"):
+        Robot.from_urdf(path, points=["a", "b"], tool="c")
+    assert capfd.readouterr() == ("", "")

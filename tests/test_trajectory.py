@@ -1,3 +1,4 @@
+import dataclasses
 import os
 from pathlib import Path
 
@@ -79,3 +80,28 @@ def test_an_unwritable_folder_is_refused_before_any_work() -> None:
         pytest.skip("needs /proc")
     with pytest.raises(ParameterError, match="cannot write here"):
         straddling().save("/proc/t.npz")
+
+
+def test_the_safety_diagnostics_round_trip_and_old_files_still_load(tmp_path: Path) -> None:
+    traj = straddling()
+    n = traj.t.shape[0]
+    full = dataclasses.replace(
+        traj,
+        probe_clearance=np.linspace(0.02, 0.01, n),
+        tilt=np.full(n, 1.2),
+        limit_excess=np.array([0.0, 2e-5, 0.0, 0.0]),
+        limits_kept=np.ones(n, dtype=bool),
+        substeps=np.array([1, 4, 1], dtype=np.int64),
+    )
+    back = Trajectory.load(full.save(tmp_path / "new.npz"))
+    for name in ("probe_clearance", "tilt", "limit_excess", "limits_kept", "substeps"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(full, name))
+    # a file written before 0.2: "dv" for the tool, no diagnostics
+    arrays = {name: getattr(traj, name) for name in ("t", "q", "qdot", "points", "w",
+              "min_clearance", "solve_time", "step_time", "task_error", "iterations",
+              "success", "status")}  # fmt: skip
+    old = tmp_path / "old.npz"
+    np.savez(old, dv=traj.tool, backend="pinv", pipe_radius=R, scene="", **arrays)
+    loaded = Trajectory.load(old)
+    np.testing.assert_array_equal(loaded.tool, traj.tool)
+    assert loaded.limits_kept.shape == (0,) and loaded.substeps.shape == (0,)

@@ -104,7 +104,7 @@ def _worst(row: Row, kept: bool) -> str:
     """The worst limit excess with its limit, or that every limit was kept."""
     if not row["worst_limit"]:
         return "every limit kept"
-    worst = f"{row['worst_limit']} past by {row['max_limit_excess']:.3g}"
+    worst = f"{row['worst_limit']} past its bound by {row['max_limit_excess']:.2g}"
     return f"every limit kept to its tolerance (deepest: {worst})" if kept else f"BROKEN: {worst}"
 
 

@@ -245,44 +245,50 @@ class Robot:
 
 UNBOUNDED_REVOLUTE = {"JointModelRUBX": pin.JointModelRX, "JointModelRUBY": pin.JointModelRY,
                       "JointModelRUBZ": pin.JointModelRZ}  # fmt: skip
-"""Pinocchio's joints for a URDF ``continuous`` joint (nq = 2: cos, sin) and their nq = 1 twin
-(an unaligned axis: ``JointModelRevoluteUnboundedUnaligned``, twin ``…RevoluteUnaligned``)."""
+"""Pinocchio's joints for a URDF ``continuous`` joint about x, y, z (nq = 2: cos, sin) and their
+nq = 1 twins (any other axis: ``JointModelRevoluteUnboundedUnaligned``, see :func:`_twin`)."""
 
 
 def _bounded_revolute(model: pin.Model) -> pin.Model:
     """``model`` with each continuous joint (nq = 2) as a revolute one without limits (nq = 1).
 
     The joints, bodies and frames keep their names, placements, inertias and order; any other
-    joint with ``nq != nv`` is refused.
+    joint with ``nq != nv`` is refused (``ParameterError`` named ``urdf``).
     """
-    kinds = [model.joints[i].shortname() for i in range(1, model.njoints)]
-    unaligned = "JointModelRevoluteUnboundedUnaligned"
-    for name, kind, joint in zip(model.names[1:], kinds, model.joints[1:], strict=True):
-        if joint.nq != joint.nv and kind not in UNBOUNDED_REVOLUTE and kind != unaligned:
+    twins = [_twin(model.joints[i]) for i in range(1, model.njoints)]
+    for name, joint, twin in zip(model.names[1:], model.joints[1:], twins, strict=True):
+        if joint.nq != joint.nv and twin is None:
             raise ParameterError(
-                "urdf", f"joint {name!r} is a {kind.removeprefix('JointModel')} joint: only "
-                "revolute, continuous and prismatic joints are supported"
+                "urdf", f"joint {name!r} is a {joint.shortname().removeprefix('JointModel')} "
+                "joint: only revolute, continuous and prismatic joints are supported"
             )  # fmt: skip
-    if not any(k in UNBOUNDED_REVOLUTE or k == unaligned for k in kinds):
+    if all(twin is None for twin in twins):
         return model
     out = pin.Model()
     out.name = model.name
-    for i in range(1, model.njoints):
-        joint, kind = model.joints[i], kinds[i - 1]
-        q, v = (
-            slice(joint.idx_q, joint.idx_q + joint.nq),
-            slice(joint.idx_v, joint.idx_v + joint.nv),
-        )
+    for i, twin in enumerate(twins, start=1):
+        joint = model.joints[i]
+        q = slice(joint.idx_q, joint.idx_q + joint.nq)
         lo, hi = model.lowerPositionLimit[q], model.upperPositionLimit[q]
-        if kind in UNBOUNDED_REVOLUTE or kind == unaligned:
-            new = (UNBOUNDED_REVOLUTE[kind]() if kind != unaligned
-                   else pin.JointModelRevoluteUnaligned(joint.extract().axis))  # fmt: skip
+        if twin is not None:
             lo, hi = np.array([-np.inf]), np.array([np.inf])
-        else:
-            new = joint.extract()
-        out.addJoint(model.parents[i], new, model.jointPlacements[i], model.names[i],
-                     model.effortLimit[v], model.velocityLimit[v], lo, hi)  # fmt: skip
+        v = slice(joint.idx_v, joint.idx_v + joint.nv)
+        out.addJoint(model.parents[i], joint.extract() if twin is None else twin,
+                     model.jointPlacements[i], model.names[i], model.effortLimit[v],
+                     model.velocityLimit[v], lo, hi)  # fmt: skip
         out.appendBodyToJoint(i, model.inertias[i], pin.SE3.Identity())
     for frame in list(model.frames)[1:]:
         out.addFrame(pin.Frame(frame), False)
     return out
+
+
+def _twin(joint: pin.JointModel) -> pin.JointModel | None:
+    """The nq = 1 revolute joint of a continuous (nq = 2) one; None for any other joint."""
+    kind = joint.shortname()
+    if kind in UNBOUNDED_REVOLUTE:
+        return UNBOUNDED_REVOLUTE[kind]()
+    if kind != "JointModelRevoluteUnboundedUnaligned":
+        return None
+    data = joint.createData()  # the axis is not exposed: read it from the motion subspace
+    joint.calc(data, np.array([1.0, 0.0]))
+    return pin.JointModelRevoluteUnaligned(*np.asarray(data.S, dtype=float).reshape(6)[3:])
