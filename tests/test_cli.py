@@ -403,3 +403,22 @@ def test_numerical_warnings_are_summed_up_in_one_line(
     assert capsys.readouterr().err == (  # once per place in the code
         "dvqp: warning: RuntimeWarning: overflow encountered in scalar multiply\n"
     )
+
+
+def test_the_progress_bar_tells_the_time_left(monkeypatch: pytest.MonkeyPatch) -> None:
+    from dvqp.cli.progress import ProgressBar, duration
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    clock = iter([0.0, 30.0, 60.0])
+    monkeypatch.setattr("dvqp.cli.progress.time.perf_counter", lambda: next(clock))
+    term = Terminal()
+    bar = ProgressBar(term)  # started at t = 0
+    bar.show(1, 4, "steps")  # 30 s for a quarter: 1.5 min left
+    bar.show(3, 4, "steps")  # 60 s for three quarters: 20 s left
+    frames = term.getvalue().split("\r")[1:]
+    assert frames[0].startswith("[#######.......................] 1/4 1.5 min left steps")
+    assert frames[1].startswith("[######################........] 3/4 20 s left steps")
+    assert [duration(s) for s in (42, 210, 4680, 9000)] == ["42 s", "3.5 min", "78 min", "2.5 h"]

@@ -191,7 +191,7 @@ INVALID = [
      "objective.orbital_level: must be finite, got nan"),
     ("obstacle swallows the tool", ("center = [0.20, 0.45]", "center = [0.2973, 0.40]"),
      "obstacles[0]: covers the tool's start point [l, z] = [0.2973, 0.35] m "
-     "(distance 0.04999 m < radius 0.06 m)"),
+     "(10 mm inside the circle)"),
     # sane bounds of physical quantities, the bound in the message
     ("huge pipe", ("radius = 0.254", "radius = 1e300"),
      "pipe.radius: must be <= 100 m, got 1e+300"),

@@ -22,7 +22,8 @@ from dvqp.kinematics.developed_view import unwrap, wrap
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from dvqp import Obstacle, Trajectory
+    from dvqp import Trajectory
+    from dvqp.geometry.shapes import Shape
 
 SHIFTS = (-1, 0, 1)
 """Copies of seam-periodic drawings, in periods ``2πR``."""
@@ -38,7 +39,7 @@ class View(NamedTuple):
     radius
         Pipe radius ``R``, m.
     obstacles
-        Obstacle circles (l, z).
+        Obstacle shapes (l, z).
     h_star
         Orbital level ``h*``, m, or None.
     weld
@@ -49,7 +50,7 @@ class View(NamedTuple):
 
     traj: Trajectory
     radius: float
-    obstacles: tuple[Obstacle, ...]
+    obstacles: tuple[Shape, ...]
     h_star: float | None
     weld: float | None
     limits: tuple[float, float, float, float]
@@ -62,7 +63,7 @@ class View(NamedTuple):
 
 def make_view(
     traj: Trajectory,
-    obstacles: Sequence[Obstacle] = (),
+    obstacles: Sequence[Shape] = (),
     orbital_level: float | None = None,
     weld_z: float | None = None,
 ) -> View:
@@ -89,11 +90,11 @@ def make_view(
 
 
 def _limits(
-    traj: Trajectory, radius: float, obstacles: Sequence[Obstacle], weld: float | None
+    traj: Trajectory, radius: float, obstacles: Sequence[Shape], weld: float | None
 ) -> tuple[float, float, float, float]:
     """Developed-view limits: l a little beyond the seams, z around everything drawn, m."""
     z = [traj.points[..., 1].ravel(), traj.tool[:, 1]]
-    z += [np.array([o.center[1] - o.radius, o.center[1] + o.radius]) for o in obstacles]
+    z += [np.array(o.z_range) for o in obstacles]
     zs = np.concatenate([*z, [] if weld is None else [weld]])
     pad, edge = 0.08 * float(np.ptp(zs)) + 0.03, 1.12 * np.pi * radius
     return (-edge, edge, float(zs.min()) - pad, float(zs.max()) + pad)
@@ -136,16 +137,24 @@ def draw_developed_view(ax: Axes, view: View) -> None:
 
 
 def _draw_obstacles(ax: Axes, view: View) -> None:
-    """Every obstacle circle, wrapped, with its copies one period left and right."""
-    from matplotlib.patches import Circle
+    """Every obstacle's outline, wrapped, with its copies one period left and right; a band
+    as a strip across the whole view."""
+    from matplotlib.patches import Polygon as Patch
 
     period = 2.0 * np.pi * view.radius
     style = {"fc": "tab:red", "ec": "darkred", "alpha": 0.3}
     for j, o in enumerate(view.obstacles):
-        cl = float(wrap_arc(o.center[0], view.radius))
+        ring = o.outline()
+        if np.isnan(ring[:, 0]).all():  # a band: every l
+            label = "obstacle" if j == 0 else None
+            ax.axhspan(ring[0, 1], ring[1, 1], **style, label=label)
+            continue
+        ref = float(np.mean(ring[:, 0]))
+        shift = float(wrap_arc(ref, view.radius)) - ref
         for s in SHIFTS:
             label = "obstacle" if j == 0 and s == 0 else None
-            ax.add_patch(Circle((cl + s * period, o.center[1]), o.radius, **style, label=label))
+            moved = ring + np.array([shift + s * period, 0.0])
+            ax.add_patch(Patch(moved, closed=True, **style, label=label))
 
 
 def _draw_tool_path(ax: Axes, view: View) -> None:
@@ -203,7 +212,12 @@ def draw_section(ax: Axes, view: View, instants: Sequence[tuple[int, Any]]) -> N
         orbit = (radius + h_star) * circle
         ax.plot(*orbit, color="0.3", ls="--", lw=1.0, label="orbital level R + h*")
     for j, o in enumerate(view.obstacles):
-        arc = np.linspace(o.center[0] - o.radius, o.center[0] + o.radius, 50) / radius
+        ring = o.outline()
+        if np.isnan(ring[:, 0]).all():  # a band covers the whole circumference
+            lo, hi = -np.pi * radius, np.pi * radius
+        else:
+            lo, hi = float(ring[:, 0].min()), float(ring[:, 0].max())
+        arc = np.linspace(lo, hi, 90) / radius
         label = "obstacle (l extent)" if j == 0 else None
         xy = radius * np.cos(arc), radius * np.sin(arc)
         ax.plot(*xy, color="tab:red", lw=5, alpha=0.5, solid_capstyle="butt", label=label)

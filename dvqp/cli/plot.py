@@ -36,7 +36,8 @@ if TYPE_CHECKING:
     from matplotlib.cm import ScalarMappable
     from matplotlib.figure import Figure
 
-    from dvqp import Obstacle, Trajectory
+    from dvqp import Trajectory
+    from dvqp.geometry.shapes import Shape
 
 __all__ = ["FIGURE_FORMATS", "animate_trajectory", "plot_trajectory"]
 
@@ -45,7 +46,7 @@ def plot_trajectory(
     traj: Trajectory,
     path: str | Path,
     *,
-    obstacles: Sequence[Obstacle] = (),
+    obstacles: Sequence[Shape] = (),
     orbital_level: float | None = None,
     weld_z: float | None = None,
     instants: int = 6,
@@ -64,7 +65,7 @@ def plot_trajectory(
     path
         Output file, ``.png``, ``.svg`` or ``.pdf``; its folder must exist.
     obstacles
-        Obstacle circles (l, z) to draw.
+        Obstacle shapes (l, z) to draw.
     orbital_level
         ``h*`` (m), drawn as a dashed line and circle if given.
     weld_z
@@ -109,7 +110,7 @@ def animate_trajectory(
     traj: Trajectory,
     path: str | Path,
     *,
-    obstacles: Sequence[Obstacle] = (),
+    obstacles: Sequence[Shape] = (),
     orbital_level: float | None = None,
     weld_z: float | None = None,
     fps: int = 20,

@@ -1,104 +1,86 @@
-"""Circular obstacles in the developed view and the body's clearance to them.
+"""Obstacles in the developed view: shapes in the (l, z) plane, packed into a set per run.
 
-An obstacle is a circle in the (l, z) plane (m). Differences in l are wrapped modulo
-``2πR``, so a circle near the seam ``l = ±πR`` acts on both sides of it.
+An obstacle is any :class:`~dvqp.geometry.shapes.Shape` (a circle, a branch inlet, a band, a
+polygon). Differences in l are wrapped modulo ``2πR``, so an obstacle near the seam
+``l = ±πR`` acts on both sides of it. ``Obstacle`` is the circle, the paper's envelope.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Iterator, Sequence
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
 from dvqp.errors import ParameterError
-from dvqp.kinematics.developed_view import wrap
+from dvqp.geometry.shapes import Circle, Shape, ShapeDistances
 
-
-@dataclass(frozen=True, eq=False)
-class Obstacle:
-    """A circle in the (l, z) plane of the developed view.
-
-    Parameters
-    ----------
-    center
-        ``[l, z]`` of the centre, m, shape (2,).
-    radius
-        Radius, m, > 0.
-    weight
-        The objective weight ``w_j`` (>= 0).
-    """
-
-    center: NDArray[np.float64]
-    radius: float
-    weight: float = 1.0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(
-            self, "center", _validate.readonly(_validate.vector("center", self.center, 2))
-        )
-        object.__setattr__(self, "radius", _validate.positive("radius", self.radius))
-        object.__setattr__(self, "weight", _validate.positive("weight", self.weight, strict=False))
+Obstacle = Circle
+"""The paper's obstacle: a circle, ``Obstacle(center, radius, weight)``."""
 
 
 class ObstacleSet:
-    """An immutable set of obstacle circles, packed as arrays (identity-hashed cache key).
+    """An immutable set of obstacles, grouped by shape (identity-hashed cache key).
 
     Parameters
     ----------
     obstacles
-        The circles.
+        The shapes, in the order their rows and labels (``obstacle1``, ...) follow.
 
     Attributes
     ----------
-    centers : ndarray, shape (J, 2)
-        ``[l, z]`` of each centre, m.
-    radii : ndarray, shape (J,)
-        m.
     weights : ndarray, shape (J,)
         Objective weights ``w_j``.
     """
 
-    def __init__(self, obstacles: Sequence[Obstacle] = ()) -> None:
+    def __init__(self, obstacles: Sequence[Shape] = ()) -> None:
         self.obstacles = tuple(obstacles)
         for i, o in enumerate(self.obstacles):
-            if not isinstance(o, Obstacle):
-                raise ParameterError(f"obstacles[{i}]", "must be an Obstacle")
-        ro = _validate.readonly
-        if self.obstacles:
-            self.centers = ro(np.array([o.center for o in self.obstacles]))
-            self.radii = ro(np.array([o.radius for o in self.obstacles]))
-            self.weights = ro(np.array([o.weight for o in self.obstacles]))
-        else:
-            self.centers, self.radii, self.weights = (
-                ro(np.zeros((0, 2))),
-                ro(np.zeros(0)),
-                ro(np.zeros(0)),
-            )
+            if not isinstance(o, Shape):
+                raise ParameterError(f"obstacles[{i}]", "must be an obstacle shape")
+        self.weights = _validate.readonly(np.array([o.weight for o in self.obstacles], float))
+        groups: dict[type[Shape], list[int]] = {}
+        for i, o in enumerate(self.obstacles):
+            groups.setdefault(type(o), []).append(i)
+        self._groups = [(cls, [self.obstacles[i] for i in idx]) for cls, idx in groups.items()]
+        order = [i for idx in groups.values() for i in idx]
+        self._inverse = np.argsort(order) if order != sorted(order) else None
 
     @classmethod
-    def of(cls, obstacles: ObstacleSet | Sequence[Obstacle]) -> ObstacleSet:
+    def of(cls, obstacles: ObstacleSet | Sequence[Shape]) -> ObstacleSet:
         """``obstacles`` itself if it is a set already (keeping its cache identity), else a new
         set of them."""
         return obstacles if isinstance(obstacles, ObstacleSet) else cls(obstacles)
 
+    def points(self, lz: np.ndarray, period: float) -> ShapeDistances:
+        """Every obstacle against m points ``lz`` (m, 2): arrays (J, m, ...)."""
+        return self._gather([cls.batch_points(shapes, lz, period) for cls, shapes in self._groups])
+
+    def segments(self, a: np.ndarray, b: np.ndarray, period: float) -> ShapeDistances:
+        """Every obstacle against m segments ``a → b`` (each (m, 2))."""
+        parts = [cls.batch_segments(shapes, a, b, period) for cls, shapes in self._groups]
+        return self._gather(parts)
+
+    def _gather(self, parts: list[ShapeDistances]) -> ShapeDistances:
+        if not parts:
+            m = 0
+            return ShapeDistances(np.zeros((0, m)), np.zeros((0, m, 2)), np.zeros((0, m)),
+                             np.zeros((0, m, 2)), np.zeros((0, m)))  # fmt: skip
+        found = parts[0] if len(parts) == 1 else ShapeDistances.stack(parts)
+        if self._inverse is None:
+            return found
+        i = self._inverse
+        return ShapeDistances(found.distance[i], found.normal[i], found.penalty[i],
+                         found.penalty_gradient[i], found.t[i])  # fmt: skip
+
     def __len__(self) -> int:
         return len(self.obstacles)
 
-    def __getitem__(self, index: int) -> Obstacle:
+    def __getitem__(self, index: int) -> Shape:
         return self.obstacles[index]
 
-    def __iter__(self):  # type: ignore[no-untyped-def]
+    def __iter__(self) -> Iterator[Shape]:
         return iter(self.obstacles)
 
     def __repr__(self) -> str:
         return f"ObstacleSet({list(self.obstacles)!r})"
-
-
-def offsets(lz: ArrayLike, centers: ArrayLike, pipe_radius: float) -> NDArray[np.float64]:
-    """``S_j − p_i`` with l wrapped, for k points and J centres: shape (J, k, 2), m."""
-    d = np.asarray(centers, dtype=np.float64)[:, None, :] - np.asarray(lz, dtype=np.float64)[None]
-    d[..., 0] = wrap(d[..., 0], pipe_radius)
-    return d

@@ -1,74 +1,69 @@
-"""Where the body is relative to the obstacles, computed once per state and shared.
+"""Where the arm is relative to the obstacles, computed once per state and shared.
 
 The objective's obstacle terms, the QP's dampers and the clearance diagnostic all need the
-offsets of the guarded parts to every obstacle circle: the k body points and the probe (the
+signed distances of the guarded parts to every obstacle: the k body points and the probe (the
 tool point), the k−1 body links and the probe holder (last body point to the tool).
-:func:`proximity` computes them once for a :class:`~dvqp.kinematics.state.KinematicState` and an
-:class:`ObstacleSet` and caches the result on the state, so each step does that geometry once.
+:func:`proximity` computes them once for a :class:`~dvqp.kinematics.state.KinematicState` and
+an :class:`ObstacleSet` and caches the result on the state, so each step does that geometry
+once.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp.geometry.obstacle import ObstacleSet, offsets
-from dvqp.kinematics.developed_view import wrap
+from dvqp.geometry.obstacle import ObstacleSet
+from dvqp.geometry.shapes import ShapeDistances
 from dvqp.kinematics.state import KinematicState
 
 
 @dataclass(frozen=True)
 class Proximity:
-    """Offsets of the k+1 guarded points and k guarded links to J obstacles (l wrapped).
+    """Signed distances of the k+1 guarded points and k guarded links to J obstacles.
 
     Index i < k is body point i+1, i = k the probe; link i < k−1 is body link i+1, link k−1
     the probe holder (see :func:`point_label`, :func:`link_label`).
 
     Attributes
     ----------
-    point_offsets : ndarray, shape (J, k+1, 2)
-        ``S_j − p_i``, m.
-    point_distance : ndarray, shape (J, k+1)
-        ``‖S_j − p_i‖``, m.
-    link_t : ndarray, shape (J, k)
-        Parameter in [0, 1] of the closest point ``p̄`` of link i to centre j.
-    link_offsets : ndarray, shape (J, k, 2)
-        ``S_j − p̄``, m.
-    link_distance : ndarray, shape (J, k)
-        ``‖S_j − p̄‖``, m.
-    radii : ndarray, shape (J,)
-        Obstacle radii, m.
+    points : ShapeDistances
+        Arrays (J, k+1, ...): distance, normal ``∇_p d``, penalty and its gradient.
+    links : ShapeDistances
+        Arrays (J, k, ...), at each link's closest point ``p̄ = p_i + t (p_{i+1} − p_i)``.
     """
 
-    point_offsets: NDArray[np.float64]
-    point_distance: NDArray[np.float64]
-    link_t: NDArray[np.float64]
-    link_offsets: NDArray[np.float64]
-    link_distance: NDArray[np.float64]
-    radii: NDArray[np.float64]
+    points: ShapeDistances
+    links: ShapeDistances
 
     @property
     def point_clearance(self) -> NDArray[np.float64]:
-        """Signed clearance of each guarded point to each circle, m, shape (J, k+1)."""
-        return self.point_distance - self.radii[:, None]
+        """Signed clearance of each guarded point to each obstacle, m, shape (J, k+1)."""
+        return self.points.distance
 
     @property
     def link_clearance(self) -> NDArray[np.float64]:
-        """Signed clearance of each guarded link to each circle, m, shape (J, k)."""
-        return self.link_distance - self.radii[:, None]
+        """Signed clearance of each guarded link to each obstacle, m, shape (J, k)."""
+        return self.links.distance
+
+    @property
+    def link_t(self) -> NDArray[np.float64]:
+        """Parameter in [0, 1] of each link's closest point, shape (J, k)."""
+        return self.links.t
 
     def min_clearance(self) -> float:
         """Smallest clearance of any guarded point or link, m (``inf`` with no obstacle)."""
-        if self.radii.shape[0] == 0:
-            return float("inf")
+        if self.points.distance.shape[0] == 0:
+            return math.inf
         return float(min(self.point_clearance.min(), self.link_clearance.min()))
 
     def probe_clearance(self) -> float:
         """Smallest clearance of the probe and its holder, m (``inf`` with no obstacle)."""
-        if self.radii.shape[0] == 0:
-            return float("inf")
+        if self.points.distance.shape[0] == 0:
+            return math.inf
         return float(min(self.point_clearance[:, -1].min(), self.link_clearance[:, -1].min()))
 
     def closest(self) -> tuple[float, str, int]:
@@ -102,31 +97,17 @@ def proximity(state: KinematicState, obstacles: ObstacleSet) -> Proximity:
     if found is not None:
         return found  # type: ignore[no-any-return]
     lz = state.guarded[:, :2]
-    s = offsets(lz, obstacles.centers, state.radius)  # (J, k+1, 2)
-    # Links [p_i, p_{i+1}] with l wrapped; closest point p̄ = p_i + t (p_{i+1} − p_i), t ∈ [0, 1].
-    seg = lz[1:] - lz[:-1]
-    seg[:, 0] = wrap(seg[:, 0], state.radius)
-    length2 = np.maximum((seg * seg).sum(axis=-1), 1e-18)  # a zero-length link gives t = 0
-    s_start = s[:, :-1]
-    t = ((s_start * seg).sum(axis=-1) / length2).clip(0.0, 1.0)
-    r = s_start - t[..., None] * seg
-    result = Proximity(
-        point_offsets=s,
-        point_distance=np.sqrt((s * s).sum(axis=-1)),
-        link_t=t,
-        link_offsets=r,
-        link_distance=np.sqrt((r * r).sum(axis=-1)),
-        radii=obstacles.radii,
-    )
+    period = 2.0 * np.pi * state.radius
+    result = Proximity(obstacles.points(lz, period), obstacles.segments(lz[:-1], lz[1:], period))
     cache[obstacles] = result
     return result
 
 
 def min_clearance(state: KinematicState, obstacles: ObstacleSet) -> float:
-    """Smallest signed clearance (m) of any body point or link to ``obstacles``.
+    """Smallest signed clearance (m) of any guarded part to ``obstacles``.
 
     Negative inside an obstacle; ``inf`` with no obstacles.
     """
     if not len(obstacles):
-        return float("inf")
+        return math.inf
     return proximity(state, obstacles).min_clearance()

@@ -2,8 +2,8 @@
 
 The guarded parts are the body points and the probe (the tool point), the body links and the
 probe holder (last body point to the tool). For a pair (part, obstacle j) with signed
-clearance ``d = ‖S_j − p‖ − R_j`` (m) below the influence distance ``d_i``, one damper row
-(see :mod:`dvqp.limits.damper`) keeps ``d ≥ d_safe``. A link row is added only where its
+clearance ``d`` (m; a circle: ``‖S_j − p‖ − R_j``) below the influence distance ``d_i``, one
+damper row (see :mod:`dvqp.limits.damper`) keeps ``d ≥ d_safe``. A link row is added only where its
 closest point is interior; at an end the point's own row holds.
 """
 
@@ -19,8 +19,6 @@ from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.proximity import link_label, point_label, proximity
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import Distances, VelocityDamper
-
-_TINY = 1e-12
 
 
 class ObstacleDamper(VelocityDamper):
@@ -65,19 +63,19 @@ class ObstacleDamper(VelocityDamper):
             return Distances(np.zeros(0), np.zeros((0, state.n)), self.margin)
         near = proximity(state, self.obstacles)
         jac = state.guarded_jacobians[:, :2, :]  # (k+1, 2, n)
-        # Points: ∇d = −(S − p)ᵀ/‖S − p‖ · ∂p/∂Q
-        dist, clearance = near.point_distance, near.point_clearance
-        pj, pi = np.nonzero((clearance < self.influence) & (dist > _TINY))
-        unit = near.point_offsets[pj, pi] / dist[pj, pi, None]  # (p, 2)
-        point_rows = (unit[:, :, None] * jac[pi]).sum(axis=1)
-        # Links: ∇d = −(S − p̄)ᵀ/‖S − p̄‖ · ((1 − t) ∂p_i + t ∂p_{i+1}), interior closest points
-        t, dist, link_clearance = near.link_t, near.link_distance, near.link_clearance
-        interior = (t > 0.0) & (t < 1.0)
-        lj, li = np.nonzero((link_clearance < self.influence) & (dist > _TINY) & interior)
-        unit = near.link_offsets[lj, li] / dist[lj, li, None]
+        points, links = near.points, near.links
+        # Points: ∇d = n · ∂p/∂Q, n the outward normal (a circle: −(S − p)/‖S − p‖)
+        usable = (points.normal != 0.0).any(axis=-1)  # no normal at a circle's centre
+        pj, pi = np.nonzero((points.distance < self.influence) & usable)
+        away = -points.normal[pj, pi]  # (p, 2)
+        point_rows = (away[:, :, None] * jac[pi]).sum(axis=1)
+        # Links: ∇d = n · ((1 − t) ∂p_i + t ∂p_{i+1}) at interior closest points
+        t = links.t
+        usable = (links.normal != 0.0).any(axis=-1) & (t > 0.0) & (t < 1.0)
+        lj, li = np.nonzero((links.distance < self.influence) & usable)
+        away = -links.normal[lj, li]
         tt = t[lj, li, None, None]
-        link_rows = (unit[:, :, None] * ((1.0 - tt) * jac[li] + tt * jac[li + 1])).sum(axis=1)
-
+        link_rows = (away[:, :, None] * ((1.0 - tt) * jac[li] + tt * jac[li + 1])).sum(axis=1)
         k = state.k
 
         def describe() -> tuple[str, ...]:
@@ -85,7 +83,7 @@ class ObstacleDamper(VelocityDamper):
             links = [f"{link_label(i, k)}/obstacle{j + 1}" for j, i in zip(lj, li, strict=True)]
             return (*points, *links)
 
-        value = np.concatenate([clearance[pj, pi], link_clearance[lj, li]])
+        value = np.concatenate([points.distance[pj, pi], links.distance[lj, li]])
         return Distances(value, -np.concatenate([point_rows, link_rows]), self.margin, describe)
 
     def all_distances(self, state: KinematicState) -> Distances:

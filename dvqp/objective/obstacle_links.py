@@ -12,15 +12,15 @@ from dvqp.objective.term import Term, per_point, point_gains
 
 
 class ObstacleLinks:
-    """``Σ_j ³w_j = Σ_j Σ_i ½ w_j k̂_i (D_ij² − R_j²)`` over the links ``[p_i, p_{i+1}]``.
+    """``Σ_j ³w_j = Σ_j Σ_i ½ w_j k̂_i e_ij`` over the links ``[p_i, p_{i+1}]``.
 
-    ``k̂_i = k¹_i`` where the closest point of link i to centre j is interior and inside the
-    circle, else 0.
+    ``e_ij`` is obstacle j's penalty at the closest point of link i (a circle:
+    ``D_ij² − R_j²``); ``k̂_i = k¹_i`` where that point is interior and inside, else 0.
 
     Parameters
     ----------
     obstacles
-        Circles in (l, z) with their weights ``w_j``.
+        Shapes in (l, z) with their weights ``w_j``.
     k_obstacle
         ``k¹``, scalar or one per body point (link i takes ``k¹_i``), >= 0.
     """
@@ -32,21 +32,21 @@ class ObstacleLinks:
         self.k_obstacle = point_gains("k_obstacle", k_obstacle)
 
     def evaluate(self, state: KinematicState) -> Term:
-        """Value and ``−Σ w k̂ (S − p̄)ᵀ ((1−t) ∂p_i + t ∂p_{i+1})`` (the ∂t term vanishes)."""
+        """Value and ``Σ w k̂ ½ ∇eᵀ ((1−t) ∂p_i + t ∂p_{i+1})`` (the ∂t term vanishes)."""
         obstacles = self.obstacles
         if not len(obstacles):
             return Term(0.0, np.zeros(state.n))
-        near = proximity(state, obstacles)
+        near = proximity(state, obstacles).links
         k = state.k  # the body links; the holder (last guarded link) is left to the dampers
-        t = near.link_t[:, : k - 1]
-        excess = near.link_distance[:, : k - 1] ** 2 - obstacles.radii[:, None] ** 2  # (J, k-1)
+        t = near.t[:, : k - 1]
+        excess = near.penalty[:, : k - 1]  # (J, k-1): e at the closest point
         active = (excess < 0.0) & (t > 0.0) & (t < 1.0)
         if not active.any():
             return Term(0.0, np.zeros(state.n))
         k1 = per_point("k_obstacle", self.k_obstacle, k)
         coef = obstacles.weights[:, None] * k1[None, :-1] * active
         value = 0.5 * float(np.sum(coef * excess))
-        a = coef[..., None] * near.link_offsets[:, : k - 1]  # (J, k-1, 2)
+        a = coef[..., None] * (-0.5 * near.penalty_gradient[:, : k - 1])  # (J, k-1, 2)
         at_points = np.zeros((k, 2))
         at_points[:-1] += (a * (1.0 - t)[..., None]).sum(axis=0)
         at_points[1:] += (a * t[..., None]).sum(axis=0)

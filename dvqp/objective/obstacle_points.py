@@ -12,12 +12,15 @@ from dvqp.objective.term import Term, per_point, point_gains
 
 
 class ObstaclePoints:
-    """``Σ_j ²w_j = Σ_j Σ_i ½ w_j k̂_i (‖S_j − p_i‖² − R_j²)``, ``k̂_i = k¹_i`` inside circle j.
+    """``Σ_j ²w_j = Σ_j Σ_i ½ w_j k̂_i e_ij``, ``k̂_i = k¹_i`` inside obstacle j, else 0.
+
+    ``e`` is the shape's penalty (:mod:`dvqp.geometry.shapes.shape`): ``‖S_j − p_i‖² − R_j²``
+    for a circle, as in the paper.
 
     Parameters
     ----------
     obstacles
-        Circles in (l, z) with their weights ``w_j``.
+        Shapes in (l, z) with their weights ``w_j``.
     k_obstacle
         ``k¹``, scalar or one per body point, >= 0.
     """
@@ -29,19 +32,20 @@ class ObstaclePoints:
         self.k_obstacle = point_gains("k_obstacle", k_obstacle)
 
     def evaluate(self, state: KinematicState) -> Term:
-        """Value and ``−Σ w k̂ (S − p)ᵀ ∂p/∂Q`` (point Jacobian rows l, z)."""
+        """Value and ``Σ w k̂ ½ ∇eᵀ ∂p/∂Q`` (point Jacobian rows l, z); a circle:
+        ``−Σ w k̂ (S − p)ᵀ ∂p/∂Q``."""
         obstacles = self.obstacles
         if not len(obstacles):
             return Term(0.0, np.zeros(state.n))
-        near = proximity(state, obstacles)
+        near = proximity(state, obstacles).points
         k = state.k  # the body points; the probe (last guarded point) is the task's
-        excess = near.point_distance[:, :k] ** 2 - obstacles.radii[:, None] ** 2  # (J, k)
+        excess = near.penalty[:, :k]  # (J, k): e, negative inside (a circle: ‖S − p‖² − R²)
         inside = excess < 0.0
         if not inside.any():
             return Term(0.0, np.zeros(state.n))
         k1 = per_point("k_obstacle", self.k_obstacle, k)
         coef = obstacles.weights[:, None] * k1[None, :] * inside
         value = 0.5 * float(np.sum(coef * excess))
-        v = (coef[..., None] * near.point_offsets[:, :k]).sum(axis=0)  # (k, 2)
+        v = (coef[..., None] * (-0.5 * near.penalty_gradient[:, :k])).sum(axis=0)  # (k, 2)
         grad = -np.einsum("kc,kcn->n", v, state.point_jacobians[:, :2, :])
         return Term(value, grad)

@@ -29,6 +29,7 @@ from dvqp.motion.jog import JogSegment
 from dvqp.motion.path import ToolPath
 from dvqp.objective import Objective
 from dvqp.resolution.spec import StepSpec
+from dvqp.scenes import obstacles as obstacle_section
 from dvqp.scenes import robot_section, start
 from dvqp.scenes import sections as sec
 from dvqp.scenes.fields import Fields
@@ -149,7 +150,7 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
     with f.guard("robot"):
         robot, q0, weights = robot_section.robot(f, doc, Path(base_dir))
     with f.guard("obstacles"):
-        obstacles = sec.obstacles(f, doc)
+        obstacles = obstacle_section.obstacles(f, doc, radius)
     with f.guard("objective"):
         objective = sec.objective(f, doc, robot.n_points, obstacles)
         level = sec.orbital_level(f, doc)
@@ -190,7 +191,7 @@ def environment(text: str, source: str = "<string>") -> Environment:
     with f.guard("objective"):
         level = sec.orbital_level(f, doc)
     with f.guard("obstacles"):
-        return Environment(radius, level, weld, sec.obstacles(f, doc))
+        return Environment(radius, level, weld, obstacle_section.obstacles(f, doc, radius))
 
 
 def _parse(f: Fields, text: str) -> dict[str, Any]:

@@ -1,8 +1,10 @@
-"""Readers of the sections of a scene file: pipe, obstacles, objective, constraints, motion.
+"""Readers of the sections of a scene file: pipe, objective, constraints, motion.
 
 Each reader takes the parsed TOML document and returns typed objects, raising
 :class:`~dvqp.errors.SceneError` through :class:`~dvqp.scenes.fields.Fields`. The keys of the
-``[constraints]`` table live on the limit classes that take them (``SCENE_KEYS``).
+``[constraints]`` table live on the limit classes that take them (``SCENE_KEYS``); the
+obstacles are read by :mod:`dvqp.scenes.obstacles`. The sane range of each number is a
+:class:`~dvqp.scenes.fields.Bound` declared here with its field (``docs/scenes.md``, Ranges).
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ import numpy as np
 
 from dvqp import _validate
 from dvqp.errors import ParameterError
-from dvqp.geometry.obstacle import Obstacle, ObstacleSet
+from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
 from dvqp.limits import (
     JointPositionLimit,
@@ -57,19 +59,6 @@ def pipe(f: Fields, doc: dict[str, Any]) -> tuple[float, float | None]:
     pipe = f.table(doc, "pipe", "", ("radius", "weld"))
     radius = f.number(pipe, "radius", "pipe", within=PIPE_RADIUS)
     return radius, f.number(pipe, "weld", "pipe", within=POSITION) if "weld" in pipe else None
-
-
-def obstacles(f: Fields, doc: dict[str, Any]) -> ObstacleSet:
-    """``[[obstacles]]``: circles in the (l, z) plane (none if absent)."""
-    out = []
-    for i, t in enumerate(f.tables(doc, "obstacles", "", ("center", "radius", "weight"))):
-        prefix = join("obstacles", i)
-        center = f.vector(t, "center", prefix, 2, within=POSITION)
-        radius = f.number(t, "radius", prefix, within=SIZE)
-        weight = f.number(t, "weight", prefix, 1.0, within=WEIGHT)
-        with f.mapped(prefix):
-            out.append(Obstacle(center, radius, weight))
-    return ObstacleSet(out)
 
 
 def orbital_level(f: Fields, doc: dict[str, Any]) -> float:

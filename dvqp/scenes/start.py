@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.errors import DvqpError
-from dvqp.geometry.obstacle import ObstacleSet, offsets
+from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
 from dvqp.scenes.fields import Fields, join
@@ -35,11 +35,12 @@ def check_start(
         if h < 0.0:
             part = "the tool" if i == robot.n_points else f"body point {i + 1}"
             f.fail("robot.q0", f"{part} (frame {frame!r}) starts inside the pipe: h = {h:.4g} m")
+    period = 2.0 * np.pi * radius
     for i, o in enumerate(obstacles):
-        d = float(np.linalg.norm(offsets(tool[None, :2], o.center[None], radius)))
-        if d < o.radius:
+        d = float(o.point_distance(tool[None, :2], period)[0][0])
+        if d < 0.0:
             f.fail(
                 join("obstacles", i),
                 f"covers the tool's start point [l, z] = [{tool[0]:.4g}, {tool[1]:.4g}] m "
-                f"(distance {d:.4g} m < radius {o.radius:g} m)",
+                f"({-d * 1e3:.3g} mm inside the {o.kind})",
             )

@@ -1,0 +1,56 @@
+"""Reader of a scene file's ``[[obstacles]]`` tables: one shape each, keys from the shape.
+
+``shape`` names the kind (default ``"circle"``, so scenes written before there were other
+shapes still read); the other keys are those the shape class declares in ``SCENE_FIELDS``, so
+a new shape needs no change here.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from dvqp.geometry.obstacle import ObstacleSet
+from dvqp.geometry.shapes import SHAPES, Shape
+from dvqp.scenes.fields import Fields, join
+from dvqp.scenes.sections import POSITION, SIZE, WEIGHT
+
+
+def obstacles(f: Fields, doc: dict[str, Any], pipe_radius: float) -> ObstacleSet:
+    """``[[obstacles]]``: shapes in the (l, z) plane (none if absent)."""
+    keys = ("shape", *dict.fromkeys(k for cls in SHAPES.values() for k in cls.SCENE_FIELDS))
+    out = []
+    for i, t in enumerate(f.tables(doc, "obstacles", "", keys)):
+        prefix = join("obstacles", i)
+        kind = f.string(t, "shape", prefix, "circle")
+        cls = SHAPES.get(kind)
+        if cls is None:
+            f.fail(join(prefix, "shape"), f"unknown shape {kind!r} (known: {', '.join(SHAPES)})")
+        f.check_keys(t, prefix, ("shape", *cls.SCENE_FIELDS))
+        out.append(_shape(f, t, prefix, cls, pipe_radius))
+    return ObstacleSet(out)
+
+
+def _shape(f: Fields, t: dict[str, Any], prefix: str, cls: type[Shape], radius: float) -> Shape:
+    values = {key: _value(f, t, prefix, key, kind, default)
+              for key, (kind, default) in cls.SCENE_FIELDS.items()}  # fmt: skip
+    with f.mapped(prefix):
+        return cls.from_scene(values, radius)
+
+
+def _value(f: Fields, t: dict[str, Any], prefix: str, key: str, kind: str, default: Any) -> Any:
+    if kind == "point":
+        return f.vector(t, key, prefix, 2, within=POSITION)
+    if kind == "interval":
+        return f.vector(t, key, prefix, 2, within=POSITION)
+    if kind == "length":
+        return f.number(t, key, prefix, within=SIZE)
+    if kind == "weight":
+        return f.number(t, key, prefix, default, within=WEIGHT)
+    raw = f.get(t, key, prefix)  # "points"
+    field = join(prefix, key)
+    if not isinstance(raw, list) or len(raw) < 3:
+        f.fail(field, "expected an array of at least 3 vertices [l, z]")
+    return np.array([f.vector_value(join(field, j), p, 2, within=POSITION)
+                     for j, p in enumerate(raw)])  # fmt: skip
