@@ -1,7 +1,8 @@
 """Limits of a configuration recomputed independently of dvqp's limit code, for the tests.
 
-Clearances come from sampling every guarded segment densely in the developed view (not from
-the closed-form closest points); heights and tilt from the frames' Cartesian positions.
+Clearances come from sampling every guarded segment densely in the developed view and taking
+the shapes' point distances there (not the closest-point computations of segments, which the
+planner uses); heights and tilt from the frames' Cartesian positions.
 """
 
 from __future__ import annotations
@@ -32,9 +33,7 @@ def clearances(scene: Scene, q: np.ndarray) -> tuple[float, float]:
         b[0] = a[0] + ((b[0] - a[0] + period / 2) % period - period / 2)
         pts = a + t[:, None] * (b - a)
         for o in scene.obstacles:
-            d = pts - o.center
-            d[:, 0] = (d[:, 0] + period / 2) % period - period / 2
-            c = float(np.sqrt((d * d).sum(axis=1)).min()) - o.radius
+            c = float(o.point_distance(pts, period)[0].min())
             best = min(best, c)
             if i == lz.shape[0] - 2:
                 probe = min(probe, c)

@@ -358,6 +358,9 @@ LONG = "[[motion.jog]]\nduration = 1500.0\nvelocity = [0.0, 0.0, 0.0, 0.0]"  # 3
               "--json", "{tmp}/c.json"]],
     ids=["plan", "compare --jobs 2"],
 )  # fmt: skip
+@pytest.mark.skipif(
+    not sys.platform.startswith("linux"), reason="workers are forked (inherit the handler) on Linux"
+)
 def test_a_real_sigint_stops_cleanly_with_exit_130(tmp_path: Path, args: list[str]) -> None:
     scene = write_scene(tmp_path, motion=LONG)
     write_scene(tmp_path, "two", motion=LONG)
@@ -422,3 +425,15 @@ def test_the_progress_bar_tells_the_time_left(monkeypatch: pytest.MonkeyPatch) -
     assert frames[0].startswith("[#######.......................] 1/4 1.5 min left steps")
     assert frames[1].startswith("[######################........] 3/4 20 s left steps")
     assert [duration(s) for s in (42, 210, 4680, 9000)] == ["42 s", "3.5 min", "78 min", "2.5 h"]
+
+
+def test_a_quiet_worker_ends_on_ctrl_c_without_a_word() -> None:
+    code = (
+        "import os, signal, time\n"
+        "from dvqp.cli.progress import quiet_worker\n"
+        "quiet_worker()\n"
+        "os.kill(os.getpid(), signal.SIGINT)\n"
+        "time.sleep(5)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert (done.returncode, done.stdout, done.stderr) == (130, "", "")

@@ -61,6 +61,25 @@ def test_the_baseline_drives_the_probe_through_the_clamp() -> None:
     assert min(safety.clearances(s, q)[1] for q in traj.q[::10]) < -0.02
 
 
+@pytest.mark.parametrize("backend", [b for b in ("daqp", "clarabel") if b in QP])
+def test_no_part_enters_an_inlet_a_band_or_a_pad(backend: str) -> None:
+    s, traj = scene("pipe-rack"), run("pipe-rack", backend)
+    assert {o.kind for o in s.obstacles} == {"inlet", "band", "polygon"}
+    assert succeeded(s, traj) and "relaxed" in set(traj.status)
+    every = [safety.clearances(s, q) for q in traj.q[::15]]
+    assert min(c for c, _ in every) >= 0.01 - 0.001
+    worst = int(np.argmin(traj.min_clearance))
+    assert traj.min_clearance[worst] == pytest.approx(
+        safety.clearances(s, traj.q[worst])[0], abs=2e-5
+    )
+
+
+def test_the_baseline_drives_the_probe_into_the_pad() -> None:
+    s, traj = scene("pipe-rack"), run("pipe-rack", "pinv")
+    assert not succeeded(s, traj)
+    assert min(safety.clearances(s, q)[1] for q in traj.q[::15]) < -0.01
+
+
 @functools.cache
 def paper_with_dt(dt: float) -> dvqp.Scene:
     text = (SCENES / "paper-two-inlets.toml").read_text(encoding="utf-8")
