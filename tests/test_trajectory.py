@@ -63,8 +63,16 @@ def test_a_failed_write_keeps_the_old_file(tmp_path: Path, monkeypatch: pytest.M
 def test_bad_targets_raise_before_writing(tmp_path: Path) -> None:
     with pytest.raises(ParameterError, match="no such directory"):
         straddling().save(tmp_path / "missing" / "t.npz")
-    with pytest.raises(DvqpError, match="not a dvqp trajectory"):
+    with pytest.raises(DvqpError, match="absent.npz: cannot read: No such file"):
         Trajectory.load(tmp_path / "absent.npz")
+
+
+def test_a_pickled_file_is_refused_without_suggesting_to_unpickle_it(tmp_path: Path) -> None:
+    bad = tmp_path / "pickled.npz"
+    np.savez(bad, t=np.array([object()], dtype=object))
+    with pytest.raises(DvqpError) as info:
+        Trajectory.load(bad)
+    assert "unsafe" not in str(info.value) and "not a dvqp trajectory" in str(info.value)
 
 
 @pytest.mark.parametrize("content", [b"", b"PK\x03\x04 not really a zip", b"plain text"])

@@ -18,6 +18,7 @@ import numpy as np
 
 import solvers
 from dvqp import load_scene, plan
+from dvqp.cli.progress import quiet_worker
 from dvqp.errors import DvqpError
 from dvqp.geometry import proximity
 from dvqp.kinematics import KinematicState
@@ -208,7 +209,7 @@ def compare(
         for path in paths:
             results[path] = run_scene(path, backends, lambda b, p=path: tick(1, f"{p} {b}"))
     else:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
+        with ProcessPoolExecutor(max_workers=jobs, initializer=quiet_worker) as pool:
             futures = {pool.submit(run_scene, path, list(backends)): path for path in paths}
             for future in as_completed(futures):
                 results[futures[future]] = future.result()

@@ -215,5 +215,10 @@ class Trajectory:
                         data["tracking_error"] if "tracking_error" in data else np.zeros((0, 4))
                     ),
                 )
-        except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile) as exc:
-            raise DvqpError(f"{path}: not a dvqp trajectory ({exc})") from exc
+        except OSError as exc:
+            reason = exc.strerror or type(exc).__name__
+            raise DvqpError(f"{path}: cannot read: {reason}") from exc
+        except (KeyError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+            # numpy's own text for pickled data suggests loading it unsafely: never pass it on
+            reason = "a missing array" if isinstance(exc, KeyError) else "not a dvqp .npz file"
+            raise DvqpError(f"{path}: not a dvqp trajectory ({reason})") from exc
