@@ -80,7 +80,7 @@ def test_plan_writes_csv_by_suffix(tmp_path: Path, capsys: pytest.CaptureFixture
     out = tmp_path / "traj.csv"
     assert main(["plan", write_scene(tmp_path), "--backend", "pinv", "-o", str(out)]) == 0
     table = np.loadtxt(out, delimiter=",", skiprows=1)
-    assert table.shape == (21, 1 + 13 + 4 + 4)
+    assert table.shape == (21, 1 + 13 + 13 + 4 + 4)  # t, q, qdot, tool, tracking error
 
 
 @pytest.mark.parametrize(

@@ -189,7 +189,8 @@ def test_a_trajectory_round_trips_through_its_file(tmp_path: Path, suffix: str) 
     table = np.loadtxt(out, delimiter=",", skiprows=1)
     header = out.read_text(encoding="utf-8").splitlines()[0].split(",")
     assert header[:2] == ["t", "q1"] and header[-5:] == ["alpha", "e_l", "e_z", "e_h", "e_alpha"]
-    expected = np.column_stack([traj.t, traj.q, traj.tool, traj.tracking_error])
+    qdot = np.vstack([traj.qdot, np.zeros((1, traj.q.shape[1]))])  # 0 after the last sample
+    expected = np.column_stack([traj.t, traj.q, qdot, traj.tool, traj.tracking_error])
     np.testing.assert_allclose(table, expected, rtol=1e-9, atol=1e-12)
 
 

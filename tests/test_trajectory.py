@@ -63,7 +63,7 @@ def test_a_failed_write_keeps_the_old_file(tmp_path: Path, monkeypatch: pytest.M
 def test_bad_targets_raise_before_writing(tmp_path: Path) -> None:
     with pytest.raises(ParameterError, match="no such directory"):
         straddling().save(tmp_path / "missing" / "t.npz")
-    with pytest.raises(DvqpError, match="absent.npz: cannot read: No such file"):
+    with pytest.raises(DvqpError, match=r"absent\.npz: cannot read: No such file"):
         Trajectory.load(tmp_path / "absent.npz")
 
 

@@ -16,7 +16,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-import solvers
 from dvqp import load_scene, plan
 from dvqp.cli.progress import quiet_worker
 from dvqp.errors import DvqpError
@@ -225,14 +224,3 @@ def machine() -> dict[str, Any]:
         "cpu_count": os.cpu_count(),
         "python": platform.python_version(),
     }
-
-
-def versions() -> dict[str, str]:
-    """Versions of dvqp, numpy, pinocchio and the QP solver packages."""
-    import pinocchio
-
-    from dvqp import __version__
-
-    out = {"dvqp": __version__, "numpy": np.__version__, "pinocchio": str(pinocchio.__version__)}
-    out.update(solvers.backend_versions())
-    return out

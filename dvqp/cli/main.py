@@ -21,6 +21,7 @@ import numpy as np
 
 from dvqp import Trajectory, __version__, load_scene, plan
 from dvqp._files import output_path
+from dvqp._versions import versions
 from dvqp.cli import compare as cmp
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
@@ -204,7 +205,7 @@ def _comparison_json(
 ) -> str:
     """The ``--json`` document: names, rows, machine and versions (no NaN: undefined is null)."""
     doc = {"backends": list(backends), "scenes": list(scenes), "results": list(rows),
-           "machine": cmp.machine(), "versions": cmp.versions()}  # fmt: skip
+           "machine": cmp.machine(), "versions": versions()}  # fmt: skip
     return json.dumps(doc, indent=2, allow_nan=False) + "\n"
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -11,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp._files import atomic_file, output_path
+from dvqp._versions import versions
 from dvqp.errors import DvqpError
 from dvqp.kinematics.developed_view import unwrap
 
@@ -33,6 +35,17 @@ ARRAYS = (
 
 DIAGNOSTICS = ("probe_clearance", "tilt", "limit_excess", "limits_kept", "substeps")
 """Arrays added in dvqp 0.2; files written before hold none of them (loaded as empty)."""
+
+CONVENTIONS = {
+    "failed_steps": (
+        "success is the mask of steps that were solved and kept every limit; a failed step "
+        "has qdot = 0 (the arm held still) and task_error = +inf (no motion was computed)"
+    ),
+    "no_obstacles": "min_clearance and probe_clearance are +inf in a scene without obstacles",
+    "units": "m, rad, s; tool = [l, z, h, alpha], l and alpha unwrapped",
+}
+"""What a reader of a trajectory file must know about its non-finite values; stored in the
+``.npz`` as ``meta``. No array ever holds NaN."""
 
 
 @dataclass(frozen=True)
@@ -164,8 +177,12 @@ class Trajectory:
     def save(self, path: str | Path) -> Path:
         """Write ``.npz`` (all arrays, metadata, scene text) or ``.csv`` atomically.
 
-        The CSV has the columns ``t, q1..qn, l, z, h, alpha`` and, if the trajectory has a
-        tracking error, ``e_l, e_z, e_h, e_alpha``.
+        The CSV has one row per sample and the columns ``t, q1..qn, qdot1..qdotn, l, z, h,
+        alpha`` and, if the trajectory has a tracking error, ``e_l, e_z, e_h, e_alpha``.
+        ``qdot`` on a row is the joint velocity applied from that sample to the next (0 on
+        the last row: the motion has ended). The ``.npz`` also holds ``meta``, a JSON text
+        with the versions of dvqp, numpy, Pinocchio and the solvers, and the file's
+        conventions (:data:`CONVENTIONS`).
 
         The file appears complete or not at all: it is written to a temporary file in the
         same folder and renamed.
@@ -181,6 +198,7 @@ class Trajectory:
                     pipe_radius=np.float64(self.pipe_radius),
                     scene=np.str_(self.scene_text),
                     tracking_error=self.tracking_error,
+                    meta=np.str_(json.dumps({"versions": versions(), **CONVENTIONS})),
                 )
             else:
                 self._write_csv(fh)
@@ -188,8 +206,10 @@ class Trajectory:
 
     def _write_csv(self, fh: object) -> None:
         n = self.q.shape[1]
-        header = ["t"] + [f"q{i + 1}" for i in range(n)] + ["l", "z", "h", "alpha"]
-        columns = [self.t, self.q, self.tool]
+        header = ["t", *(f"q{i + 1}" for i in range(n)), *(f"qdot{i + 1}" for i in range(n)),
+                  "l", "z", "h", "alpha"]  # fmt: skip
+        qdot = np.vstack([self.qdot, np.zeros((1, n))])
+        columns = [self.t, self.q, qdot, self.tool]
         if self.tracking_error.shape[0] == self.t.shape[0]:
             header += ["e_l", "e_z", "e_h", "e_alpha"]
             columns.append(self.tracking_error)
