@@ -50,11 +50,27 @@ def scene_commands(scene: Scene) -> Commands:
     """Sample a scene's JOG segments or path every ``scene.dt``."""
     tool0 = KinematicState.compute(scene.robot, scene.q0, scene.pipe_radius).tool
     if scene.path is None:
-        cmd = jog_commands(scene.jog, scene.dt)
+        cmd = jog_commands(scene.jog, scene.dt, scene.ramp)
         ref = tool0 + np.vstack([np.zeros(4), np.cumsum(cmd * scene.dt, axis=0)])
         return Commands(cmd, ref, 0.0)
-    ref = scene.path.reference(tool0, scene.dt, scene.pipe_radius)
+    ref = ramped(scene.path.reference(tool0, scene.dt, scene.pipe_radius), scene.ramp, scene.dt)
     return Commands(np.diff(ref, axis=0) / scene.dt, ref, scene.path.gain)
+
+
+def ramped(reference: NDArray[np.float64], ramp: float, dt: float) -> NDArray[np.float64]:
+    """A path reference ``(N+1, 4)`` whose start and stop take ``ramp`` seconds.
+
+    The positions are averaged over ``W = round(ramp/dt)`` samples, the first and last held
+    before and after: the velocity rises and falls linearly over ``W`` steps instead of
+    jumping, the path and its end are unchanged, and the run is ``W − 1`` steps longer.
+    """
+    window = round(ramp / dt)
+    if window <= 1:
+        return reference
+    padded = np.vstack([np.repeat(reference[:1], window - 1, axis=0), reference,
+                        np.repeat(reference[-1:], window - 1, axis=0)])  # fmt: skip
+    total = np.cumsum(np.vstack([np.zeros((1, 4)), padded]), axis=0)
+    return (total[window:] - total[:-window]) / window
 
 
 def plan(

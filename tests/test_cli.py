@@ -35,6 +35,7 @@ center = [0.20, 0.48]
 radius = {radius}
 [motion]
 dt = 0.005
+ramp = 0.0
 {motion}
 """
 JOG = "[[motion.jog]]\nduration = 0.1\nvelocity = [0.05, 0.0, 0.0, 0.0]"
@@ -146,7 +147,8 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
     captured = capsys.readouterr()
     lines = captured.out.splitlines()
     assert lines[0].split() == ["scene", "backend", "ok", "steps", "med", "us", "p95", "us", "x",
-                                "pinv", "task", "err", "clearance", "m", "closest", "excess", "q",
+                                "pinv", "task", "err", "clearance", "m", "closest", "self", "m",
+                                "qdd", "excess", "q",
                                 "viol", "rad", "qd", "viol", "rad/s", "relaxed", "split",
                                 "fails"]  # fmt: skip
     assert [line.split()[:4] for line in lines[2:6]] == [

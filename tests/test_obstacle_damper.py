@@ -59,7 +59,11 @@ def test_right_hand_side_is_the_damped_clearance_above_the_margin(
     damper = ObstacleDamper(obstacles, margin=0.01, influence=0.2, gain=0.3)
     d = damper.distances(state0)
     rows = damper.compute(state0, DT)
-    np.testing.assert_allclose(rows.h, 0.3 / DT * np.maximum(d.value - 0.01, -1e-4))
+    room = d.value - 0.01
+    geometric = 0.3 / DT * np.maximum(room, -1e-4)
+    braking = np.sqrt(2.0 * damper.deceleration * np.maximum(room, 0.0))  # 1 m/s² by default
+    np.testing.assert_allclose(rows.h, np.minimum(geometric, braking))
+    assert (braking < geometric).all()  # at 5 ms steps the braking speed binds from 0.1 mm on
     np.testing.assert_array_equal(rows.G, -d.gradient)
 
 

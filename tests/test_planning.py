@@ -35,6 +35,7 @@ radius = 0.07
 weight = 20.0
 [motion]
 dt = {dt}
+ramp = 0.0
 {motion}
 """
 

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import functools
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,19 +17,7 @@ from hypothesis import strategies as st
 import dvqp
 from dvqp.planning import final_errors
 from tests import safety
-
-SCENES = Path(__file__).resolve().parent.parent / "scenes"
-QP = [b for b in ("daqp", "clarabel", "osqp") if b in dvqp.resolution.available_resolvers()]
-
-
-@functools.cache
-def scene(name: str) -> dvqp.Scene:
-    return dvqp.load_scene(SCENES / f"{name}.toml")
-
-
-@functools.cache
-def run(name: str, backend: str) -> dvqp.Trajectory:
-    return dvqp.plan(scene(name), backend)
+from tests.runs import QP, SCENES, run, scene
 
 
 def succeeded(s: dvqp.Scene, traj: dvqp.Trajectory) -> bool:

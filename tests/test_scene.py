@@ -9,10 +9,12 @@ import pytest
 
 from dvqp import KinematicState, SceneError, load_scene, plan
 from dvqp.limits import (
+    AccelerationLimit,
     JointPositionLimit,
     JointVelocityLimit,
     ObstacleDamper,
     ProbeHeight,
+    SelfCollision,
     SurfaceHeight,
     TiltLimit,
 )
@@ -76,10 +78,12 @@ def test_a_valid_scene_becomes_typed_objects() -> None:
     np.testing.assert_array_equal(scene.obstacles[0].center, [0.20, 0.45])
     assert scene.orbital_level == ORBITAL_LEVEL and scene.objective.gain == 1.0
     assert scene.objective.terms[0].level == ORBITAL_LEVEL
-    kinds = (JointPositionLimit, JointVelocityLimit, ObstacleDamper, SurfaceHeight, ProbeHeight,
-             TiltLimit)  # fmt: skip
+    kinds = (JointPositionLimit, JointVelocityLimit, AccelerationLimit, ObstacleDamper,
+             SurfaceHeight, ProbeHeight, TiltLimit, SelfCollision)  # fmt: skip
     assert [type(limit) for limit in scene.limits] == list(kinds)
-    damper, height, probe, tilt = scene.limits[2:]
+    acceleration, damper, height, probe, tilt, self_collision = scene.limits[2:]
+    np.testing.assert_array_equal(acceleration.qdd_max, np.full(13, 10.0))
+    assert (self_collision.margin, self_collision.gain) == (0.02, 0.5)
     assert (damper.margin, damper.influence, damper.gain) == (0.01, 0.06, 0.5)
     assert (height.min_height, height.gain) == (0.0, 0.5)
     assert (probe.floor, probe.gain, tilt.min_tilt, tilt.gain) == (0.0, 0.5, 0.2, 0.5)

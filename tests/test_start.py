@@ -72,5 +72,5 @@ def test_a_start_within_an_obstacles_margin_gets_no_closer_and_is_pushed_out() -
     scene = loads(edit(text, "duration = 0.1", "duration = 1.0"), SRC)
     clearance = plan(scene, "daqp").min_clearance
     assert 0.0 < clearance[0] < 0.01  # within the 1 cm margin
-    assert np.all(np.diff(clearance) >= -1e-9)
+    assert np.all(np.diff(clearance) >= -1e-7)  # at the margin: flat to 0.1 µm
     assert clearance[-1] >= 0.01 - 1e-6

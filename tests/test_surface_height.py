@@ -17,7 +17,8 @@ def test_height_rows_are_minus_the_height_gradient(robot: Robot, q0: np.ndarray)
         lambda v: KinematicState.compute(robot, v, PIPE_RADIUS).points[:, 2], q0, 1e-7
     )
     np.testing.assert_allclose(-rows.G, fd, rtol=1e-6, atol=1e-8)
-    np.testing.assert_allclose(rows.h, 0.5 / DT * (state.points[:, 2] - 0.02))
+    room = state.points[:, 2] - 0.02
+    np.testing.assert_allclose(rows.h, np.minimum(0.5 / DT * room, np.sqrt(2.0 * room)))
     assert rows.labels == tuple(f"point{i}/height" for i in range(1, 6))
 
 
@@ -35,6 +36,9 @@ def test_damper_rhs_is_the_geometric_decay_with_a_bounded_return() -> None:
     np.testing.assert_allclose(
         damper_rhs(d, 0.01, 0.5, 0.1, 1e-4), [0.2, 0.0, -0.00025, -0.0005], atol=1e-15
     )
+    # with a braking deceleration of 0.2 m/s², 4 cm away: at most sqrt(2·0.2·0.04) = 0.126 m/s
+    capped = damper_rhs(d, 0.01, 0.5, 0.1, 1e-4, deceleration=0.2)
+    np.testing.assert_allclose(capped, [np.sqrt(0.016), 0.0, -0.00025, -0.0005], atol=1e-15)
 
 
 def test_constructor_validates_its_parameters() -> None:

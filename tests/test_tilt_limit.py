@@ -44,7 +44,7 @@ def test_tilt_is_measured_from_the_frames(robot: Robot, q0: np.ndarray) -> None:
 
 def test_the_right_hand_side_damps_toward_the_minimum_tilt(robot: Robot, q0: np.ndarray) -> None:
     state = KinematicState.compute(robot, q0, PIPE_RADIUS)
-    rows = TiltLimit(min_tilt=0.3, gain=0.4).compute(state, DT)
+    rows = TiltLimit(min_tilt=0.3, gain=0.4, deceleration=math.inf).compute(state, DT)
     expected = 0.4 / DT * (tilt_sine(state) - math.sin(0.3))
     np.testing.assert_allclose(rows.h, [expected])
 

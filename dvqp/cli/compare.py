@@ -21,6 +21,7 @@ from dvqp.cli.progress import quiet_worker
 from dvqp.errors import DvqpError
 from dvqp.geometry import proximity
 from dvqp.kinematics import KinematicState
+from dvqp.limits import self_distance
 from dvqp.planning import check_run, final_errors, worst_sample_excess
 from dvqp.resolution.registry import PINV
 
@@ -28,9 +29,10 @@ if TYPE_CHECKING:
     from dvqp import Scene, Trajectory
 
 FIELDS = (
-    "scene", "file", "backend", "success", "steps", "failures", "relaxed", "substepped",
+    "scene", "file", "backend", "success", "steps", "failures", "relaxed", "braking", "substepped",
     "median_step_us", "p95_step_us", "ratio_to_pinv", "max_task_error", "min_clearance",
-    "closest", "min_probe_clearance", "min_tilt", "max_limit_excess", "worst_limit",
+    "closest", "min_probe_clearance", "min_tilt", "min_self_distance", "closest_pair",
+    "max_joint_acceleration", "max_limit_excess", "worst_limit",
     "max_joint_limit_violation", "max_velocity_limit_violation", "final_tracking_error", "error",
 )  # fmt: skip
 """Keys of a result row, in table / CSV order."""
@@ -61,12 +63,15 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
         keeps every limit to its tolerance, and a path's end was reached
         (:func:`dvqp.planning.check_run`); ``error`` says why not. ``steps``; ``failures``
         (steps not solved or that broke a limit even in substeps); ``relaxed`` (steps whose
-        task gave way to a limit); ``substepped`` (steps split to keep a limit); median and
-        95th-percentile full step time (µs); the largest task error ``‖J̄Q̇ − ẋ‖∞`` of the
-        succeeded steps; the smallest clearance of any guarded part (m), the part and
-        obstacle that have it (``closest``), the probe's own smallest clearance (m), the
-        smallest probe tilt from radial (rad); ``max_limit_excess`` of the worst limit (in
-        its unit, see ``worst_limit``); the largest joint-limit violation (rad) of ``q`` and
+        task gave way to a limit) and ``braking`` (steps where the limits conflicted among
+        themselves and the arm slowed down toward rest); ``substepped`` (steps split to keep
+        a limit); median and 95th-percentile full step time (µs); the largest task error
+        ``‖J̄Q̇ − ẋ‖∞`` of the succeeded steps; the smallest clearance of any guarded part
+        (m) and the part and obstacle that have it (``closest``); the probe's own smallest
+        clearance (m); the smallest probe tilt from radial (rad); the smallest distance
+        between non-adjacent links (m) and that pair (``closest_pair``); the largest joint
+        acceleration (rad/s²); ``max_limit_excess`` of the worst limit (in its unit, see
+        ``worst_limit``); the largest joint-limit violation (rad) of ``q`` and
         velocity-limit violation (rad/s) of ``Q̇``; the final tracking error (m) against the
         commanded motion; ``final_tool`` ``[l, z, h, α]``. Undefined figures are None.
     """
@@ -80,6 +85,7 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
         "steps": traj.n_steps,
         "failures": int(np.sum(~ok)),
         "relaxed": int(np.sum(traj.status == "relaxed")),
+        "braking": int(np.sum(traj.status == "braking")),
         "substepped": int(np.sum(traj.substeps > 1)) if traj.substeps.size else None,
         "median_step_us": _finite(np.median(steps_us)) if traj.n_steps else None,
         "p95_step_us": _finite(np.percentile(steps_us, 95)) if traj.n_steps else None,
@@ -108,7 +114,18 @@ def _clearances(scene: Scene, traj: Trajectory) -> Row:
         if traj.probe_clearance.size
         else None,
         "min_tilt": _finite(np.min(traj.tilt)) if traj.tilt.size else None,
+        **_self_distance(scene, traj),
+        "max_joint_acceleration": _finite(np.abs(traj.qddot).max()) if traj.qddot.size else None,
     }
+
+
+def _self_distance(scene: Scene, traj: Trajectory) -> Row:
+    """``min_self_distance`` (m) and ``closest_pair`` (e.g. ``"link1/holder"``)."""
+    if not traj.self_distance.size:
+        return {"min_self_distance": None, "closest_pair": None}
+    k = int(np.argmin(traj.self_distance))
+    _, pair = self_distance(KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius))
+    return {"min_self_distance": _finite(traj.self_distance[k]), "closest_pair": pair or None}
 
 
 def _limit_figures(scene: Scene, traj: Trajectory) -> Row:

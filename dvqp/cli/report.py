@@ -23,7 +23,8 @@ TABLE = (  # (row key, header, format)
     ("steps", "steps", "{}"), ("median_step_us", "med us", "{:.0f}"),
     ("p95_step_us", "p95 us", "{:.0f}"), ("ratio_to_pinv", "x pinv", "{:.2f}"),
     ("max_task_error", "task err", "{:.1e}"), ("min_clearance", "clearance m", "{:+.4f}"),
-    ("closest", "closest", "{}"), ("max_limit_excess", "excess", "{:.2g}"),
+    ("closest", "closest", "{}"), ("min_self_distance", "self m", "{:.3f}"),
+    ("max_joint_acceleration", "qdd", "{:.3g}"), ("max_limit_excess", "excess", "{:.2g}"),
     ("max_joint_limit_violation", "q viol rad", "{:.3g}"),
     ("max_velocity_limit_violation", "qd viol rad/s", "{:.3g}"), ("relaxed", "relaxed", "{}"),
     ("substepped", "split", "{}"), ("failures", "fails", "{}"),
@@ -78,6 +79,9 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         + (f" ({row['closest']})" if row["closest"] else ""),
         f"probe           clearance {_num(row['min_probe_clearance'], '{:+.4f} m')}, "
         f"tilt from radial >= {_num(row['min_tilt'], '{:.3f} rad')}",
+        f"self distance   {_num(row['min_self_distance'], '{:.4f} m')}"
+        + (f" ({row['closest_pair']})" if row["closest_pair"] else ""),
+        f"acceleration    max |qdd| {_num(row['max_joint_acceleration'], '{:.3g} rad/s^2')}",
         f"limits          {_worst(row, bool(traj.limits_kept.all()))}",
         f"step time       median {_num(row['median_step_us'], '{:.0f}')} us, "
         f"p95 {_num(row['p95_step_us'], '{:.0f}')} us",
@@ -96,7 +100,9 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
 def _steps(row: Row) -> str:
     """``"720: 657 optimal, 63 relaxed, 0 failed; 3 split into substeps"``."""
     steps, relaxed, fails = row["steps"], row["relaxed"], row["failures"]
-    text = f"{steps}: {steps - relaxed - fails} optimal, {relaxed} relaxed, {fails} failed"
+    braking = row.get("braking") or 0
+    text = f"{steps}: {steps - relaxed - braking - fails} optimal, {relaxed} relaxed, "
+    text += f"{braking} braking, {fails} failed" if braking else f"{fails} failed"
     return text + (f"; {row['substepped']} split into substeps" if row["substepped"] else "")
 
 

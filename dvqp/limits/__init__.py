@@ -5,6 +5,7 @@ Each limit has a ``name`` and ``compute(state, dt)`` returning a :class:`Constra
 :class:`VelocityDamper`, which owns the damper's right-hand side.
 """
 
+from dvqp.limits.acceleration import DEFAULT_QDD_MAX, AccelerationLimit
 from dvqp.limits.damper import Distances, VelocityDamper, damper_rhs
 from dvqp.limits.excess import NO_EXCESS, Excess, VerifiedLimit, worst_excess
 from dvqp.limits.joint_position import JointPositionLimit
@@ -12,11 +13,14 @@ from dvqp.limits.joint_velocity import JointVelocityLimit
 from dvqp.limits.limit import Bounds, Constraint, Limit
 from dvqp.limits.obstacle_damper import ObstacleDamper
 from dvqp.limits.probe_height import ProbeHeight
+from dvqp.limits.self_collision import SelfCollision, self_distance
 from dvqp.limits.surface_height import SurfaceHeight
 from dvqp.limits.tilt import TiltLimit, tilt, tilt_cosine, tilt_sine
 
 __all__ = [
+    "DEFAULT_QDD_MAX",
     "NO_EXCESS",
+    "AccelerationLimit",
     "Bounds",
     "Constraint",
     "Distances",
@@ -26,11 +30,13 @@ __all__ = [
     "Limit",
     "ObstacleDamper",
     "ProbeHeight",
+    "SelfCollision",
     "SurfaceHeight",
     "TiltLimit",
     "VelocityDamper",
     "VerifiedLimit",
     "damper_rhs",
+    "self_distance",
     "tilt",
     "tilt_cosine",
     "tilt_sine",

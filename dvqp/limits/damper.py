@@ -16,6 +16,7 @@ escape speed the velocity limits could not give. A subclass implements
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -26,6 +27,10 @@ from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.excess import NO_EXCESS, Excess
 from dvqp.limits.limit import Constraint
+
+DEFAULT_DECELERATION = 1.0
+"""m/s²: the default braking of a damper's approach, within what the arm's joints, limited to
+10 rad/s², can give at its points (lever arms up to about 0.5 m)."""
 
 
 @dataclass(frozen=True)
@@ -56,9 +61,15 @@ def damper_rhs(
     gain: float,
     dt: float,
     depth: float,
+    deceleration: float = math.inf,
 ) -> NDArray[np.float64]:
-    """``γ/dt · max(d − d_safe, −δ)``, m/s, the right-hand side of every damper row."""
-    return gain / dt * np.maximum(distance - safe, -depth)
+    """``γ/dt · max(d − d_safe, −δ)``, capped above ``d_safe`` by the braking speed
+    ``sqrt(2 a (d − d_safe))``: m/s, the right-hand side of every damper row."""
+    room = distance - safe
+    rhs = gain / dt * np.maximum(room, -depth)
+    if math.isinf(deceleration):
+        return rhs
+    return np.minimum(rhs, np.sqrt(2.0 * deceleration * np.maximum(room, 0.0)))
 
 
 class VelocityDamper:
@@ -69,6 +80,10 @@ class VelocityDamper:
     gain
         ``γ`` in (0, 1]: the fraction of the distance to the safe value that one step may
         close.
+    deceleration
+        ``a`` (m/s², or the distance's unit per s²), > 0: the approach speed is at most
+        ``sqrt(2 a (d − d_safe))``, so a part slows down in time for joints whose accelerations
+        are limited; ``inf`` removes the cap.
     """
 
     name = "damper"
@@ -77,10 +92,13 @@ class VelocityDamper:
     tolerance = 1e-4
     """m: how far below ``min(d_safe, d at the start)`` an integrated step may end."""
 
-    def __init__(self, gain: float = 0.5) -> None:
+    def __init__(self, gain: float = 0.5, deceleration: float = DEFAULT_DECELERATION) -> None:
         if not 0.0 < float(gain) <= 1.0:
             raise ParameterError("gain", f"must be in (0, 1], got {gain!r}")
+        if not float(deceleration) > 0.0:
+            raise ParameterError("deceleration", f"must be > 0, got {deceleration!r}")
         self.gain = float(gain)
+        self.deceleration = float(deceleration)
 
     def distances(self, state: KinematicState) -> Distances:
         """The distances this damper keeps at ``state``, with their gradients (the rows)."""
@@ -100,7 +118,7 @@ class VelocityDamper:
         d = self.distances(state)
         if d.gradient is None:
             raise ValueError(f"{type(self).__name__}.distances must return gradients")
-        rhs = damper_rhs(d.value, d.safe, self.gain, dt, self.tolerance)
+        rhs = damper_rhs(d.value, d.safe, self.gain, dt, self.tolerance, self.deceleration)
         return Constraint(-d.gradient, rhs, d.describe)
 
     def excess(self, start: KinematicState, state: KinematicState) -> Excess:

@@ -18,7 +18,7 @@ from dvqp.errors import ParameterError
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.proximity import link_label, point_label, proximity
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits.damper import Distances, VelocityDamper
+from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
 
 
 class ObstacleDamper(VelocityDamper):
@@ -40,6 +40,7 @@ class ObstacleDamper(VelocityDamper):
     name = "obstacles"
     quantity = "clearance"
     SCENE_KEYS: ClassVar[dict[str, str]] = {
+        "damper_deceleration": "deceleration",
         "margin": "margin",
         "influence": "influence",
         "damper_gain": "gain",
@@ -48,9 +49,9 @@ class ObstacleDamper(VelocityDamper):
 
     def __init__(
         self, obstacles: ObstacleSet, margin: float = 0.01, influence: float = 0.06,
-        gain: float = 0.5,
+        gain: float = 0.5, deceleration: float = DEFAULT_DECELERATION,
     ) -> None:  # fmt: skip
-        super().__init__(gain)
+        super().__init__(gain, deceleration)
         self.obstacles = ObstacleSet.of(obstacles)
         self.margin = _validate.positive("margin", margin, strict=False)
         if not float(influence) > self.margin or not np.isfinite(influence):

@@ -8,7 +8,7 @@ import numpy as np
 
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits.damper import Distances, VelocityDamper
+from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
 
 
 class ProbeHeight(VelocityDamper):
@@ -27,11 +27,16 @@ class ProbeHeight(VelocityDamper):
 
     name = "probe_height"
     quantity = "height"
-    SCENE_KEYS: ClassVar[dict[str, str]] = {"damper_gain": "gain"}
+    SCENE_KEYS: ClassVar[dict[str, str]] = {
+        "damper_deceleration": "deceleration",
+        "damper_gain": "gain",
+    }
     """Keys of the scene file's ``[constraints]`` table -> constructor arguments."""
 
-    def __init__(self, floor: float = 0.0, gain: float = 0.5) -> None:
-        super().__init__(gain)
+    def __init__(
+        self, floor: float = 0.0, gain: float = 0.5, deceleration: float = DEFAULT_DECELERATION
+    ) -> None:
+        super().__init__(gain, deceleration)
         if not np.isfinite(floor):
             raise ParameterError("floor", "must be finite")
         self.floor = float(floor)

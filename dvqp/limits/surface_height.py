@@ -8,7 +8,7 @@ import numpy as np
 
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits.damper import Distances, VelocityDamper
+from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
 
 
 class SurfaceHeight(VelocityDamper):
@@ -24,11 +24,18 @@ class SurfaceHeight(VelocityDamper):
 
     name = "height"
     quantity = "height"
-    SCENE_KEYS: ClassVar[dict[str, str]] = {"min_height": "min_height", "damper_gain": "gain"}
+    SCENE_KEYS: ClassVar[dict[str, str]] = {
+        "damper_deceleration": "deceleration",
+        "min_height": "min_height",
+        "damper_gain": "gain",
+    }
     """Keys of the scene file's ``[constraints]`` table -> constructor arguments."""
 
-    def __init__(self, min_height: float = 0.0, gain: float = 0.5) -> None:
-        super().__init__(gain)
+    def __init__(
+        self, min_height: float = 0.0, gain: float = 0.5,
+        deceleration: float = DEFAULT_DECELERATION,
+    ) -> None:  # fmt: skip
+        super().__init__(gain, deceleration)
         if not np.isfinite(min_height):
             raise ParameterError("min_height", "must be finite")
         self.min_height = float(min_height)

@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits.damper import Distances, VelocityDamper
+from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
 from dvqp.limits.excess import Excess
 from dvqp.limits.limit import Constraint
 
@@ -67,11 +67,17 @@ class TiltLimit(VelocityDamper):
     quantity = "tilt"
     tolerance = 1e-3
     """rad: how far below ``min(θ_min, θ at the start)`` an integrated step may end."""
-    SCENE_KEYS: ClassVar[dict[str, str]] = {"min_tilt": "min_tilt", "damper_gain": "gain"}
+    SCENE_KEYS: ClassVar[dict[str, str]] = {
+        "damper_deceleration": "deceleration",
+        "min_tilt": "min_tilt",
+        "damper_gain": "gain",
+    }
     """Keys of the scene file's ``[constraints]`` table -> constructor arguments."""
 
-    def __init__(self, min_tilt: float = 0.2, gain: float = 0.5) -> None:
-        super().__init__(gain)
+    def __init__(
+        self, min_tilt: float = 0.2, gain: float = 0.5, deceleration: float = DEFAULT_DECELERATION
+    ) -> None:
+        super().__init__(gain, deceleration)
         if not 0.0 <= float(min_tilt) < 0.5 * math.pi:
             raise ParameterError("min_tilt", f"must be in [0, π/2) rad, got {min_tilt!r}")
         self.min_tilt = float(min_tilt)

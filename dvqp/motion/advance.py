@@ -100,9 +100,18 @@ def advance(
     return _attempt(ctx, state, dt, 0)
 
 
+def _observe(ctx: _Context, qdot: NDArray[np.float64], dt: float) -> None:
+    """Tell the limits that remember motion (acceleration) the velocity actually applied."""
+    for limit in ctx.resolver.spec.limits:
+        observe = getattr(limit, "observe", None)
+        if observe is not None:
+            observe(qdot, dt)
+
+
 def _attempt(ctx: _Context, state: KinematicState, dt: float, depth: int) -> Advance:
     step = ctx.resolver.resolve(state, ctx.command, dt)
     if not step.success:
+        _observe(ctx, np.zeros(state.n), dt)
         return Advance(state, step, 1, NO_EXCESS)
     try:
         after = KinematicState.compute(ctx.robot, state.q + dt * step.qdot, ctx.radius)
@@ -113,8 +122,10 @@ def _attempt(ctx: _Context, state: KinematicState, dt: float, depth: int) -> Adv
     else:
         broken = worst_excess(ctx.resolver.spec.limits, ctx.start, after)
         if not ctx.verify or not broken.broken:
+            _observe(ctx, step.qdot, dt)
             return Advance(after, step, 1, broken)
     if depth >= ctx.max_halvings:
+        _observe(ctx, np.zeros(state.n), dt)
         return _failed(state, step, broken, 2**depth)
     first = _attempt(ctx, state, 0.5 * dt, depth + 1)
     if not first.step.success:

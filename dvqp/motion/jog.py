@@ -14,6 +14,9 @@ from dvqp.errors import ParameterError
 MAX_STEPS = 10_000_000
 """Most steps a planned motion may take."""
 
+DEFAULT_RAMP = 0.2
+"""s: a JOG's velocity changes (its start, its end, between segments) are spread over this."""
+
 
 @dataclass(frozen=True)
 class JogSegment:
@@ -41,11 +44,26 @@ def jog_step_count(segments: Sequence[JogSegment], dt: float) -> int:
     return sum(max(1, round(s.duration / dt)) for s in segments)
 
 
-def jog_commands(segments: Sequence[JogSegment], dt: float) -> NDArray[np.float64]:
-    """Sample JOG segments every ``dt`` seconds: the commands, shape (N, 4)."""
+def jog_commands(
+    segments: Sequence[JogSegment], dt: float, ramp: float = 0.0
+) -> NDArray[np.float64]:
+    """Sample JOG segments every ``dt`` seconds: the commands, shape (N, 4).
+
+    With ``ramp > 0`` (s) the piecewise-constant commands, from rest and back to rest, are
+    averaged over a window of ``W = round(ramp/dt)`` steps: every change of velocity becomes
+    a linear ramp lasting ``W`` steps, so the commanded velocity is continuous, the motion
+    starts and ends at rest, and the total displacement is exactly that of the segments. The
+    run is ``W − 1`` steps longer.
+    """
     dt = _validate.positive("dt", dt)
     counts = [max(1, round(s.duration / dt)) for s in segments]
     if sum(counts) > MAX_STEPS:
         raise ParameterError("dt", f"{sum(counts)} steps is too many (at most {MAX_STEPS})")
     rows = [np.tile(s.velocity, (c, 1)) for s, c in zip(segments, counts, strict=True)]
-    return np.vstack(rows) if rows else np.zeros((0, 4))
+    commands = np.vstack(rows) if rows else np.zeros((0, 4))
+    window = round(_validate.positive("ramp", ramp, strict=False) / dt)
+    if window <= 1 or commands.shape[0] == 0:
+        return commands
+    pad = np.zeros((window - 1, 4))
+    total = np.cumsum(np.vstack([np.zeros((1, 4)), pad, commands, pad]), axis=0)
+    return (total[window:] - total[:-window]) / window

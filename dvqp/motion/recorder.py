@@ -10,11 +10,12 @@ from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.proximity import proximity
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.excess import Excess
+from dvqp.limits.self_collision import self_distance
 from dvqp.limits.tilt import tilt
 from dvqp.motion.advance import Advance
 from dvqp.motion.trajectory import Trajectory
 
-PER_SAMPLE = ("w", "min_clearance", "probe_clearance", "tilt", "limit_excess")
+PER_SAMPLE = ("w", "min_clearance", "probe_clearance", "tilt", "self_distance", "limit_excess")
 PER_STEP = ("solve_time", "step_time", "task_error")
 
 
@@ -58,6 +59,7 @@ class TrajectoryRecorder:
         a["limit_excess"][k] = max(excess.value, 0.0)
         a["limits_kept"][k] = not excess.broken
         a["tilt"][k] = tilt(state)
+        a["self_distance"][k] = self_distance(state)[0]
         if len(self.obstacles):
             near = proximity(state, self.obstacles)
             a["min_clearance"][k], a["probe_clearance"][k] = (
@@ -79,7 +81,11 @@ class TrajectoryRecorder:
             a["qdot"][k] = step.qdot
 
     def trajectory(self, dt: float, pipe_radius: float, backend: str) -> Trajectory:
-        """The recorded run (l and α unwrapped)."""
+        """The recorded run (l and α unwrapped), with ``qddot``: the change of joint velocity
+        at the start of each step over dt (the run starts at rest), rad/s²."""
+        qdot = self.arrays["qdot"]
+        before = np.vstack([np.zeros((1, qdot.shape[1])), qdot[:-1]])
         return Trajectory.from_samples(
-            dt=dt, pipe_radius=pipe_radius, backend=backend, status=self.status, **self.arrays
-        )
+            dt=dt, pipe_radius=pipe_radius, backend=backend, status=self.status,
+            qddot=(qdot - before) / dt, **self.arrays,
+        )  # fmt: skip

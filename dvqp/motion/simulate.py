@@ -109,6 +109,10 @@ def simulate(
     objective = resolver.spec.objective
     state = start = KinematicState.compute(robot, robot.check_q(q0, "q0"), radius)
     resolver.reset()
+    for limit in resolver.spec.limits:  # limits that remember motion start at rest
+        reset = getattr(limit, "reset", None)
+        if reset is not None:
+            reset()
     n_steps = cmd.shape[0]
     record = TrajectoryRecorder(n_steps, robot.n, robot.n_points, obstacles)
     started = time.perf_counter()

@@ -33,7 +33,8 @@ ARRAYS = (
 )
 """The arrays every trajectory file holds."""
 
-DIAGNOSTICS = ("probe_clearance", "tilt", "limit_excess", "limits_kept", "substeps")
+DIAGNOSTICS = ("probe_clearance", "tilt", "self_distance", "limit_excess", "limits_kept",
+               "substeps", "qddot")  # fmt: skip
 """Arrays added in dvqp 0.2; files written before hold none of them (loaded as empty)."""
 
 CONVENTIONS = {
@@ -103,6 +104,12 @@ class Trajectory:
         Every limit is kept at the sample to within its tolerance (0.1 mm, 1 mrad, 1 µrad).
     substeps : ndarray of int, shape (N,)
         Substeps the step was split into to keep every limit (1: not split).
+    self_distance : ndarray, shape (N+1,)
+        Smallest 3-D distance between two non-adjacent links of the arm (the probe holder
+        included), m.
+    qddot : ndarray, shape (N, n)
+        Joint acceleration at the start of each step, ``(qdot[k] − qdot[k−1]) / dt`` with the
+        run starting at rest, rad/s².
     """
 
     t: NDArray[np.float64]
@@ -127,6 +134,8 @@ class Trajectory:
     limit_excess: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     limits_kept: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
     substeps: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    self_distance: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    qddot: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 0)))
 
     @classmethod
     def from_samples(

@@ -3,7 +3,9 @@
 Each step first solves the QP with the hard tasks as equalities. If that fails (the tasks and
 the limits conflict, or the backend's answer does not pass the residual check), it solves the
 relaxed QP whose tasks carry a heavily weighted slack: the step then keeps every limit and
-reports its task error (status ``"relaxed"``). Only if that fails too is the step a failure.
+reports its task error (status ``"relaxed"``). If that fails too (the limits conflict among
+themselves), the step brakes: the velocity closest to rest within the joint bounds (status
+``"braking"``), which the exact check of the integrated motion then accepts, splits or fails.
 """
 
 from __future__ import annotations
@@ -18,7 +20,8 @@ import solvers
 from dvqp import _validate
 from dvqp.errors import BackendError
 from dvqp.kinematics.state import KinematicState
-from dvqp.resolution.qp import build_qp
+from dvqp.limits.limit import Bounds
+from dvqp.resolution.qp import StepTerms, build_qp
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Step, check_command
 
@@ -80,10 +83,23 @@ class QPResolver:
             )
             status = "relaxed"
         if not solution.found or solution.x is None:
-            elapsed = time.perf_counter() - start
-            message = f"failed: {solution.message}"
-            return Step(np.zeros(state.n), False, message, np.inf, elapsed, solution.iterations)
+            return self._brake(strict.terms, strict.bounds, solution, start)
         qdot = np.array(solution.x[: state.n])
         error = strict.terms.task_error(qdot)
         elapsed = time.perf_counter() - start
         return Step(qdot, True, status, error, elapsed, solution.iterations)
+
+    @staticmethod
+    def _brake(terms: StepTerms, box: Bounds, solution: solvers.Solution, start: float) -> Step:
+        """When even the relaxed QP has no answer (its inequalities conflict with the bounds,
+        e.g. a damper whose distance turns a corner faster than the joints may accelerate):
+        the step closest to rest inside the box, ``clip(0, lb, ub)``, the minimiser of
+        ``½ Q̇ᵀ W Q̇`` over the box. The exact check of the integrated step then decides (a
+        breach is split or fails). Status ``"braking"``; with crossed bounds, a failure."""
+        elapsed = time.perf_counter() - start
+        if np.any(box.lb > box.ub):
+            message = f"failed: {solution.message}"
+            return Step(np.zeros(box.lb.shape[0]), False, message, np.inf, elapsed,
+                        solution.iterations)  # fmt: skip
+        qdot = np.clip(0.0, box.lb, box.ub)
+        return Step(qdot, True, "braking", terms.task_error(qdot), elapsed, solution.iterations)

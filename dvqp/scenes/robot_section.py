@@ -19,7 +19,7 @@ ANGLE = Bound(-1000.0, 1000.0, "rad")
 JOINT_SPEED = Bound(0.0, 1000.0, "rad/s", strict=True)
 JOINT_WEIGHT = Bound(1e-6, 1e6)
 ROBOT_KEYS = ("model", "link_lengths", "urdf", "points", "tool", "q0", "q_min", "q_max", "qd_max",
-              "weights")  # fmt: skip
+              "qdd_max", "weights")  # fmt: skip
 MODELS = ("ndt13",)
 
 

@@ -83,6 +83,8 @@ class Scene:
         JOG segments (empty in path mode).
     path : ToolPath or None
         The path to follow (None in JOG mode).
+    ramp : float
+        s: JOG velocity changes are spread linearly over this time (0: steps).
     """
 
     name: str
@@ -101,6 +103,7 @@ class Scene:
     dt: float
     jog: tuple[JogSegment, ...] = field(repr=False)
     path: ToolPath | None = field(repr=False)
+    ramp: float = 0.0
 
     def spec(self) -> StepSpec:
         """The step of this scene: the tool's DV task, the objective, the limits, ``W``."""
@@ -157,7 +160,7 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
     with f.guard("constraints"):
         limits = sec.limits(f, doc, robot, obstacles)
     with f.guard("motion"):
-        dt, jog, path = sec.motion(f, doc)
+        dt, jog, path, ramp = sec.motion(f, doc)
     with f.guard("robot.q0"):
         start.check_start(f, robot, q0, radius, obstacles)
     stem = "scene" if source.startswith("<") else Path(source).stem
@@ -165,7 +168,7 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
         name=f.string(doc, "name", "", stem), description=f.string(doc, "description", "", ""),
         source=source, text=text, pipe_radius=radius, weld=weld, robot=robot, q0=q0,
         weights=weights, orbital_level=level, obstacles=obstacles,
-        objective=objective, limits=limits, dt=dt, jog=jog, path=path,
+        objective=objective, limits=limits, dt=dt, jog=jog, path=path, ramp=ramp,
     )  # fmt: skip
 
 

@@ -18,15 +18,18 @@ from dvqp.errors import ParameterError
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
 from dvqp.limits import (
+    DEFAULT_QDD_MAX,
+    AccelerationLimit,
     JointPositionLimit,
     JointVelocityLimit,
     Limit,
     ObstacleDamper,
     ProbeHeight,
+    SelfCollision,
     SurfaceHeight,
     TiltLimit,
 )
-from dvqp.motion.jog import MAX_STEPS, JogSegment, jog_step_count
+from dvqp.motion.jog import DEFAULT_RAMP, MAX_STEPS, JogSegment, jog_step_count
 from dvqp.motion.path import ToolPath
 from dvqp.objective import Objective
 from dvqp.scenes.fields import Bound, Fields, join
@@ -42,6 +45,8 @@ WEIGHT = Bound(0.0, 1e6)
 """A weight or gain of the objective."""
 GAIN = Bound(0.0, 1000.0, "1/s")
 DT = Bound(0.0, 1.0, "s", strict=True)
+RAMP = Bound(0.0, 10.0, "s")
+JOINT_ACCELERATION = Bound(0.0, 1e4, "rad/s²", strict=True)
 DURATION = Bound(0.0, 1e6, "s", strict=True)
 SPEED = Bound(-10.0, 10.0, "m/s")
 TURN_RATE = Bound(-10.0, 10.0, "rad/s")
@@ -49,7 +54,7 @@ TOLERANCE = Bound(0.0, 10.0, "m", strict=True)
 HEADING_TOLERANCE = Bound(0.0, 10.0, "rad", strict=True)
 OBJECTIVE_KEYS = ("orbital_level", "k_height", "k_obstacle", "gain")
 PATH_KEYS = ("waypoints", "speed", "gain", "tolerance", "heading_tolerance")
-SCENE_LIMITS = (ObstacleDamper, SurfaceHeight, ProbeHeight, TiltLimit)
+SCENE_LIMITS = (ObstacleDamper, SurfaceHeight, ProbeHeight, TiltLimit, SelfCollision)
 """The limits configured by the ``[constraints]`` table, in row order."""
 CONSTRAINT_KEYS = tuple(dict.fromkeys(key for cls in SCENE_LIMITS for key in cls.SCENE_KEYS))
 
@@ -81,13 +86,18 @@ def objective(f: Fields, doc: dict[str, Any], k: int, obstacles: ObstacleSet) ->
 def limits(
     f: Fields, doc: dict[str, Any], robot: Robot, obstacles: ObstacleSet
 ) -> tuple[Limit, ...]:
-    """Joint position and velocity limits, then ``[constraints]`` (optional): the dampers."""
+    """Joint position, velocity and acceleration limits (``[robot]``), then the dampers of
+    ``[constraints]`` (optional)."""
     t = f.table(doc, "constraints", "", CONSTRAINT_KEYS, required=False)
     values = {key: f.number(t, key, "constraints") for key in CONSTRAINT_KEYS if key in t}
     damper = _configured(f, ObstacleDamper, values, obstacles)
     height = _configured(f, SurfaceHeight, values)
     probe, tilt = _configured(f, ProbeHeight, values), _configured(f, TiltLimit, values)
-    return (JointPositionLimit(robot), JointVelocityLimit(robot), damper, height, probe, tilt)
+    arm = doc.get("robot", {})
+    qdd = f.vector(arm, "qdd_max", "robot", robot.n, scalar=True, default=DEFAULT_QDD_MAX,
+                   within=JOINT_ACCELERATION)  # fmt: skip
+    joints = (JointPositionLimit(robot), JointVelocityLimit(robot), AccelerationLimit(robot, qdd))
+    return (*joints, damper, height, probe, tilt, _configured(f, SelfCollision, values))
 
 
 def _configured(f: Fields, cls: Any, values: dict[str, float], *args: Any) -> Any:
@@ -100,17 +110,20 @@ def _configured(f: Fields, cls: Any, values: dict[str, float], *args: Any) -> An
         f.fail(join("constraints", field), exc.reason)
 
 
-def motion(f: Fields, doc: dict[str, Any]) -> tuple[float, tuple[JogSegment, ...], ToolPath | None]:
-    """``dt`` (s), and the JOG segments or the path."""
-    motion = f.table(doc, "motion", "", ("dt", "jog", "path"))
+def motion(
+    f: Fields, doc: dict[str, Any]
+) -> tuple[float, tuple[JogSegment, ...], ToolPath | None, float]:
+    """``dt`` (s), the JOG segments or the path, and the JOG ramp time (s)."""
+    motion = f.table(doc, "motion", "", ("dt", "ramp", "jog", "path"))
     dt = f.number(motion, "dt", "motion", within=DT)
+    ramp = f.number(motion, "ramp", "motion", DEFAULT_RAMP, within=RAMP)
     jog, path = _motion(f, motion)
     steps = sum(s.duration for s in jog) / dt if path is None else path.step_count(dt)
     if steps <= MAX_STEPS and path is None:  # now the exact count cannot overflow
         steps = jog_step_count(jog, dt)
     if steps > MAX_STEPS:
         f.fail("motion", f"about {steps:.3g} steps of dt: too many (at most {MAX_STEPS:.0e})")
-    return dt, jog, path
+    return dt, jog, path, ramp
 
 
 def _motion(f: Fields, motion: dict[str, Any]) -> tuple[tuple[JogSegment, ...], ToolPath | None]:

@@ -1,0 +1,79 @@
+"""Joint acceleration limits, with the braking distance that keeps the position limits reachable.
+
+``|q̈| ≤ q̈_max`` per joint becomes a box on this step's ``Q̇`` around the previous step's
+``Q̇_prev``: ``Q̇_prev − q̈_max dt ≤ Q̇ ≤ Q̇_prev + q̈_max dt``. So that a joint can always stop
+before its position limit, the box is also capped by the fastest velocity from which the joint
+still stops in time: moving ``Q̇ dt`` this step, then braking at ``q̈_max`` over
+``Q̇²/(2 q̈_max)``, must end within the limit, ``Q̇ dt + Q̇²/(2a) ≤ D`` with ``D`` the distance
+left, i.e. ``Q̇ ≤ −a dt + sqrt(a² dt² + 2 a D)`` (and the mirror bound toward ``q_min``).
+
+The limit remembers the velocity of the last step it was told about: the resolution loop
+calls :meth:`AccelerationLimit.observe` after each accepted (sub)step and
+:meth:`AccelerationLimit.reset` at the start of a run (at rest).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from dvqp import _validate
+from dvqp.errors import ParameterError
+from dvqp.kinematics.robot import Robot
+from dvqp.kinematics.state import KinematicState
+from dvqp.limits.limit import Bounds
+
+DEFAULT_QDD_MAX = 10.0
+"""rad/s²: the default joint acceleration limit of the NDT arm's drives."""
+
+
+class AccelerationLimit:
+    """``|Q̇ − Q̇_prev| ≤ q̈_max dt`` and the braking bound toward the position limits.
+
+    Parameters
+    ----------
+    robot
+        Its ``q_min``, ``q_max`` (rad) for the braking bound; shape (n,).
+    qdd_max
+        ``q̈_max``, rad/s², scalar or shape (n,), > 0.
+    """
+
+    name = "acceleration"
+
+    def __init__(self, robot: Robot, qdd_max: ArrayLike = DEFAULT_QDD_MAX) -> None:
+        a = _validate.broadcast("qdd_max", qdd_max, robot.n)
+        if np.any(a <= 0):
+            raise ParameterError("qdd_max", "must be > 0 for every joint")
+        self.qdd_max = _validate.readonly(a)
+        self.q_min, self.q_max = robot.q_min, robot.q_max
+        self._previous = np.zeros(robot.n)
+
+    @property
+    def previous(self) -> NDArray[np.float64]:
+        """The last observed joint velocity, rad/s, shape (n,)."""
+        return self._previous
+
+    def reset(self) -> None:
+        """A run starts at rest."""
+        self._previous = np.zeros_like(self._previous)
+
+    def observe(self, qdot: NDArray[np.float64], dt: float) -> None:
+        """The joint velocity (rad/s) applied over the step just taken."""
+        self._previous = np.array(qdot, dtype=np.float64)
+
+    def compute(self, state: KinematicState, dt: float) -> Bounds:
+        """The box of this step, rad/s, shape (n,) each."""
+        a = self.qdd_max
+        lb = self._previous - a * dt
+        ub = self._previous + a * dt
+        ub = np.minimum(ub, _braking(a, dt, self.q_max - state.q))
+        lb = np.maximum(lb, -_braking(a, dt, state.q - self.q_min))
+        # a joint that cannot brake in time any more keeps its position limit, not this bound
+        return Bounds(np.minimum(lb, ub), ub)
+
+
+def _braking(a: NDArray[np.float64], dt: float, room: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Fastest velocity toward a limit ``room`` (rad) away that still stops before it, rad/s."""
+    room = np.maximum(room, 0.0)
+    with np.errstate(invalid="ignore"):
+        return np.where(np.isinf(room), np.inf, -a * dt + np.sqrt((a * dt) ** 2 + 2.0 * a * room))

@@ -1,0 +1,139 @@
+"""Self-collision: non-adjacent links of the snake body kept apart, in 3-D.
+
+The guarded links are the segments between consecutive guarded points in the base frame: the
+k − 1 body links and the probe holder (last body point to the tool). Every pair of
+non-adjacent links ``(i, j)``, ``j ≥ i + 2``, keeps the distance between its segments
+``d = ‖c_i − c_j‖`` at least ``margin`` (``c_i = a_i + s (b_i − a_i)``, ``c_j`` likewise, the
+closest points; exact). With ``n = (c_i − c_j)/d`` and the frames' linear Jacobians ``J``::
+
+    ∂d/∂Q = nᵀ ((1 − s) J_{a_i} + s J_{b_i} − (1 − t) J_{a_j} − t J_{b_j})
+
+(the envelope theorem: moving the closest points along their segments does not change d to
+first order). One damper row per pair closer than ``margin + influence``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from dvqp import _validate
+from dvqp.errors import ParameterError
+from dvqp.geometry.proximity import link_label
+from dvqp.kinematics.state import KinematicState
+from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
+
+Array = NDArray[np.float64]
+
+
+def link_pairs(k: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Indices ``(i, j)`` of the non-adjacent pairs among the k guarded links (``j ≥ i + 2``)."""
+    i, j = np.triu_indices(k, 2)
+    return i.astype(np.int64), j.astype(np.int64)
+
+
+def closest_points(p1: Array, q1: Array, p2: Array, q2: Array) -> tuple[Array, Array]:
+    """Parameters ``(s, t)`` in [0, 1] of the closest points of segments ``p1→q1``, ``p2→q2``.
+
+    Vectorised over P pairs (each argument (P, 3)); Ericson's clamped solution
+    (*Real-Time Collision Detection*, 5.1.9), exact for parallel and degenerate segments too.
+    """
+    eps = 1e-18
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a, e, f = (d1 * d1).sum(-1), (d2 * d2).sum(-1), (d2 * r).sum(-1)
+    b, c = (d1 * d2).sum(-1), (d1 * r).sum(-1)
+    safe_a, safe_e = np.where(a > eps, a, 1.0), np.where(e > eps, e, 1.0)
+    denom = a * e - b * b
+    s = np.where(denom > eps * a * e, (b * f - c * e) / np.where(denom > 0, denom, 1.0), 0.0)
+    s = s.clip(0.0, 1.0)
+    t = (b * s + f) / safe_e
+    s = np.where(
+        t < 0.0,
+        (-c / safe_a).clip(0.0, 1.0),
+        np.where(t > 1.0, ((b - c) / safe_a).clip(0.0, 1.0), s),
+    )
+    t = t.clip(0.0, 1.0)
+    # degenerate segments (points)
+    s = np.where(a <= eps, 0.0, np.where(e <= eps, (-c / safe_a).clip(0.0, 1.0), s))
+    t = np.where(e <= eps, 0.0, np.where(a <= eps, (f / safe_e).clip(0.0, 1.0), t))
+    return s, t
+
+
+class SelfCollision(VelocityDamper):
+    """Keeps every pair of non-adjacent guarded links at least ``margin`` apart (3-D).
+
+    Parameters
+    ----------
+    margin
+        Smallest distance between the axes of two non-adjacent links, m, >= 0 (the links'
+        thickness plus a clearance).
+    influence
+        m, > 0: pairs farther than ``margin + influence`` add no row.
+    gain
+        ``γ`` in (0, 1].
+    """
+
+    name = "self"
+    quantity = "self distance"
+    SCENE_KEYS: ClassVar[dict[str, str]] = {
+        "damper_deceleration": "deceleration",
+        "self_margin": "margin",
+        "damper_gain": "gain",
+    }
+    """Keys of the scene file's ``[constraints]`` table -> constructor arguments."""
+
+    def __init__(
+        self, margin: float = 0.02, influence: float = 0.05, gain: float = 0.5,
+        deceleration: float = DEFAULT_DECELERATION,
+    ) -> None:  # fmt: skip
+        super().__init__(gain, deceleration)
+        self.margin = _validate.positive("margin", margin, strict=False)
+        self.influence = _validate.positive("influence", influence)
+        if not np.isfinite(self.margin):
+            raise ParameterError("margin", "must be finite")
+
+    def _geometry(self, state: KinematicState) -> tuple[Array, Array, Array, Array, Array]:
+        """Per pair: distance, unit normal, s, t, and the pair indices."""
+        o = state.origins  # (k+1, 3): the body points, then the tool
+        i, j = link_pairs(state.k)
+        a, b, c, d = o[i], o[i + 1], o[j], o[j + 1]
+        s, t = closest_points(a, b, c, d)
+        diff = (a + s[:, None] * (b - a)) - (c + t[:, None] * (d - c))
+        dist = np.sqrt((diff * diff).sum(-1))
+        normal = diff / np.maximum(dist, 1e-15)[:, None]
+        return dist, normal, s, t, np.stack([i, j])
+
+    def distances(self, state: KinematicState) -> Distances:
+        """Distances (m) of the pairs within ``margin + influence`` and their gradients."""
+        dist, normal, s, t, (i, j) = self._geometry(state)
+        near = np.flatnonzero(dist < self.margin + self.influence)
+        jv = state.frame_jacobians[:, :3, :]  # (k+1, 3, n)
+        sn, tn = s[near, None, None], t[near, None, None]
+        ii, jj = i[near], j[near]
+        moving = (1 - sn) * jv[ii] + sn * jv[ii + 1] - (1 - tn) * jv[jj] - tn * jv[jj + 1]
+        gradient = (normal[near, :, None] * moving).sum(axis=1)
+        return Distances(dist[near], gradient, self.margin, _labels(ii, jj, state.k))
+
+    def all_distances(self, state: KinematicState) -> Distances:
+        """Every non-adjacent pair's distance, m (no gradients), for verification."""
+        dist, _, _, _, (i, j) = self._geometry(state)
+        return Distances(dist, None, self.margin, _labels(i, j, state.k))
+
+
+def _labels(i: NDArray[np.int64], j: NDArray[np.int64], k: int) -> Callable[[], tuple[str, ...]]:
+    """The pairs' names, e.g. ``"link1/link3"``, ``"link2/holder"``, computed when asked."""
+    return lambda: tuple(
+        f"{link_label(a, k)}/{link_label(b, k)}" for a, b in zip(i, j, strict=True)
+    )
+
+
+def self_distance(state: KinematicState) -> tuple[float, str]:
+    """The smallest distance (m) between non-adjacent guarded links, and the pair's name."""
+    dist, _, _, _, (i, j) = SelfCollision()._geometry(state)
+    if dist.shape[0] == 0:
+        return float("inf"), ""
+    m = int(np.argmin(dist))
+    return float(dist[m]), f"{link_label(int(i[m]), state.k)}/{link_label(int(j[m]), state.k)}"
