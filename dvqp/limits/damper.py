@@ -123,10 +123,14 @@ class VelocityDamper:
 
     def excess(self, start: KinematicState, state: KinematicState) -> Excess:
         """How far ``state`` is below ``min(d_safe, d(start))``, m, for the worst distance."""
-        b, a = self.all_distances(start), self.all_distances(state)
+        floor = start.cache.get((self, "floor"))
+        if floor is None:  # the start's floors are the same at every step of a run
+            b = self.all_distances(start)
+            floor = np.minimum(b.safe, b.value)
+            start.cache[(self, "floor")] = floor
+        a = self.all_distances(state)
         if a.value.shape[0] == 0:
             return NO_EXCESS
-        floor = np.minimum(b.safe, b.value)
         over = floor - a.value
         i = int(np.argmax(over))
         label = a.describe()[i] if a.describe is not None and over[i] > 0.0 else ""

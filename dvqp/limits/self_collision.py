@@ -14,10 +14,12 @@ first order). One damper row per pair closer than ``margin + influence``.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from typing import ClassVar
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 from dvqp import _validate
@@ -29,10 +31,11 @@ from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
 Array = NDArray[np.float64]
 
 
+@functools.cache
 def link_pairs(k: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Indices ``(i, j)`` of the non-adjacent pairs among the k guarded links (``j ≥ i + 2``)."""
     i, j = np.triu_indices(k, 2)
-    return i.astype(np.int64), j.astype(np.int64)
+    return _validate.readonly(i.astype(np.int64)), _validate.readonly(j.astype(np.int64))
 
 
 def closest_points(p1: Array, q1: Array, p2: Array, q2: Array) -> tuple[Array, Array]:
@@ -60,6 +63,44 @@ def closest_points(p1: Array, q1: Array, p2: Array, q2: Array) -> tuple[Array, A
     s = np.where(a <= eps, 0.0, np.where(e <= eps, (-c / safe_a).clip(0.0, 1.0), s))
     t = np.where(e <= eps, 0.0, np.where(a <= eps, (f / safe_e).clip(0.0, 1.0), t))
     return s, t
+
+
+@njit(cache=True)
+def pair_distances(o: Array, pi: NDArray[np.int64], pj: NDArray[np.int64]):  # type: ignore[no-untyped-def]
+    """Distance, unit normal ``c_i − c_j``, ``s`` and ``t`` of the link pairs ``(pi, pj)``
+    of the chain of points ``o`` (compiled; the same algorithm as :func:`closest_points`)."""
+    p = pi.shape[0]
+    dist, normal, ss, tt = np.empty(p), np.empty((p, 3)), np.empty(p), np.empty(p)
+    eps = 1e-18
+    for m in range(p):
+        a, b, c, d = o[pi[m]], o[pi[m] + 1], o[pj[m]], o[pj[m] + 1]
+        d1, d2, r = b - a, d - c, a - c
+        aa, e, f = d1 @ d1, d2 @ d2, d2 @ r
+        if aa <= eps and e <= eps:
+            s, t = 0.0, 0.0
+        elif aa <= eps:
+            s, t = 0.0, min(max(f / e, 0.0), 1.0)
+        else:
+            cc = d1 @ r
+            if e <= eps:
+                s, t = min(max(-cc / aa, 0.0), 1.0), 0.0
+            else:
+                bb = d1 @ d2
+                denom = aa * e - bb * bb
+                s = min(max((bb * f - cc * e) / denom, 0.0), 1.0) if denom > eps * aa * e else 0.0
+                t = (bb * s + f) / e
+                if t < 0.0:
+                    s, t = min(max(-cc / aa, 0.0), 1.0), 0.0
+                elif t > 1.0:
+                    s, t = min(max((bb - cc) / aa, 0.0), 1.0), 1.0
+        diff = (a + s * d1) - (c + t * d2)
+        dist[m] = np.sqrt(diff @ diff)
+        normal[m] = diff / max(dist[m], 1e-15)
+        ss[m], tt[m] = s, t
+    return dist, normal, ss, tt
+
+
+_CACHE_KEY = "self-collision pairs"
 
 
 class SelfCollision(VelocityDamper):
@@ -95,16 +136,18 @@ class SelfCollision(VelocityDamper):
         if not np.isfinite(self.margin):
             raise ParameterError("margin", "must be finite")
 
-    def _geometry(self, state: KinematicState) -> tuple[Array, Array, Array, Array, Array]:
-        """Per pair: distance, unit normal, s, t, and the pair indices."""
-        o = state.origins  # (k+1, 3): the body points, then the tool
+    @staticmethod
+    def _geometry(state: KinematicState) -> tuple[Array, Array, Array, Array, Array]:
+        """Per pair: distance, unit normal, s, t, and the pair indices (once per state)."""
+        found = state.cache.get(_CACHE_KEY)
+        if found is not None:
+            return found  # type: ignore[no-any-return]
+        o = np.ascontiguousarray(state.origins)  # (k+1, 3): the body points, then the tool
         i, j = link_pairs(state.k)
-        a, b, c, d = o[i], o[i + 1], o[j], o[j + 1]
-        s, t = closest_points(a, b, c, d)
-        diff = (a + s[:, None] * (b - a)) - (c + t[:, None] * (d - c))
-        dist = np.sqrt((diff * diff).sum(-1))
-        normal = diff / np.maximum(dist, 1e-15)[:, None]
-        return dist, normal, s, t, np.stack([i, j])
+        dist, normal, s, t = pair_distances(o, i, j)
+        found = (dist, normal, s, t, np.stack([i, j]))
+        state.cache[_CACHE_KEY] = found
+        return found
 
     def distances(self, state: KinematicState) -> Distances:
         """Distances (m) of the pairs within ``margin + influence`` and their gradients."""
@@ -132,7 +175,7 @@ def _labels(i: NDArray[np.int64], j: NDArray[np.int64], k: int) -> Callable[[], 
 
 def self_distance(state: KinematicState) -> tuple[float, str]:
     """The smallest distance (m) between non-adjacent guarded links, and the pair's name."""
-    dist, _, _, _, (i, j) = SelfCollision()._geometry(state)
+    dist, _, _, _, (i, j) = SelfCollision._geometry(state)
     if dist.shape[0] == 0:
         return float("inf"), ""
     m = int(np.argmin(dist))

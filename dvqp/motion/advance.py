@@ -138,7 +138,8 @@ def _attempt(ctx: _Context, state: KinematicState, dt: float, depth: int) -> Adv
 
 def _failed(state: KinematicState, step: Step, broken: Excess, substeps: int) -> Advance:
     status = f"failed: {broken.describe()} in {substeps} substeps"
-    failed = Step(np.zeros(state.n), False, status, np.inf, step.solve_time, step.iterations)
+    failed = Step(np.zeros(state.n), False, status, np.inf, step.solve_time, step.iterations,
+                  step.solver_time)  # fmt: skip
     return Advance(state, failed, substeps, broken)
 
 
@@ -154,5 +155,6 @@ def _joined(start: KinematicState, first: Advance, second: Advance, dt: float) -
         task_error=max(a.task_error, b.task_error),
         solve_time=a.solve_time + b.solve_time,
         iterations=iterations,
+        solver_time=a.solver_time + b.solver_time,
     )
     return Advance(second.state, step, first.substeps + second.substeps, second.excess)

@@ -16,7 +16,7 @@ from dvqp.motion.advance import Advance
 from dvqp.motion.trajectory import Trajectory
 
 PER_SAMPLE = ("w", "min_clearance", "probe_clearance", "tilt", "self_distance", "limit_excess")
-PER_STEP = ("solve_time", "step_time", "task_error")
+PER_STEP = ("solve_time", "solver_time", "step_time", "task_error")
 
 
 class TrajectoryRecorder:
@@ -73,6 +73,7 @@ class TrajectoryRecorder:
         """Step k (from sample k to k + 1) and its full wall time, s."""
         a, step = self.arrays, advance.step
         a["solve_time"][k], a["step_time"][k] = step.solve_time, step_time
+        a["solver_time"][k] = step.solver_time
         a["task_error"][k], a["success"][k] = step.task_error, step.success
         a["iterations"][k] = -1 if step.iterations is None else step.iterations
         a["substeps"][k] = advance.substeps

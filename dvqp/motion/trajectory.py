@@ -34,7 +34,7 @@ ARRAYS = (
 """The arrays every trajectory file holds."""
 
 DIAGNOSTICS = ("probe_clearance", "tilt", "self_distance", "limit_excess", "limits_kept",
-               "substeps", "qddot")  # fmt: skip
+               "substeps", "qddot", "solver_time")  # fmt: skip
 """Arrays added in dvqp 0.2; files written before hold none of them (loaded as empty)."""
 
 CONVENTIONS = {
@@ -107,6 +107,9 @@ class Trajectory:
     self_distance : ndarray, shape (N+1,)
         Smallest 3-D distance between two non-adjacent links of the arm (the probe holder
         included), m.
+    solver_time : ndarray, shape (N,)
+        Of ``solve_time``, the time spent in the QP backend's calls (the baseline: its linear
+        algebra), s.
     qddot : ndarray, shape (N, n)
         Joint acceleration at the start of each step, ``(qdot[k] − qdot[k−1]) / dt`` with the
         run starting at rest, rad/s².
@@ -136,6 +139,7 @@ class Trajectory:
     substeps: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     self_distance: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     qddot: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 0)))
+    solver_time: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
 
     @classmethod
     def from_samples(

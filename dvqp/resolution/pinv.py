@@ -138,10 +138,12 @@ class PseudoinverseResolver:
         start = time.perf_counter()
         cmd = check_command(command)
         terms = step_terms(self.spec, state, cmd, dt)
+        solving = time.perf_counter()
         qdot = self.solve(terms)
-        elapsed = time.perf_counter() - start
+        solved = time.perf_counter()
         error = terms.task_error(qdot)
-        return Step(qdot=qdot, success=True, status="optimal", task_error=error, solve_time=elapsed)
+        elapsed = time.perf_counter() - start
+        return Step(qdot, True, "optimal", error, elapsed, solver_time=solved - solving)
 
     def solve(self, terms: StepTerms) -> NDArray[np.float64]:
         """``Q̇`` (rad/s, shape (n,)) of eq. 18 for evaluated step terms."""

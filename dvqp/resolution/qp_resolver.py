@@ -75,22 +75,24 @@ class QPResolver:
         dt = _validate.positive("dt", dt)
         strict = build_qp(self.spec, state, cmd, dt)
         solution = self._strict.solve(strict.problem)
-        status = "optimal"
+        solver_time, status = solution.solve_time, "optimal"
         if not solution.found:
             parts = (strict.terms, strict.inequalities, strict.bounds)
             solution = self._relaxed.solve(
                 build_qp(self.spec, state, cmd, dt, relax=True, parts=parts).problem
             )
-            status = "relaxed"
+            solver_time, status = solver_time + solution.solve_time, "relaxed"
         if not solution.found or solution.x is None:
-            return self._brake(strict.terms, strict.bounds, solution, start)
+            return self._brake(strict.terms, strict.bounds, solution, start, solver_time)
         qdot = np.array(solution.x[: state.n])
         error = strict.terms.task_error(qdot)
         elapsed = time.perf_counter() - start
-        return Step(qdot, True, status, error, elapsed, solution.iterations)
+        return Step(qdot, True, status, error, elapsed, solution.iterations, solver_time)
 
     @staticmethod
-    def _brake(terms: StepTerms, box: Bounds, solution: solvers.Solution, start: float) -> Step:
+    def _brake(
+        terms: StepTerms, box: Bounds, solution: solvers.Solution, start: float, spent: float
+    ) -> Step:
         """When even the relaxed QP has no answer (its inequalities conflict with the bounds,
         e.g. a damper whose distance turns a corner faster than the joints may accelerate):
         the step closest to rest inside the box, ``clip(0, lb, ub)``, the minimiser of
@@ -100,6 +102,7 @@ class QPResolver:
         if np.any(box.lb > box.ub):
             message = f"failed: {solution.message}"
             return Step(np.zeros(box.lb.shape[0]), False, message, np.inf, elapsed,
-                        solution.iterations)  # fmt: skip
+                        solution.iterations, spent)  # fmt: skip
         qdot = np.clip(0.0, box.lb, box.ub)
-        return Step(qdot, True, "braking", terms.task_error(qdot), elapsed, solution.iterations)
+        error = terms.task_error(qdot)
+        return Step(qdot, True, "braking", error, elapsed, solution.iterations, spent)

@@ -34,6 +34,9 @@ class Step:
         Wall time of the resolution (QP assembly + solve + check, or the pseudoinverse), s.
     iterations : int or None
         Solver iterations, where the backend reports them.
+    solver_time : float
+        Of ``solve_time``, the time inside the QP backend's calls (data update and solve), s;
+        for the baseline, its linear algebra.
     """
 
     qdot: NDArray[np.float64]
@@ -42,6 +45,7 @@ class Step:
     task_error: float
     solve_time: float
     iterations: int | None = None
+    solver_time: float = 0.0
 
 
 def check_command(command: ArrayLike) -> NDArray[np.float64]:
