@@ -1,4 +1,4 @@
-"""The ``dvqp`` command line: ``plan``, ``compare``, ``plot`` and ``backends``.
+"""The ``dvqp`` command line: ``plan``, ``compare``, ``plot``, ``backends`` and ``bench``.
 
 Exit codes: 0 success; 1 a run failed (failed steps, a path's end not reached, a singular
 configuration); 2 bad input (scene, backend, file names, an output that cannot be written),
@@ -94,6 +94,9 @@ def _parser() -> argparse.ArgumentParser:
     _add_plan(sub)
     _add_compare(sub)
     _add_plot(sub)
+    from dvqp.cli import bench as bench_cmd  # here: dvqp.bench imports the CLI's reports
+
+    bench_cmd.register(sub)
     b = sub.add_parser("backends", help="list the installed backends and their versions")
     b.set_defaults(run=_backends)
     return parser

@@ -1,0 +1,102 @@
+"""Run a suite of generated scenes with every backend, here or on Dask, and sum it up.
+
+:func:`run_suite` is what ``dvqp bench`` calls after its checks. Ctrl-C raises
+:class:`BenchInterrupted`, a ``KeyboardInterrupt`` that carries the suite of the scenes
+finished before it, so they can still be written.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+from dvqp.bench.dask_run import dask_client, run_dask
+from dvqp.bench.execution import Progress, Where, local_where, run_local
+from dvqp.bench.generate import BenchScene
+from dvqp.bench.output import Suite
+from dvqp.bench.runner import Job, Row
+from dvqp.bench.summary import SHIFT_US, qp_disagreement, summarize_backends
+
+
+class BenchInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a suite; ``suite`` holds the scenes finished before it."""
+
+    def __init__(self, suite: Suite) -> None:
+        super().__init__()
+        self.suite = suite
+
+
+def run_suite(
+    scenes: Sequence[BenchScene],
+    backends: Sequence[str],
+    *,
+    seed: int,
+    workers: int = 1,
+    scheduler: str | None = None,
+    progress: Progress | None = None,
+    ready: Callable[[Where], None] | None = None,
+    shift: float = SHIFT_US,
+) -> Suite:
+    """Run every scene with every backend and sum the runs up per backend.
+
+    Parameters
+    ----------
+    scenes
+        The generated scenes (:func:`dvqp.bench.generate.generate_scenes`).
+    backends
+        Resolver names, checked by the caller.
+    seed
+        The seed the scenes came from (reported).
+    workers
+        Local processes, or the workers of a Dask LocalCluster.
+    scheduler
+        None to run locally; a Dask scheduler's address, or ``"local"`` for a LocalCluster.
+    progress
+        ``progress(done, total, label)`` counting runs.
+    ready
+        Called once where the runs go is ready (a scheduler reached), before the first run.
+    shift
+        Shift of the shifted geometric means, µs.
+
+    Raises
+    ------
+    BenchInterrupted
+        Ctrl-C; it carries the suite of the finished scenes.
+    DaskUnavailableError, DvqpError
+        Dask is missing, or the scheduler cannot be reached.
+    """
+    jobs = [Job(s.index, s.name, s.text, tuple(backends)) for s in scenes]
+    rows: list[Row] = []
+    where = local_where(jobs, workers) if scheduler is None else Where("dask", 0, scheduler)
+    try:
+        if scheduler is None:
+            if ready is not None:
+                ready(where)
+            run_local(jobs, workers, rows.extend, progress)
+        else:
+            with dask_client(scheduler, workers) as (client, where):
+                if ready is not None:
+                    ready(where)
+                run_dask(client, jobs, rows.extend, progress)
+    except KeyboardInterrupt as exc:
+        suite = make_suite(rows, backends, seed, len(scenes), where, shift, interrupted=True)
+        raise BenchInterrupted(suite) from exc
+    return make_suite(rows, backends, seed, len(scenes), where, shift)
+
+
+def make_suite(
+    rows: Sequence[Row],
+    backends: Sequence[str],
+    seed: int,
+    count: int,
+    where: Where,
+    shift: float = SHIFT_US,
+    interrupted: bool = False,
+) -> Suite:
+    """The :class:`~dvqp.bench.output.Suite` of ``rows``, sorted by scene index and backend."""
+    order = {b: i for i, b in enumerate(backends)}
+    ordered = sorted(rows, key=lambda r: (r["index"], order.get(r["backend"], len(order))))
+    return Suite(
+        seed=seed, count=count, backends=tuple(backends), where=where, rows=ordered,
+        summary=summarize_backends(ordered, backends, shift),
+        disagreement=qp_disagreement(ordered), shift_us=shift, interrupted=interrupted,
+    )  # fmt: skip

@@ -1,0 +1,179 @@
+"""The bench's figures per backend: success, steps, shifted geometric means, agreement.
+
+The shifted geometric mean of times ``t_1 … t_n`` (µs) with shift ``s`` is
+``exp(mean(log(t_i + s))) − s``, as in qpbenchmark: a geometric mean (a ratio of two is the
+typical ratio of their times) that the shift keeps from being ruled by the shortest times.
+Each backend's mean is over the same scenes (those every backend ran to the end) and is also
+given relative to the best backend's (1.0 = the fastest). See ``docs/bench.md``.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from dvqp.bench.runner import Row
+from dvqp.errors import ParameterError
+from dvqp.resolution.registry import PINV
+
+SHIFT_US = 10.0
+"""Shift of the shifted geometric means of times, µs."""
+OUTCOME_KEYS = ("success", "steps", "failures", "relaxed", "substepped", "error")
+"""Figures of a run that must not depend on where it ran (with ``final_tool``)."""
+
+
+def shifted_geometric_mean(values: Sequence[float], shift: float = SHIFT_US) -> float:
+    """``exp(mean(log(v + shift))) − shift`` of non-negative ``values`` (same unit as shift).
+
+    Raises
+    ------
+    ParameterError
+        No value, a negative or non-finite value, or a shift <= 0.
+    """
+    v = np.asarray(values, dtype=float)
+    if v.size == 0 or not np.all(np.isfinite(v)) or np.any(v < 0) or not shift > 0:
+        raise ParameterError("values", "need finite values >= 0 and a shift > 0")
+    return float(np.exp(np.mean(np.log(v + shift))) - shift)
+
+
+def _max(values: Sequence[float | None]) -> float | None:
+    defined = [v for v in values if v is not None]
+    return max(defined) if defined else None
+
+
+def summarize_backends(
+    rows: Sequence[Row], backends: Sequence[str], shift: float = SHIFT_US
+) -> dict[str, dict[str, Any]]:
+    """One dict of figures per backend, in ``backends`` order (undefined figures None).
+
+    ``runs``, ``succeeded``, ``success_rate`` (0..1), ``failed_steps``, ``relaxed_steps``,
+    ``substepped_steps``, ``raised`` (runs that ended in an error, no figures);
+    ``step_time_sgm_us`` and ``solve_time_sgm_us`` (shifted geometric mean over the timed
+    scenes of each run's mean full step time and mean solver time, µs) and their ``_ratio``
+    to the best backend; ``timed_scenes``; ``worst_limit_excess`` (m or rad);
+    ``worst_task_error``; ``max_distance_to_qp_median_m`` (final tool position, m).
+    """
+    mine = {b: [r for r in rows if r["backend"] == b] for b in backends}
+    timed = _timed_scenes(rows, backends)
+    step = _sgm_column(rows, backends, timed, "mean_step_us", shift)
+    solve = _sgm_column(rows, backends, timed, "mean_solve_us", shift)
+    distance = _distance_to_qp_median(rows)
+    out = {}
+    for b in backends:
+        runs = mine[b]
+        ok = sum(1 for r in runs if r["success"])
+        out[b] = {
+            "runs": len(runs),
+            "succeeded": ok,
+            "success_rate": ok / len(runs) if runs else None,
+            "failed_steps": sum(r["failures"] or 0 for r in runs),
+            "relaxed_steps": sum(r["relaxed"] or 0 for r in runs),
+            "substepped_steps": sum(r["substepped"] or 0 for r in runs),
+            "raised": sum(1 for r in runs if r["steps"] is None),
+            "step_time_sgm_us": step[b][0],
+            "step_time_sgm_ratio": step[b][1],
+            "solve_time_sgm_us": solve[b][0],
+            "solve_time_sgm_ratio": solve[b][1],
+            "timed_scenes": len(timed),
+            "worst_limit_excess": _max([r["max_limit_excess"] for r in runs]),
+            "worst_task_error": _max([r["max_task_error"] for r in runs]),
+            "max_distance_to_qp_median_m": distance.get(b),
+        }
+    return out
+
+
+def _timed_scenes(rows: Sequence[Row], backends: Sequence[str]) -> list[str]:
+    """Scenes on which every backend has a mean step and solver time."""
+    timed: dict[str, set[str]] = {}
+    for r in rows:
+        if r["mean_step_us"] is not None and r["mean_solve_us"] is not None:
+            timed.setdefault(r["scene"], set()).add(r["backend"])
+    return sorted(s for s, have in timed.items() if have >= set(backends))
+
+
+def _sgm_column(
+    rows: Sequence[Row], backends: Sequence[str], scenes: Sequence[str], key: str, shift: float
+) -> dict[str, tuple[float | None, float | None]]:
+    """``(sgm, sgm / best sgm)`` of ``key`` per backend over ``scenes`` (None if none)."""
+    if not scenes:
+        return {b: (None, None) for b in backends}
+    wanted = set(scenes)
+    means = {
+        b: shifted_geometric_mean(
+            [r[key] for r in rows if r["backend"] == b and r["scene"] in wanted], shift
+        )
+        for b in backends
+    }
+    best = min(means.values())
+    return {b: (m, m / best if best > 0 else None) for b, m in means.items()}
+
+
+def _final_positions(rows: Sequence[Row]) -> dict[str, dict[str, np.ndarray]]:
+    """Final tool ``[l, z, h]`` (m) of the QP runs that succeeded, by scene and backend."""
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for r in rows:
+        if r["backend"] != PINV and r["success"] and r["final_tool"] is not None:
+            out.setdefault(r["scene"], {})[r["backend"]] = np.asarray(r["final_tool"][:3])
+    return out
+
+
+def qp_disagreement(rows: Sequence[Row]) -> dict[str, Any]:
+    """The largest spread of the final tool position among QP backends that succeeded.
+
+    Returns
+    -------
+    dict
+        ``max_spread_m`` (largest distance between two QP backends' final tool positions
+        ``[l, z, h]`` on one scene, m; None if no scene had two successful QP runs),
+        ``scene`` and ``backends`` (the pair), ``scenes_compared``.
+    """
+    worst: dict[str, Any] = {"max_spread_m": None, "scene": None, "backends": None}
+    compared = 0
+    for scene, finals in _final_positions(rows).items():
+        if len(finals) < 2:
+            continue
+        compared += 1
+        for (a, pa), (b, pb) in itertools.combinations(sorted(finals.items()), 2):
+            d = float(np.linalg.norm(pa - pb))
+            if worst["max_spread_m"] is None or d > worst["max_spread_m"]:
+                worst = {"max_spread_m": d, "scene": scene, "backends": [a, b]}
+    return {**worst, "scenes_compared": compared}
+
+
+def _distance_to_qp_median(rows: Sequence[Row]) -> dict[str, float]:
+    """Per backend, the largest distance (m) of a successful run's final tool position from
+    the median of the successful QP runs' on the same scene (scenes with two or more)."""
+    finals = _final_positions(rows)
+    out: dict[str, float] = {}
+    for r in rows:
+        qp = finals.get(r["scene"], {})
+        if len(qp) < 2 or not r["success"] or r["final_tool"] is None:
+            continue
+        median = np.median(np.array(list(qp.values())), axis=0)
+        d = float(np.linalg.norm(np.asarray(r["final_tool"][:3]) - median))
+        out[r["backend"]] = max(d, out.get(r["backend"], 0.0))
+    return out
+
+
+def outcome_differences(a: Sequence[Row], b: Sequence[Row], tol: float = 1e-9) -> list[str]:
+    """How two runs of the same suite differ in outcome (timings aside); empty if they agree.
+
+    Compares :data:`OUTCOME_KEYS` exactly and ``final_tool`` to ``tol`` (m, rad), per scene
+    and backend.
+    """
+    index_a = {(r["scene"], r["backend"]): r for r in a}
+    index_b = {(r["scene"], r["backend"]): r for r in b}
+    found = [f"{s} / {k}: only in one" for s, k in sorted(set(index_a) ^ set(index_b))]
+    for key in sorted(set(index_a) & set(index_b)):
+        ra, rb = index_a[key], index_b[key]
+        where = f"{key[0]} / {key[1]}"
+        found += [f"{where}: {k} {ra[k]!r} != {rb[k]!r}" for k in OUTCOME_KEYS if ra[k] != rb[k]]
+        ta, tb = ra["final_tool"], rb["final_tool"]
+        if (ta is None) != (tb is None) or (
+            ta is not None and np.max(np.abs(np.subtract(ta, tb))) > tol
+        ):
+            found.append(f"{where}: final_tool {ta} != {tb}")
+    return found

@@ -1,0 +1,192 @@
+"""``dvqp bench``: a seeded suite of random scenes run with every backend, here or on Dask.
+
+:func:`register` adds the subcommand to the ``dvqp`` parser; :func:`run` runs it. Every
+option is checked before anything runs or is written (exit 2, one line). Ctrl-C stops the
+runs; the scenes finished before it are still summed up and written (``--json``, ``--csv``),
+then the command ends as an interrupted one (exit 130). See ``docs/bench.md``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from dvqp._files import output_path
+from dvqp.bench import (
+    BenchInterrupted,
+    DaskUnavailableError,
+    Suite,
+    bench_json,
+    format_summary,
+    generate_scenes,
+    import_distributed,
+    rows_to_csv,
+    run_suite,
+    save_scenes,
+)
+from dvqp.bench.execution import Where
+from dvqp.cli.progress import ProgressBar
+from dvqp.cli.report import write_text
+from dvqp.errors import DvqpError, ParameterError
+from dvqp.resolution.registry import check_name, default_resolvers
+
+
+@dataclass(frozen=True)
+class Options:
+    """The checked options of one ``dvqp bench``.
+
+    Attributes
+    ----------
+    count, seed, workers : int
+        Scenes, their seed, local processes (or LocalCluster workers).
+    backends : tuple of str
+        Known resolver names, without repeats.
+    scheduler : str or None
+        A Dask scheduler's address, ``"local"``, or None to run locally.
+    json, csv : Path or None
+        Output files (checked writable).
+    scenes_dir : Path or None
+        Where to save the scene files (an existing folder, or one to create).
+    """
+
+    count: int
+    seed: int
+    backends: tuple[str, ...]
+    workers: int
+    scheduler: str | None
+    json: Path | None
+    csv: Path | None
+    scenes_dir: Path | None
+
+
+def register(subparsers: Any) -> argparse.ArgumentParser:
+    """Add the ``bench`` parser to ``subparsers`` (of ``dvqp``'s parser); return it."""
+    p = subparsers.add_parser(
+        "bench",
+        help="run a seeded suite of random scenes with every backend",
+        description="Generate random scenes (deterministic for a seed), run every backend on "
+        "each, print a summary per backend (see docs/bench.md).",
+    )
+    p.add_argument("--count", default="24", help="number of scenes (default: 24)")
+    p.add_argument("--seed", default="0", help="seed of the scenes, >= 0 (default: 0)")
+    p.add_argument("--backends", help="comma-separated names (default: pinv + installed)")
+    p.add_argument("--json", help="write results, summary, machine and versions as JSON")
+    p.add_argument("--csv", help="write one row per scene and backend as CSV")
+    p.add_argument("--save-scenes", metavar="DIR", help="write the scene files into DIR")
+    p.add_argument(
+        "--workers", default="1", help="local processes, or LocalCluster workers (default: 1)"
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run on a Dask scheduler (tcp://host:8786), or 'local' for a LocalCluster",
+    )
+    p.set_defaults(run=run)
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``dvqp bench``; return the exit code (0: the suite ran; bad input raises).
+
+    Raises
+    ------
+    DvqpError
+        Bad input (checked before any run): the one-line message of exit code 2.
+    KeyboardInterrupt
+        Ctrl-C, after the finished scenes were summed up and written.
+    """
+    options = check_options(args)
+    scenes = generate_scenes(options.seed, options.count)
+
+    def ready(where: Where) -> None:
+        if options.scenes_dir is not None:
+            options.scenes_dir.mkdir(exist_ok=True)
+            save_scenes(scenes, options.scenes_dir)
+
+    bar = ProgressBar(sys.stderr)
+    try:
+        try:
+            suite = run_suite(
+                scenes, options.backends, seed=options.seed, workers=options.workers,
+                scheduler=options.scheduler, progress=bar.show, ready=ready,
+            )  # fmt: skip
+        finally:
+            bar.close()
+    except BenchInterrupted as exc:
+        _report(exc.suite, options)  # what finished is still written
+        raise
+    _report(suite, options)
+    return 0
+
+
+def _report(suite: Suite, options: Options) -> None:
+    """Print the summary; write the JSON and CSV files asked for."""
+    print(format_summary(suite))
+    if options.scenes_dir is not None:
+        print(f"scene files     {options.scenes_dir}/bench-s{options.seed}-*.toml "
+              f"({options.count}; 'dvqp plan FILE' runs one)")  # fmt: skip
+    if options.json is not None:
+        write_text(options.json, bench_json(suite))
+    if options.csv is not None:
+        write_text(options.csv, rows_to_csv(suite))
+
+
+def check_options(args: argparse.Namespace) -> Options:
+    """Every option checked, nothing run or written yet.
+
+    Raises
+    ------
+    DvqpError
+        ``--count: must be an integer >= 1, got '0'``, an unknown backend, an output file
+        that cannot be written, ``--scheduler needs Dask: pip install 'dvqp[dask]'``.
+    """
+    count = _integer("--count", args.count, 1)
+    seed = _integer("--seed", args.seed, 0)
+    workers = _integer("--workers", args.workers, 1)
+    names = [b.strip() for b in args.backends.split(",")] if args.backends else None
+    backends = tuple(dict.fromkeys(check_name(b) for b in names or default_resolvers()))
+    json_out = output_path(args.json, (".json",)) if args.json else None
+    csv_out = output_path(args.csv, (".csv",)) if args.csv else None
+    scenes_dir = _scenes_dir(args.save_scenes) if args.save_scenes else None
+    if args.scheduler is not None:
+        if not args.scheduler.strip():
+            raise ParameterError("--scheduler", "expected an address or 'local'")
+        try:
+            import_distributed()
+        except DaskUnavailableError as exc:
+            raise DvqpError(f"--scheduler {exc}") from exc
+    return Options(count, seed, backends, workers, args.scheduler, json_out, csv_out, scenes_dir)
+
+
+def _integer(option: str, text: str, minimum: int) -> int:
+    """``text`` as an integer >= ``minimum``, else a ParameterError naming ``option``."""
+    try:
+        value = int(str(text).strip())
+    except ValueError:
+        value = None
+    if value is None or value < minimum:
+        raise ParameterError(option, f"must be an integer >= {minimum}, got {text!r}")
+    return value
+
+
+def _scenes_dir(text: str) -> Path:
+    """The ``--save-scenes`` folder: an existing folder, or one to create in an existing one;
+    writable either way."""
+    folder = Path(text)
+    if folder.exists() and not folder.is_dir():
+        raise ParameterError("--save-scenes", f"{folder}: not a directory")
+    where = folder if folder.is_dir() else folder.parent
+    if not where.is_dir():
+        raise ParameterError("--save-scenes", f"{where}: no such directory")
+    try:
+        with tempfile.TemporaryFile(dir=where):
+            pass
+    except OSError as exc:
+        raise ParameterError(
+            "--save-scenes", f"{where}: cannot write here ({exc.strerror})"
+        ) from exc
+    return folder
