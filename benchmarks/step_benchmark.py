@@ -1,4 +1,4 @@
-"""Per-step timing of every backend on one scene: medians, p95 and ratios, in one run.
+"""Per-step timing of every backend on one scene, pink's step as the peer: medians and ratios.
 
 Usage::
 
@@ -6,15 +6,20 @@ Usage::
 
 Each repeat runs the whole scene once per backend, in a rotated order so that drift of the
 machine's speed falls on every backend alike. A "full step" is what ``simulate`` times:
-kinematics + objective + (QP assembly + solve + check, or the pseudoinverse); "solve" is the
-resolver alone. Ratios compare medians measured in this same run. Timing is noisy on a shared
-machine: compare ratios, not absolute numbers across runs.
+kinematics, objective, the resolution and the exact check of the integrated step. "resolve" is
+the resolver alone (QP assembly + solve + residual check, or the pseudoinverse), "solver" the
+time inside the QP backend's calls, "rest" the full step less the solver. The peer line is
+pink's ``solve_ik`` (FrameTask on the tool frame, ConfigurationLimit, VelocityLimit, DAQP) on
+the same Pinocchio model, integration included (``pip install 'dvqp[bench]'``; skipped without
+it). Ratios compare medians measured in this same run. Timing is noisy on a shared machine:
+compare ratios, not absolute numbers across runs.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +29,35 @@ import solvers
 from dvqp.resolution.registry import default_resolvers
 
 ROOT = Path(__file__).resolve().parent.parent
+FIELDS = ("step_time", "solve_time", "solver_time")
+
+
+def pink_steps(scene: dvqp.Scene, steps: int) -> np.ndarray | None:
+    """Wall time (s) of ``steps`` pink steps following the tool along z, or None without pink."""
+    try:
+        import pink
+        from pink.limits import ConfigurationLimit, VelocityLimit
+        from pink.tasks import FrameTask
+    except ImportError:
+        return None
+    model = scene.robot.model.copy()
+    model.lowerPositionLimit = np.where(np.isfinite(scene.robot.q_min), scene.robot.q_min, -10.0)
+    model.upperPositionLimit = np.where(np.isfinite(scene.robot.q_max), scene.robot.q_max, 10.0)
+    model.velocityLimit = scene.robot.qd_max.copy()
+    config = pink.Configuration(model, model.createData(), scene.q0.copy())
+    frame = scene.robot.tool_frame
+    task = FrameTask(frame, position_cost=1.0, orientation_cost=1.0)
+    target = config.get_transform_frame_to_world(frame).copy()
+    limits = [ConfigurationLimit(model), VelocityLimit(model)]
+    times = np.empty(steps)
+    for k in range(steps):
+        target.translation[2] += 0.05 * scene.dt  # 5 cm/s along the pipe axis
+        task.set_target(target)
+        started = time.perf_counter()
+        v = pink.solve_ik(config, [task], scene.dt, solver="daqp", limits=limits)
+        config.integrate_inplace(v, scene.dt)
+        times[k] = time.perf_counter() - started
+    return times
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -40,35 +74,52 @@ def main(argv: list[str] | None = None) -> int:
         plain = default_resolvers()
         direct = [f"qpsolvers:{b}" for b in ("osqp", "clarabel", "daqp", "proxqp") if b in plain]
         backends = [*plain, *(b for b in direct if b in solvers.available_backends())]
-    step: dict[str, list[np.ndarray]] = {b: [] for b in backends}
-    solve: dict[str, list[np.ndarray]] = {b: [] for b in backends}
-    failures = dict.fromkeys(backends, 0)
+    got: dict[str, dict[str, list[np.ndarray]]] = {b: {f: [] for f in FIELDS} for b in backends}
+    iterations: dict[str, list[np.ndarray]] = {b: [] for b in backends}
+    peer: list[np.ndarray] = []
     for r in range(args.repeat):
         order = backends[r % len(backends) :] + backends[: r % len(backends)]
         for name in order:
             traj = dvqp.plan(scene, name)
-            step[name].append(traj.step_time[1:])  # the first step pays the solver's setup
-            solve[name].append(traj.solve_time[1:])
-            failures[name] += int(np.sum(~traj.success))
+            for f in FIELDS:
+                got[name][f].append(getattr(traj, f)[1:])  # the first step pays set-ups
+            iterations[name].append(traj.iterations[traj.iterations >= 0])
+        n_steps = traj.n_steps
+        found = pink_steps(scene, n_steps)
+        if found is not None:
+            peer.append(found[1:])
         print(f"repeat {r + 1}/{args.repeat} done", file=sys.stderr)
-    n_steps = len(step[backends[0]][0]) + 1
-    print(f"scene {scene.name}: {n_steps} steps x {args.repeat} repeats, "
-          f"{len(scene.obstacles)} obstacles")  # fmt: skip
-    med = {b: float(np.median(np.concatenate(step[b]))) * 1e6 for b in backends}
-    base = med.get("pinv")
-    header = (f"{'backend':<20} {'step med µs':>11} {'step p95 µs':>11} {'/pinv':>6} "
-              f"{'solve med µs':>12} {'qpsolvers/direct':>16} {'failed':>6}")  # fmt: skip
+    report(scene, backends, got, iterations, peer, args.repeat)
+    return 0
+
+
+def report(scene, backends, got, iterations, peer, repeat) -> None:  # type: ignore[no-untyped-def]
+    """Print the table: medians (µs) of the full step, resolver, solver and rest; ratios."""
+    med = {b: {f: float(np.median(np.concatenate(got[b][f]))) * 1e6 for f in FIELDS}
+           for b in backends}  # fmt: skip
+    pink_med = float(np.median(np.concatenate(peer))) * 1e6 if peer else None
+    base = med.get("pinv", {}).get("step_time")
+    print(f"scene {scene.name}: {len(got[backends[0]]['step_time'][0]) + 1} steps x {repeat} "
+          f"repeats, {len(scene.obstacles)} obstacles, {len(scene.limits)} limits")  # fmt: skip
+    header = (f"{'backend':<20} {'step us':>8} {'resolve':>8} {'solver':>7} {'rest':>7} "
+              f"{'iters':>5} {'/pinv':>6} {'/pink':>6} {'qpsolvers/direct':>16}")  # fmt: skip
     print(header)
     print("-" * len(header))
     for b in backends:
-        all_steps = np.concatenate(step[b]) * 1e6
-        solve_med = float(np.median(np.concatenate(solve[b]))) * 1e6
-        ratio = f"{med[b] / base:6.2f}" if base else "     -"
+        m = med[b]
+        its = np.concatenate(iterations[b]) if iterations[b] else np.zeros(0)
+        it = f"{np.median(its):5.0f}" if its.size else "    -"
+        ratio = f"{m['step_time'] / base:6.2f}" if base else "     -"
+        vs_pink = f"{m['step_time'] / pink_med:6.2f}" if pink_med else "     -"
         generic = f"qpsolvers:{b}"
-        vs = f"{med[generic] / med[b]:16.2f}" if generic in med else " " * 16
-        print(f"{b:<20} {med[b]:11.1f} {np.percentile(all_steps, 95):11.1f} {ratio} "
-              f"{solve_med:12.1f} {vs} {failures[b]:6d}")  # fmt: skip
-    return 0
+        vs = f"{med[generic]['step_time'] / m['step_time']:16.2f}" if generic in med else " " * 16
+        rest = m["step_time"] - m["solver_time"]
+        print(f"{b:<20} {m['step_time']:8.1f} {m['solve_time']:8.1f} {m['solver_time']:7.1f} "
+              f"{rest:7.1f} {it} {ratio} {vs_pink} {vs}")  # fmt: skip
+    if pink_med is not None:
+        print(f"{'pink (peer)':<20} {pink_med:8.1f}")
+    else:
+        print("pink (peer)          not installed: pip install 'dvqp[bench]'")
 
 
 if __name__ == "__main__":
