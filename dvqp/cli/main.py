@@ -1,4 +1,5 @@
-"""The ``dvqp`` command line: ``plan``, ``compare``, ``plot``, ``backends`` and ``bench``.
+"""The ``dvqp`` command line: ``plan``, ``compare``, ``plot``, ``backends``, ``bench`` and
+``console``.
 
 Exit codes: 0 success; 1 a run failed (failed steps, a path's end not reached, a singular
 configuration); 2 bad input (scene, backend, file names, an output that cannot be written),
@@ -23,6 +24,7 @@ from dvqp import Trajectory, __version__, load_scene, plan
 from dvqp._files import output_path
 from dvqp._versions import versions
 from dvqp.cli import compare as cmp
+from dvqp.cli import console as console_cli
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
 from dvqp.cli.report import format_summary, format_table, rows_to_csv, write_text
@@ -94,6 +96,7 @@ def _parser() -> argparse.ArgumentParser:
     _add_plan(sub)
     _add_compare(sub)
     _add_plot(sub)
+    console_cli.register(sub)
     from dvqp.cli import bench as bench_cmd  # here: dvqp.bench imports the CLI's reports
 
     bench_cmd.register(sub)

@@ -1,0 +1,213 @@
+"""The console's simulation: one scene, one resolver, a held JOG command, stepped on demand.
+
+:class:`ConsoleSession` is safe to share between the clock thread that calls :meth:`step`
+and the server that sets commands, resets and reads snapshots. A step is the same guarded,
+exactly verified step as ``dvqp plan`` makes (:func:`dvqp.motion.advance.advance`), from the
+scene's start and on its limits; it is computed outside the lock, so a command or a snapshot
+never waits for a solver. The resolver is touched by the stepping thread only.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from dvqp.console import protocol
+from dvqp.console.recording import Recording, Sample
+from dvqp.errors import DvqpError
+from dvqp.kinematics.state import KinematicState
+from dvqp.limits.excess import NO_EXCESS
+from dvqp.motion.advance import Advance, advance
+from dvqp.motion.trajectory import Trajectory
+from dvqp.resolution.registry import check_name, make_resolver
+from dvqp.resolution.step import Step
+from dvqp.scenes.scene import Scene
+
+
+class Ramp:
+    """The JOG command spread over ``window`` steps, as ``plan`` ramps JOG segments: the mean
+    of the last ``window`` targets, so a change of velocity becomes a linear ramp and the
+    displacement is that of the targets.
+
+    Parameters
+    ----------
+    window
+        Steps, >= 1 (1: no ramp).
+    """
+
+    def __init__(self, window: int) -> None:
+        self._ring = np.zeros((max(1, window), 4))
+        self._slot = 0
+
+    def __call__(self, target: NDArray[np.float64]) -> NDArray[np.float64]:
+        """This step's command, ``target`` held from now on."""
+        self._ring[self._slot] = target
+        self._slot = (self._slot + 1) % self._ring.shape[0]
+        return self._ring.mean(axis=0)  # type: ignore[no-any-return]
+
+    def clear(self) -> None:
+        """At rest at once."""
+        self._ring[:] = 0.0
+
+
+class ConsoleSession:
+    """A scene driven live by JOG commands.
+
+    Parameters
+    ----------
+    scene
+        The scene: its arm, start, objective, obstacles, limits and ``dt`` (its motion section
+        is not used: the operator drives; a ``ramp`` of its ``[motion]`` spreads each change
+        of the JOG over that time, as ``plan`` does).
+    backend
+        ``"pinv"`` or a QP backend name (default ``"daqp"``, as ``dvqp plan``).
+
+    Raises
+    ------
+    BackendError
+        Unknown backend.
+    """
+
+    def __init__(self, scene: Scene, backend: str = "daqp") -> None:
+        self.scene, self.backend = scene, check_name(backend)
+        self.resolver = make_resolver(backend, scene.spec())
+        self.verify = bool(getattr(self.resolver, "holds_limits", True))
+        self.start = KinematicState.compute(scene.robot, scene.q0, scene.pipe_radius)
+        self._first = self._evaluate(self.start, NO_EXCESS)
+        self._lock = threading.Lock()
+        self._generation = 0
+        self._version = self._applied = 0
+        self._ramp = Ramp(round(scene.ramp / scene.dt))
+        self.reset()
+        self.step()  # warm up the solver and the kinematics, so the first live steps are fast
+        self.reset()
+
+    def _evaluate(self, state: KinematicState, excess: Any) -> Sample:
+        return Sample.of(state, self.scene.objective, self.scene.obstacles, excess)
+
+    def reset(self) -> None:
+        """Back to the scene's start, no command, an empty record (warm starts forgotten)."""
+        with self._lock:
+            self._generation += 1
+            self._version += 1
+            self._sample = self._first
+            self._command, self._velocity = np.zeros(4), np.zeros(4)
+            self._ramp.clear()
+            self._clamped: str | None = None
+            self._step = Step(np.zeros(self.start.n), True, "optimal", 0.0, 0.0, None)
+            self._substeps, self._t, self._seq = 1, 0.0, 0
+            self._recording = Recording(self._first, self.scene.dt)
+            self._stale_resolver = True
+
+    def jog(self, velocity: ArrayLike) -> str | None:
+        """Hold the tool velocity ``[l̇, ż, ḣ, α̇]`` (clamped); return the clamping note or None."""
+        applied, note = protocol.clamp(np.asarray(velocity, dtype=np.float64))
+        with self._lock:
+            self._command, self._clamped = applied, note
+            self._version += 1
+        return note
+
+    def stop(self) -> None:
+        """Hold the tool still (zero command, reached along the ramp)."""
+        self.jog(np.zeros(4))
+
+    def halt(self) -> None:
+        """Stop at once, without a ramp, and start the next step from rest."""
+        with self._lock:
+            self._command, self._velocity, self._clamped = np.zeros(4), np.zeros(4), None
+            self._ramp.clear()
+            self._version += 1
+            self._stale_resolver = True
+
+    @property
+    def command(self) -> NDArray[np.float64]:
+        """The velocity in effect (a copy)."""
+        with self._lock:
+            return self._command.copy()
+
+    @property
+    def version(self) -> int:
+        """Counts the commands and resets so far."""
+        return self._version
+
+    @property
+    def applied(self) -> int:
+        """The :attr:`version` the last step made was computed with."""
+        return self._applied
+
+    def step(self) -> None:
+        """Advance one ``dt`` with the command in effect; a reset meanwhile discards it."""
+        with self._lock:
+            generation, before, version = self._generation, self._sample, self._version
+            stale, self._stale_resolver = self._stale_resolver, False
+            command = self._ramp(self._command)
+        if stale:
+            self._restart_resolver()
+        started = time.perf_counter()
+        moved = self._advance(before.state, command)
+        excess = moved.excess if moved.step.success else before.excess
+        after = self._evaluate(moved.state, excess)
+        took = time.perf_counter() - started
+        with self._lock:
+            if generation != self._generation:
+                return
+            self._recording.add(before, moved, after, command, took)
+            self._sample, self._step, self._substeps = after, moved.step, moved.substeps
+            self._velocity = command
+            self._t += self.scene.dt
+            self._seq += 1
+            self._applied = version
+
+    def _restart_resolver(self) -> None:
+        """Forget warm starts, and what limits that remember motion remember (as ``plan``)."""
+        self.resolver.reset()
+        for limit in self.resolver.spec.limits:
+            reset = getattr(limit, "reset", None)
+            if reset is not None:
+                reset()
+
+    def _advance(self, state: KinematicState, command: NDArray[np.float64]) -> Advance:
+        """One verified step; an error of the step (a singular configuration) fails it."""
+        scene = self.scene
+        try:
+            return advance(scene.robot, scene.pipe_radius, self.resolver, state, command,
+                           scene.dt, start=self.start, verify=self.verify)  # fmt: skip
+        except DvqpError as exc:
+            failed = Step(np.zeros(state.n), False, f"failed: {exc}", math.inf, 0.0, None)
+            return Advance(state, failed, 1, NO_EXCESS)
+
+    def snapshot(self) -> dict[str, Any]:
+        """The ``state`` message: time, tool, body points, status, clearance, task error, ...
+
+        ``status`` is ``optimal``, ``relaxed`` or ``failed: <why>``; ``min_clearance`` (m)
+        and ``task_error`` are null where undefined (no obstacle; a failed step).
+        """
+        with self._lock:
+            sample, step, t, seq = self._sample, self._step, self._t, self._seq
+            command, velocity = self._command.copy(), self._velocity.copy()
+            clamped, substeps = self._clamped, self._substeps
+            recorded = len(self._recording)
+        state = sample.state
+        return {
+            "type": "state", "t": round(t, 6), "tool": protocol.rounded(state.tool),
+            "points": protocol.rounded(state.points), "status": step.status,
+            "min_clearance": protocol.finite(sample.min_clearance),
+            "task_error": protocol.finite(step.task_error, 9), "closest": sample.closest,
+            "probe_clearance": protocol.finite(sample.probe_clearance),
+            "tilt": protocol.finite(sample.tilt), "limits_kept": not sample.excess.broken,
+            "substeps": substeps, "command": protocol.rounded(command),
+            "velocity": protocol.rounded(velocity),
+            "clamped": clamped, "seq": seq, "recorded_steps": recorded,
+        }  # fmt: skip
+
+    def trajectory(self) -> Trajectory:
+        """What was driven since the last reset (at most the last
+        :data:`~dvqp.console.recording.MAX_RECORD_SECONDS`), scene text included."""
+        with self._lock:
+            recording = self._recording.copy()
+        return recording.trajectory(self.scene.pipe_radius, self.backend, self.scene.text)
