@@ -9,6 +9,7 @@ console extra is an error, not a skip. A screenshot is kept in the test's tmp fo
 
 from __future__ import annotations
 
+import importlib
 import os
 import shutil
 import time
@@ -34,7 +35,7 @@ pytestmark = pytest.mark.skipif(
 def need(module: str, install: str) -> Any:
     """Import ``module``; skip without it, except on CI where it must be installed."""
     if os.environ.get("CI") == "true":
-        return __import__(module)
+        return importlib.import_module(module)
     return pytest.importorskip(module, reason=f"{module} is not installed: {install}")
 
 
