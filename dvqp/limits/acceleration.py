@@ -74,6 +74,5 @@ class AccelerationLimit:
 
 def _braking(a: NDArray[np.float64], dt: float, room: NDArray[np.float64]) -> NDArray[np.float64]:
     """Fastest velocity toward a limit ``room`` (rad) away that still stops before it, rad/s."""
-    room = np.maximum(room, 0.0)
-    with np.errstate(invalid="ignore"):
-        return np.where(np.isinf(room), np.inf, -a * dt + np.sqrt((a * dt) ** 2 + 2.0 * a * room))
+    # an unlimited joint: room = inf gives inf (no bound), without warnings
+    return -a * dt + np.sqrt((a * dt) ** 2 + 2.0 * a * np.maximum(room, 0.0))

@@ -23,7 +23,6 @@ from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
 from dvqp.limits.excess import Excess
 from dvqp.limits.limit import Constraint
 
-_PLANAR = np.diag([1.0, 1.0, 0.0])
 _SIN_FLOOR = 1e-9
 
 
@@ -31,10 +30,13 @@ def tilt_cosine(state: KinematicState) -> tuple[float, NDArray[np.float64]]:
     """``u = cos θ`` of the probe axis to the radial direction, and ``∂u/∂Q``, shape (n,)."""
     origin, axis, jac = state.origins[-1], state.axes[-1], state.frame_jacobians[-1]
     rho = math.hypot(origin[0], origin[1])
-    radial = np.array([origin[0] / rho, origin[1] / rho, 0.0])
-    tangential = _PLANAR - np.outer(radial, radial)
-    row = np.cross(axis, radial) @ jac[3:] + (axis @ tangential) @ jac[:3] / rho
-    return float(axis @ radial), row
+    rx, ry = origin[0] / rho, origin[1] / rho
+    ax, ay, az = axis.tolist()
+    u = ax * rx + ay * ry
+    # (a × r̂)ᵀ J_ω + aᵀ (P − r̂ r̂ᵀ) J_v / ρ, with r̂ = (rx, ry, 0)
+    cross = np.array([-az * ry, az * rx, ax * ry - ay * rx])
+    tangential = np.array([(ax - u * rx) / rho, (ay - u * ry) / rho, 0.0])
+    return u, cross @ jac[3:] + tangential @ jac[:3]
 
 
 def tilt_sine(state: KinematicState) -> float:
