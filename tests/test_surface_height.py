@@ -22,23 +22,24 @@ def test_height_rows_are_minus_the_height_gradient(robot: Robot, q0: np.ndarray)
     assert rows.labels == tuple(f"point{i}/height" for i in range(1, 6))
 
 
-def test_a_point_below_the_minimum_is_pushed_back_at_a_bounded_rate(
-    state0: KinematicState,
-) -> None:
+def test_a_point_well_below_the_minimum_may_only_not_descend(state0: KinematicState) -> None:
     above = float(state0.points[:, 2].max()) + 0.01
-    limit = SurfaceHeight(min_height=above, gain=0.5)
-    rows = limit.compute(state0, DT)
-    np.testing.assert_allclose(rows.h, -0.5 / DT * limit.tolerance)
+    rows = SurfaceHeight(min_height=above, gain=0.5).compute(state0, DT)
+    np.testing.assert_array_equal(rows.h, 0.0)
 
 
-def test_damper_rhs_is_the_geometric_decay_with_a_bounded_return() -> None:
+def test_damper_rhs_decays_brakes_pulls_small_drifts_back_and_holds_deep_starts() -> None:
     d = np.array([0.05, 0.01, 0.00995, -0.02])
+    # 4 cm above: decay; at the margin: 0; 0.05 mm below: pulled back; 3 cm below: held
     np.testing.assert_allclose(
-        damper_rhs(d, 0.01, 0.5, 0.1, 1e-4), [0.2, 0.0, -0.00025, -0.0005], atol=1e-15
+        damper_rhs(d, 0.01, 0.5, 0.1, 1e-4), [0.2, 0.0, -0.00025, 0.0], atol=1e-15
     )
-    # with a braking deceleration of 0.2 m/s², 4 cm away: at most sqrt(2·0.2·0.04) = 0.126 m/s
+    # with a deceleration of 0.2 m/s², 4 cm away: at most sqrt(2·0.2·0.04) = 0.126 m/s;
+    # the pull back no faster than 0.2 m/s² · 0.1 s
     capped = damper_rhs(d, 0.01, 0.5, 0.1, 1e-4, deceleration=0.2)
-    np.testing.assert_allclose(capped, [np.sqrt(0.016), 0.0, -0.00025, -0.0005], atol=1e-15)
+    np.testing.assert_allclose(capped, [np.sqrt(0.016), 0.0, -0.00025, 0.0], atol=1e-15)
+    slow = damper_rhs(d, 0.01, 0.5, 0.1, 1e-4, deceleration=0.001)
+    assert slow[2] == pytest.approx(-0.0001)
 
 
 def test_constructor_validates_its_parameters() -> None:

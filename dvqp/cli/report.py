@@ -73,7 +73,7 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         f"scene           {scene.name} ({scene.source}), {scene.mode} mode",
         f"backend         {traj.backend}",
         f"steps           {_steps(row)}",
-        "result          " + ("safe to send: every limit kept" if row["success"] else "NOT OK"),
+        f"result          {_result(row)}",
         f"max task error  {_num(row['max_task_error'], '{:.2e}')}",
         f"min clearance   {_num(row['min_clearance'], '{:+.4f} m')}"
         + (f" ({row['closest']})" if row["closest"] else ""),
@@ -95,6 +95,15 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
     if output is not None:
         lines.append(f"saved           {output}")
     return "\n".join(lines)
+
+
+def _result(row: Row) -> str:
+    """``safe to send`` (and how much of the task gave way), or ``NOT OK``."""
+    if not row["success"]:
+        return "NOT OK"
+    gave_way = row["relaxed"] + (row.get("braking") or 0)
+    text = "safe to send: every limit kept"
+    return text + (f"; the task gave way on {gave_way} of {row['steps']} steps" if gave_way else "")
 
 
 def _steps(row: Row) -> str:

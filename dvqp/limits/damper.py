@@ -1,17 +1,20 @@
 """Velocity dampers: the base of every limit that keeps a distance above a safe value.
 
-For a distance ``d(Q)`` (m) with safe value ``d_safe``, a damper adds the row::
+For a distance ``d(Q)`` (m) with safe value ``d_safe`` and room ``r = d − d_safe``, a damper
+adds the row ``∇d · Q̇ ≥ −rhs``, written ``−∇d · Q̇ ≤ rhs``, with::
 
-    ∇d · Q̇ ≥ −γ/dt · max(d − d_safe, −δ)      written as   −∇d · Q̇ ≤ γ/dt · max(d − d_safe, −δ)
+    rhs = min(γ r / dt, sqrt(2 a r))     r ≥ 0      decay toward d_safe, braking in time
+    rhs = max(γ r / dt, −a dt)           −δ ≤ r < 0  a drift below d_safe is pulled back
+    rhs = 0                              r < −δ     a part that starts inside: no worse
 
-Above ``d_safe``, ``d`` decays at most geometrically toward it and does not cross it at first
-order. Below it (the linearisation's second-order error, or a part that started there), the row
-asks ``d`` to come back at ``γ (d_safe − d)/dt``, capped at ``γ δ/dt``: a drift below ``d_safe``
-is corrected instead of accumulating step after step (its steady state is about ``|ε|/γ`` for a
-second-order error ``ε`` per step), and a part that starts deep inside is pushed out at a
-bounded rate (``δ`` is the damper's verification tolerance, 0.1 mm) rather than asked for an
-escape speed the velocity limits could not give. A subclass implements
-:meth:`VelocityDamper.distances`; the base owns the right-hand side.
+Above ``d_safe``, ``d`` decays at most geometrically toward it, no faster than the braking
+speed for a deceleration ``a``, and does not cross it at first order. A second-order drift of
+at most ``δ`` (the damper's verification tolerance, 0.1 mm) below it is pulled back, so it
+settles at about ``|ε|/γ`` instead of adding up step after step; the return is asked no faster
+than one step's acceleration. A part deeper inside (it started there) may not get worse, and
+no escape it might not be able to make is demanded; the objective pushes body points out of
+obstacles and toward the orbital level. A subclass implements :meth:`VelocityDamper.distances`;
+the base owns the right-hand side.
 """
 
 from __future__ import annotations
@@ -63,13 +66,19 @@ def damper_rhs(
     depth: float,
     deceleration: float = math.inf,
 ) -> NDArray[np.float64]:
-    """``γ/dt · max(d − d_safe, −δ)``, capped above ``d_safe`` by the braking speed
-    ``sqrt(2 a (d − d_safe))``: m/s, the right-hand side of every damper row."""
+    """``γ/dt · (d − d_safe)``, capped above ``d_safe`` by the braking speed
+    ``sqrt(2 a (d − d_safe))``; below it, a drift of at most ``δ`` is pulled back no faster
+    than one step's acceleration ``a·dt``, and deeper (a start inside the margin) the distance
+    may only not shrink (0): m/s, the right-hand side of every damper row."""
     room = distance - safe
-    rhs = gain / dt * np.maximum(room, -depth)
+    # a drift of at most δ below the safe value is pulled back; deeper (a start inside the
+    # margin) the distance may only not shrink: an escape it may not be able to make is not
+    # demanded
+    rhs = np.where(room < -depth, 0.0, gain / dt * room)
     if math.isinf(deceleration):
         return rhs
-    return np.minimum(rhs, np.sqrt(2.0 * deceleration * np.maximum(room, 0.0)))
+    # above: brake in time; below: ask for no faster a return than one step's acceleration
+    return np.clip(rhs, -deceleration * dt, np.sqrt(2.0 * deceleration * np.maximum(room, 0.0)))
 
 
 class VelocityDamper:
