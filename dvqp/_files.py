@@ -23,14 +23,14 @@ def output_path(path: str | Path, suffixes: Sequence[str]) -> Path:
     """
     target = Path(path)
     suffix = target.suffix.lower()
+    if target.is_dir():
+        raise ParameterError("output", f"{target}: is a directory")
     if suffix not in suffixes:
         raise ParameterError(
             "output", f"{target}: unknown format {suffix or '(none)'!r} (use {', '.join(suffixes)})"
         )
     if not target.parent.is_dir():
         raise ParameterError("output", f"{target.parent}: no such directory")
-    if target.is_dir():
-        raise ParameterError("output", f"{target}: is a directory")
     try:  # find out now, not after a long run, that the folder cannot take the file
         with tempfile.TemporaryFile(dir=target.parent):
             pass

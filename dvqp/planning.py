@@ -116,11 +116,14 @@ def plan(
     return dataclasses.replace(traj, tracking_error=error, scene_text=scene.text)
 
 
-def check_run(scene: Scene, traj: Trajectory) -> None:
+def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> None:
     """Raise if a planned run failed: steps that failed, a broken limit, a path's end missed.
 
     The path's end counts as reached when the final position error is within
     ``path.tolerance`` (m) and the heading error within ``path.heading_tolerance`` (rad).
+
+    ``limits`` are the limits given to :func:`plan` beyond the scene's own, so that a broken
+    one is named.
 
     Raises
     ------
@@ -131,13 +134,13 @@ def check_run(scene: Scene, traj: Trajectory) -> None:
     """
     where = f"{scene.source}: {traj.backend}"
     if traj.limits_kept.shape[0] and not traj.limits_kept.all():
-        worst = worst_sample_excess(scene, traj)
-        sample = int(np.argmin(traj.limits_kept)) if worst is None else worst[0]
-        detail = (
-            ""
-            if worst is None
-            else f": worst at t = {traj.t[worst[0]]:.3f} s, {worst[1].describe()}"
-        )
+        worst = worst_sample_excess(scene, traj, limits)
+        if worst is None or not worst[1].broken:  # a limit given to plan, not to check_run
+            sample = int(np.argmin(traj.limits_kept))
+            detail = f" at t = {traj.t[sample]:.3f} s (one given to plan and not named here)"
+        else:
+            sample = worst[0]
+            detail = f": worst at t = {traj.t[sample]:.3f} s, {worst[1].describe()}"
         count = int(np.sum(~traj.limits_kept))
         raise LimitViolationError(
             f"{where}: {count} of {traj.t.shape[0]} samples break a limit{detail}",
@@ -164,14 +167,16 @@ def check_run(scene: Scene, traj: Trajectory) -> None:
         )
 
 
-def worst_sample_excess(scene: Scene, traj: Trajectory) -> tuple[int, Excess] | None:
+def worst_sample_excess(
+    scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()
+) -> tuple[int, Excess] | None:
     """The sample whose limit excess is worst relative to its tolerance, and that excess.
 
     None if the trajectory has no sample or records no excess (a file from before 0.2).
     """
     if traj.limit_excess.shape[0] == 0:
         return None
-    limits = scene.spec().limits
+    every = (*scene.spec().limits, *limits)
     start = KinematicState.compute(scene.robot, traj.q[0], scene.pipe_radius)
     candidates = np.flatnonzero(traj.limit_excess > 0.0)
     if candidates.shape[0] == 0:
@@ -179,7 +184,7 @@ def worst_sample_excess(scene: Scene, traj: Trajectory) -> tuple[int, Excess] | 
     found = []
     for k in candidates[np.argsort(traj.limit_excess[candidates])[-20:]]:
         state = KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius)
-        found.append((int(k), worst_excess(limits, start, state)))
+        found.append((int(k), worst_excess(every, start, state)))
     return max(found, key=lambda item: item[1].ratio)
 
 

@@ -79,3 +79,13 @@ def test_a_user_limit_stops_the_probe_at_its_floor_and_relaxes_the_task() -> Non
     assert "relaxed" in set(limited.status) and limited.task_error.max() > 1e-3
     baseline = dvqp.plan(scene, "pinv", limits=[floor])  # the baseline holds no limit
     assert baseline.tool[-1, 2] < 0.045
+
+
+def test_a_broken_user_limit_is_named_when_it_is_passed_to_check_run() -> None:
+    floor = load("probe_floor").ProbeFloor(floor=0.07)
+    scene = jog_scene("[0.0, 0.0, -0.02, 0.0]", duration=2.0)
+    traj = dvqp.plan(scene, "pinv", limits=[floor])  # the baseline holds no limit
+    with pytest.raises(dvqp.LimitViolationError, match=r"probe/floor distance .* < 0\.07 m"):
+        dvqp.check_run(scene, traj, [floor])
+    with pytest.raises(dvqp.LimitViolationError, match="one given to plan and not named here"):
+        dvqp.check_run(scene, traj)

@@ -134,6 +134,8 @@ def _limit_figures(scene: Scene, traj: Trajectory) -> Row:
     q_out = np.maximum(robot.q_min - traj.q, traj.q - robot.q_max)
     qd_out = np.abs(traj.qdot) - robot.qd_max
     worst = worst_sample_excess(scene, traj)
+    if worst is not None and worst[1].value <= 0.0:  # kept, or a limit not in the scene
+        worst = None
     return {
         "max_limit_excess": float(worst[1].value) if worst is not None else 0.0,
         "worst_limit": (

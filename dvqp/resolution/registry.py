@@ -19,7 +19,8 @@ from dvqp.resolution.step import Resolver
 PINV = "pinv"
 """Name of the paper's pseudoinverse baseline (eq. 18)."""
 
-EXTRA_HINT = "pip install 'dvqp[solvers]' for proxqp, quadprog, piqp and highs"
+EXTRA_BACKENDS = ("proxqp", "quadprog", "piqp", "highs")
+"""The backends the extra ``dvqp[solvers]`` installs."""
 
 
 @dataclass(frozen=True)
@@ -74,9 +75,9 @@ def check_name(name: str) -> str:
     """
     known = available_resolvers()
     if name not in known:
-        raise BackendError(
-            f"unknown backend {name!r}; installed: {', '.join(known)} ({EXTRA_HINT})"
-        )
+        missing = [b for b in EXTRA_BACKENDS if b not in known]
+        hint = f" (pip install 'dvqp[solvers]' for {', '.join(missing)})" if missing else ""
+        raise BackendError(f"unknown backend {name!r}; installed: {', '.join(known)}{hint}")
     return name
 
 

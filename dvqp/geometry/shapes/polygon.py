@@ -44,6 +44,8 @@ class Polygon(Shape):
         v = np.asarray(self.vertices, dtype=np.float64)
         if v.ndim != 2 or v.shape[1] != 2:
             raise ShapeError("vertices", (-1, 2), v.shape)
+        if v.shape[0] > 3 and np.array_equal(v[0], v[-1]):  # written closed: drop the repeat
+            v = v[:-1]
         _check_simple(v)
         object.__setattr__(self, "vertices", _validate.readonly(v))
         object.__setattr__(self, "weight", _validate.positive("weight", self.weight, strict=False))
@@ -55,8 +57,18 @@ class Polygon(Shape):
 
     @classmethod
     def from_scene(cls, values: dict[str, Any], pipe_radius: float) -> Polygon:
-        """From a scene file's ``[[obstacles]]`` table (keys :attr:`SCENE_FIELDS`)."""
-        return cls(values["vertices"], values["weight"])
+        """From a scene file's ``[[obstacles]]`` table (keys :attr:`SCENE_FIELDS`).
+
+        Every vertex must lie within half the circumference of the vertices' mean l: a wider
+        polygon would wrap onto itself around the pipe.
+        """
+        shape = cls(values["vertices"], values["weight"])
+        half = np.pi * pipe_radius
+        if np.abs(shape.local_vertices[:, 0]).max() >= half:
+            raise ParameterError(
+                "vertices", f"spans more than the pipe's circumference (2πR = {2 * half:.4g} m)"
+            )
+        return shape
 
     @property
     def size(self) -> float:
@@ -92,6 +104,9 @@ def _check_simple(v: Array) -> None:
         raise ParameterError("vertices", f"need at least 3 vertices, got {v.shape[0]}")
     if not np.isfinite(v).all():
         raise ParameterError("vertices", "must be finite")
+    repeated = np.flatnonzero((v == np.roll(v, 1, axis=0)).all(axis=1))
+    if repeated.size:
+        raise ParameterError("vertices", f"vertex {int(repeated[0])} repeats the one before it")
     if geo.self_intersects(v):
         raise ParameterError("vertices", "the polygon's edges cross (it must be simple)")
     if abs(geo.signed_area(v)) < 1e-10:
