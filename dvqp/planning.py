@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from dvqp.errors import LimitViolationError, UnreachableTargetError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits import Excess, Limit, worst_excess
-from dvqp.motion.jog import jog_commands
+from dvqp.motion.jog import box_average, jog_commands
 from dvqp.motion.simulate import dv_error, simulate
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.registry import make_resolver
@@ -69,8 +69,7 @@ def ramped(reference: NDArray[np.float64], ramp: float, dt: float) -> NDArray[np
         return reference
     padded = np.vstack([np.repeat(reference[:1], window - 1, axis=0), reference,
                         np.repeat(reference[-1:], window - 1, axis=0)])  # fmt: skip
-    total = np.cumsum(np.vstack([np.zeros((1, 4)), padded]), axis=0)
-    return (total[window:] - total[:-window]) / window
+    return box_average(padded, window)
 
 
 def plan(

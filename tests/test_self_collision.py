@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from dvqp import KinematicState, Robot
 from dvqp.errors import ParameterError
 from dvqp.limits import SelfCollision, self_distance
-from dvqp.limits.self_collision import closest_points, link_pairs
+from dvqp.limits.self_collision import link_pairs, pair_distances
 from tests.common import PIPE_RADIUS, central_difference, random_configurations
 
 DT = 0.01
@@ -20,8 +20,10 @@ def test_closest_points_are_no_farther_than_any_pair_of_samples(seed: int, paral
     rng = np.random.default_rng(seed)
     p1, q1, p2 = (rng.normal(size=(1, 3)) for _ in range(3))
     q2 = p2 + 0.7 * (q1 - p1) if parallel else rng.normal(size=(1, 3))
-    s, t = closest_points(p1, q1, p2, q2)
+    chain = np.vstack([p1, q1, p2, q2])  # segments 0 → 1 and 2 → 3
+    dist, _, s, t = pair_distances(chain, np.array([0]), np.array([2]))
     best = np.linalg.norm((p1 + s[:, None] * (q1 - p1)) - (p2 + t[:, None] * (q2 - p2)))
+    assert dist[0] == pytest.approx(best, abs=1e-12)
     g = np.linspace(0, 1, 301)[:, None]
     a, b = p1 + g * (q1 - p1), p2 + g * (q2 - p2)
     brute = np.sqrt(((a[:, None] - b[None]) ** 2).sum(-1)).min()

@@ -54,16 +54,16 @@ class ObstacleSet:
 
     def points(self, lz: np.ndarray, period: float) -> ShapeDistances:
         """Every obstacle against m points ``lz`` (m, 2): arrays (J, m, ...)."""
-        return self._gather([cls.batch_points(shapes, lz, period) for cls, shapes in self._groups])
+        parts = [cls.batch_points(shapes, lz, period) for cls, shapes in self._groups]
+        return self._gather(parts, lz.shape[0])
 
     def segments(self, a: np.ndarray, b: np.ndarray, period: float) -> ShapeDistances:
         """Every obstacle against m segments ``a → b`` (each (m, 2))."""
         parts = [cls.batch_segments(shapes, a, b, period) for cls, shapes in self._groups]
-        return self._gather(parts)
+        return self._gather(parts, a.shape[0])
 
-    def _gather(self, parts: list[ShapeDistances]) -> ShapeDistances:
+    def _gather(self, parts: list[ShapeDistances], m: int) -> ShapeDistances:
         if not parts:
-            m = 0
             return ShapeDistances(np.zeros((0, m)), np.zeros((0, m, 2)), np.zeros((0, m)),
                              np.zeros((0, m, 2)), np.zeros((0, m)))  # fmt: skip
         found = parts[0] if len(parts) == 1 else ShapeDistances.stack(parts)

@@ -38,37 +38,13 @@ def link_pairs(k: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     return _validate.readonly(i.astype(np.int64)), _validate.readonly(j.astype(np.int64))
 
 
-def closest_points(p1: Array, q1: Array, p2: Array, q2: Array) -> tuple[Array, Array]:
-    """Parameters ``(s, t)`` in [0, 1] of the closest points of segments ``p1→q1``, ``p2→q2``.
-
-    Vectorised over P pairs (each argument (P, 3)); Ericson's clamped solution
-    (*Real-Time Collision Detection*, 5.1.9), exact for parallel and degenerate segments too.
-    """
-    eps = 1e-18
-    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
-    a, e, f = (d1 * d1).sum(-1), (d2 * d2).sum(-1), (d2 * r).sum(-1)
-    b, c = (d1 * d2).sum(-1), (d1 * r).sum(-1)
-    safe_a, safe_e = np.where(a > eps, a, 1.0), np.where(e > eps, e, 1.0)
-    denom = a * e - b * b
-    s = np.where(denom > eps * a * e, (b * f - c * e) / np.where(denom > 0, denom, 1.0), 0.0)
-    s = s.clip(0.0, 1.0)
-    t = (b * s + f) / safe_e
-    s = np.where(
-        t < 0.0,
-        (-c / safe_a).clip(0.0, 1.0),
-        np.where(t > 1.0, ((b - c) / safe_a).clip(0.0, 1.0), s),
-    )
-    t = t.clip(0.0, 1.0)
-    # degenerate segments (points)
-    s = np.where(a <= eps, 0.0, np.where(e <= eps, (-c / safe_a).clip(0.0, 1.0), s))
-    t = np.where(e <= eps, 0.0, np.where(a <= eps, (f / safe_e).clip(0.0, 1.0), t))
-    return s, t
-
-
 @njit(cache=True)
 def pair_distances(o: Array, pi: NDArray[np.int64], pj: NDArray[np.int64]):  # type: ignore[no-untyped-def]
     """Distance, unit normal ``c_i − c_j``, ``s`` and ``t`` of the link pairs ``(pi, pj)``
-    of the chain of points ``o`` (compiled; the same algorithm as :func:`closest_points`)."""
+    of the chain of points ``o``: segment ``o[pi] → o[pi+1]`` against ``o[pj] → o[pj+1]``.
+
+    Ericson's clamped closest points (*Real-Time Collision Detection*, 5.1.9), exact for
+    parallel and degenerate segments too; compiled."""
     p = pi.shape[0]
     dist, normal, ss, tt = np.empty(p), np.empty((p, 3)), np.empty(p), np.empty(p)
     eps = 1e-18

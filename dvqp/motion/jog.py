@@ -64,6 +64,11 @@ def jog_commands(
     window = round(_validate.positive("ramp", ramp, strict=False) / dt)
     if window <= 1 or commands.shape[0] == 0:
         return commands
-    pad = np.zeros((window - 1, 4))
-    total = np.cumsum(np.vstack([np.zeros((1, 4)), pad, commands, pad]), axis=0)
+    pad = np.zeros((window - 1, commands.shape[1]))
+    return box_average(np.vstack([pad, commands, pad]), window)
+
+
+def box_average(rows: NDArray[np.float64], window: int) -> NDArray[np.float64]:
+    """Means of every ``window`` consecutive rows of ``rows`` (m, c): shape (m − window + 1, c)."""
+    total = np.cumsum(np.vstack([np.zeros((1, rows.shape[1])), rows]), axis=0)
     return (total[window:] - total[:-window]) / window

@@ -42,8 +42,10 @@ class StepSpec:
     limits: tuple[Limit, ...] = ()
     weights: ArrayLike = 1.0
     task_weight: float = DEFAULT_TASK_WEIGHT
-    # diag(W) under n, W under -n: built once per number of joints
-    _diagonal: dict[int, NDArray[np.float64]] = field(
+    _diagonals: dict[int, NDArray[np.float64]] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
+    _hessians: dict[int, NDArray[np.float64]] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
 
@@ -65,18 +67,18 @@ class StepSpec:
 
     def diagonal(self, n: int) -> NDArray[np.float64]:
         """The diagonal of ``W`` for n joints, shape (n,) (read-only, built once)."""
-        found = self._diagonal.get(n)
+        found = self._diagonals.get(n)
         if found is None:
             found = _validate.readonly(_validate.broadcast("weights", self.weights, n))
-            self._diagonal[n] = found
+            self._diagonals[n] = found
         return found
 
     def hessian(self, n: int) -> NDArray[np.float64]:
         """``W = diag(weights)`` for n joints, shape (n, n) (read-only, built once)."""
-        found = self._diagonal.get(-n)
+        found = self._hessians.get(n)
         if found is None:
             found = _validate.readonly(np.diag(self.diagonal(n)))
-            self._diagonal[-n] = found
+            self._hessians[n] = found
         return found
 
     def with_extra(self, tasks: Sequence[Task] = (), limits: Sequence[Limit] = ()) -> StepSpec:
