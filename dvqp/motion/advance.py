@@ -168,6 +168,8 @@ def _straight(
     """
     delta = end - state.q
     count = math.ceil(float(np.abs(delta).max()) / JOINT_STRIDE) - 1
+    if count <= 0:  # the usual small step: nothing between its ends to check
+        return worst
     for a in np.linspace(0.0, 1.0, count + 2)[1:-1]:
         try:
             inner = KinematicState.compute(ctx.robot, state.q + a * delta, ctx.radius)
