@@ -43,6 +43,7 @@ class ObstacleSet:
         for i, o in enumerate(self.obstacles):
             groups.setdefault(type(o), []).append(i)
         self._groups = [(cls, [self.obstacles[i] for i in idx]) for cls, idx in groups.items()]
+        self._indices = [tuple(idx) for idx in groups.values()]
         order = [i for idx in groups.values() for i in idx]
         self._inverse = np.argsort(order) if order != sorted(order) else None
 
@@ -51,6 +52,10 @@ class ObstacleSet:
         """``obstacles`` itself if it is a set already (keeping its cache identity), else a new
         set of them."""
         return obstacles if isinstance(obstacles, ObstacleSet) else cls(obstacles)
+
+    def groups(self) -> list[tuple[type[Shape], list[Shape], tuple[int, ...]]]:
+        """The shapes grouped by class: ``(class, shapes, their indices in the set)``."""
+        return [(c, shapes, idx) for (c, shapes), idx in zip(self._groups, self._indices, strict=True)]
 
     def points(self, lz: np.ndarray, period: float) -> ShapeDistances:
         """Every obstacle against m points ``lz`` (m, 2): arrays (J, m, ...)."""

@@ -19,10 +19,13 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from dvqp.compiled.plan import Kernel, ProximityBuffers, StepPlan
 
 Array = NDArray[np.float64]
 
@@ -116,6 +119,16 @@ class Shape(ABC):
         """``e = d (d + 2ρ)`` and ``∇e = 2 (d + ρ) ∇d``."""
         rho = self.size
         return distance * (distance + 2.0 * rho), (2.0 * (distance + rho))[..., None] * normal
+
+    @classmethod
+    def kernel(
+        cls, shapes: Sequence[Shape], indices: NDArray[np.int64], plan: StepPlan,
+        buffers: ProximityBuffers,
+    ) -> Kernel | None:  # fmt: skip
+        """The compiled kernel that writes rows ``indices`` of ``buffers`` (this class's
+        shapes against the guarded points and links of ``plan.state``), or None: a class
+        without one makes the run take the reference (uncompiled) path."""
+        return None
 
     @classmethod
     def batch_points(cls, shapes: Sequence[Shape], lz: Array, period: float) -> ShapeDistances:
