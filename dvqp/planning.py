@@ -79,6 +79,7 @@ def plan(
     tasks: Sequence[Task] = (),
     limits: Sequence[Limit] = (),
     progress: Callable[[int, int], None] | None = None,
+    engine: str = "auto",
 ) -> Trajectory:
     """Run a scene with a resolver and return its trajectory.
 
@@ -96,6 +97,9 @@ def plan(
         Tasks and limits added to the scene's own (the baseline ignores limits).
     progress
         Called as ``progress(k, N)`` after each step.
+    engine
+        ``"auto"`` (compiled where every part has a kernel), ``"compiled"`` or
+        ``"reference"``: see :func:`dvqp.motion.simulate.simulate`.
 
     Raises
     ------
@@ -109,7 +113,7 @@ def plan(
     traj = simulate(
         scene.robot, scene.pipe_radius, resolver, scene.q0, c.velocity, scene.dt,
         obstacles=scene.obstacles, reference=c.reference[:-1] if c.feedback_gain > 0 else None,
-        feedback_gain=c.feedback_gain, progress=progress,
+        feedback_gain=c.feedback_gain, progress=progress, engine=engine,
     )  # fmt: skip
     error = dv_error(c.reference, traj.tool, scene.pipe_radius)
     return dataclasses.replace(traj, tracking_error=error, scene_text=scene.text)

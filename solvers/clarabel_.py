@@ -11,29 +11,31 @@ Clarabel is an interior-point method and its Python API (0.11) has no warm
 start, so ``initvals`` is ignored; the saving of the update path is the set-up
 (equilibration, symbolic factorisation). Updates need ``presolve_enable=False``
 (presolve drops rows); if ``is_data_update_allowed()`` is False anyway, every
-solve rebuilds.
+solve rebuilds. Per step, the kept rows are gathered with index arrays fixed at
+set-up into buffers (dense ``M`` block, CSC data, right-hand side) refilled in
+place, and ``P`` is passed only when it differs from the kept copy.
 """
 
 from __future__ import annotations
 
 from collections.abc import Hashable
+from time import perf_counter
 from typing import Any, ClassVar
 
 import clarabel
 import numpy as np
 
 from ._csc import CscPattern
+from ._fast import refresh
 from .problem import Problem
 from .stateful import RawResult, StatefulBackend
 
+_NONE = np.zeros(0, dtype=bool)
 
-def _finite_masks(problem: Problem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Boolean masks of kept rows: finite ``h``, finite ``lb``, finite ``ub``."""
-    none = np.zeros(problem.n, dtype=bool)
-    h_ok = np.isfinite(problem.h) if problem.h is not None else np.zeros(0, dtype=bool)
-    lb_ok = np.isfinite(problem.lb) if problem.lb is not None else none
-    ub_ok = np.isfinite(problem.ub) if problem.ub is not None else none
-    return h_ok, lb_ok, ub_ok
+
+def _finite(v: np.ndarray | None) -> np.ndarray:
+    """Mask of the finite entries of ``v`` (empty when ``v`` is absent)."""
+    return _NONE if v is None else np.isfinite(v)
 
 
 class ClarabelBackend(StatefulBackend):
@@ -61,10 +63,11 @@ class ClarabelBackend(StatefulBackend):
         super().__init__(tolerance=tolerance, **settings)
         self._solver: Any = None
         self._updatable = False
-        self._p_pattern: CscPattern | None = None
-        self._m_pattern: CscPattern | None = None
-        self._m_dense = np.zeros((0, 0))
-        self._masks: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._m = 0
+        self._rows = self._lb_rows = self._ub_rows = np.zeros(0, dtype=np.intp)
+        self._P = self._m_dense = np.zeros((0, 0))
+        self._p_take = self._m_take = np.zeros(0, dtype=np.int64)
+        self._Px = self._Ax = self._rhs = np.zeros(0)
 
     @classmethod
     def known_settings(cls) -> set[str]:
@@ -72,88 +75,102 @@ class ClarabelBackend(StatefulBackend):
         return {k for k in dir(clarabel.DefaultSettings()) if not k.startswith("_")}
 
     def _structure_of(self, problem: Problem) -> Hashable:
-        h_ok, lb_ok, ub_ok = _finite_masks(problem)
-        return (problem.n, problem.n_eq, h_ok.tobytes(), lb_ok.tobytes(), ub_ok.tobytes())
+        A = problem.A
+        return (
+            problem.q.shape[0],
+            0 if A is None else A.shape[0],
+            _finite(problem.h).tobytes(),
+            _finite(problem.lb).tobytes(),
+            _finite(problem.ub).tobytes(),
+        )
 
     def _release(self) -> None:
         self._solver = None
 
-    def _fill(self, problem: Problem) -> np.ndarray:
-        """Write ``A``/``G`` into the dense buffer; return the right-hand side."""
-        assert self._masks is not None
-        h_ok, lb_ok, ub_ok = self._masks
-        m_eq, k = problem.n_eq, int(h_ok.sum())
-        parts = []
-        if problem.A is not None and problem.b is not None:
-            self._m_dense[:m_eq] = problem.A
-            parts.append(problem.b)
-        if problem.G is not None and problem.h is not None:
-            self._m_dense[m_eq : m_eq + k] = problem.G[h_ok]
-            parts.append(problem.h[h_ok])
-        if problem.lb is not None:
-            parts.append(-problem.lb[lb_ok])
-        if problem.ub is not None:
-            parts.append(problem.ub[ub_ok])
-        return np.concatenate(parts) if parts else np.zeros(0)
+    def _fill(self, problem: Problem) -> None:
+        """Gather the kept rows into ``_m_dense``/``_Ax`` and the right-hand side ``_rhs``."""
+        m, k, k_lb = self._m, self._rows.size, self._lb_rows.size
+        rhs = self._rhs
+        if problem.A is not None:
+            self._m_dense[:m] = problem.A
+            rhs[:m] = problem.b
+        # mode="clip" (indices are valid by construction) lets np.take write to ``out``
+        # directly; the default mode="raise" buffers it.
+        if k:
+            np.take(problem.G, self._rows, axis=0, out=self._m_dense[m : m + k], mode="clip")
+            np.take(problem.h, self._rows, out=rhs[m : m + k], mode="clip")
+        if k_lb:
+            lower = rhs[m + k : m + k + k_lb]
+            np.take(problem.lb, self._lb_rows, out=lower, mode="clip")
+            np.negative(lower, out=lower)
+        if self._ub_rows.size:
+            np.take(problem.ub, self._ub_rows, out=rhs[m + k + k_lb :], mode="clip")
+        np.take(self._m_dense, self._m_take, out=self._Ax, mode="clip")
 
     def _setup(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
-        n = problem.n
-        self._masks = h_ok, lb_ok, ub_ok = _finite_masks(problem)
-        m_dense = problem.n_eq + int(h_ok.sum())
+        n, m = problem.n, problem.n_eq
+        self._m = m
+        self._rows, self._lb_rows, self._ub_rows = (
+            np.flatnonzero(_finite(v)) for v in (problem.h, problem.lb, problem.ub)
+        )
+        m_dense = m + self._rows.size
         eye = np.eye(n)
-        self._m_dense = np.vstack([np.zeros((m_dense, n)), -eye[lb_ok], eye[ub_ok]])
-        mask = np.vstack([np.ones((m_dense, n), dtype=bool), eye[lb_ok] != 0, eye[ub_ok] != 0])
-        self._p_pattern = CscPattern.upper_triangle(n)
-        self._m_pattern = CscPattern.from_mask(mask)
-        rhs = self._fill(problem)
+        self._m_dense = np.vstack([np.zeros((m_dense, n)), -eye[self._lb_rows], eye[self._ub_rows]])
+        mask = np.vstack([np.ones((m_dense, n), dtype=bool), self._m_dense[m_dense:] != 0])
+        p_pattern = CscPattern.upper_triangle(n)
+        m_pattern = CscPattern.from_mask(mask)
+        self._P, self._p_take, self._m_take = np.array(problem.P), p_pattern.take, m_pattern.take
+        self._Px = p_pattern.data(self._P)
+        self._Ax = np.zeros(m_pattern.take.size)
+        self._rhs = np.zeros(self._m_dense.shape[0])
+        self._fill(problem)
         cones = []
-        if problem.n_eq:
-            cones.append(clarabel.ZeroConeT(problem.n_eq))
-        if rhs.size > problem.n_eq:
-            cones.append(clarabel.NonnegativeConeT(rhs.size - problem.n_eq))
+        if m:
+            cones.append(clarabel.ZeroConeT(m))
+        if self._rhs.size > m:
+            cones.append(clarabel.NonnegativeConeT(self._rhs.size - m))
         settings = clarabel.DefaultSettings()
         for key, value in self.settings.items():
             setattr(settings, key, value)
+        start = perf_counter()
         self._solver = clarabel.DefaultSolver(
-            self._p_pattern.matrix(problem.P),
+            p_pattern.matrix(self._P),
             problem.q,
-            self._m_pattern.matrix(self._m_dense),
-            rhs,
+            m_pattern.matrix(self._m_dense),
+            self._rhs,
             cones,
             settings,
         )
         self._updatable = bool(self._solver.is_data_update_allowed())
-        return self._run(problem)
+        return self._run(problem, start)
 
     def _update(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
         if not self._updatable:
             return self._setup(problem, guess)
-        assert self._p_pattern is not None and self._m_pattern is not None
-        rhs = self._fill(problem)
-        self._solver.update(
-            P=self._p_pattern.data(problem.P),
-            q=problem.q,
-            A=self._m_pattern.data(self._m_dense),
-            b=rhs,
-        )
-        return self._run(problem)
+        self._fill(problem)
+        data: dict[str, np.ndarray] = {"q": problem.q, "A": self._Ax, "b": self._rhs}
+        if refresh(problem.P, self._P):
+            data["P"] = np.take(self._P, self._p_take, out=self._Px, mode="clip")
+        start = perf_counter()
+        self._solver.update(**data)
+        return self._run(problem, start)
 
-    def _run(self, problem: Problem) -> RawResult:
-        assert self._masks is not None
+    def _run(self, problem: Problem, start: float) -> RawResult:
         result = self._solver.solve()
-        h_ok, lb_ok, ub_ok = self._masks
+        solver_time = perf_counter() - start
         dual = np.asarray(result.z, dtype=np.float64)
-        m_eq, k, k_lb = problem.n_eq, int(h_ok.sum()), int(lb_ok.sum())
+        m, k, k_lb = self._m, self._rows.size, self._lb_rows.size
         z = np.zeros(problem.n_in)
-        z[h_ok] = dual[m_eq : m_eq + k]
+        z[self._rows] = dual[m : m + k]
         z_box = np.zeros(problem.n)
-        z_box[lb_ok] -= dual[m_eq + k : m_eq + k + k_lb]
-        z_box[ub_ok] += dual[m_eq + k + k_lb :]
+        z_box[self._lb_rows] -= dual[m + k : m + k + k_lb]
+        z_box[self._ub_rows] += dual[m + k + k_lb :]
         return RawResult(
             x=np.asarray(result.x, dtype=np.float64),
             status=str(result.status),
             iterations=int(result.iterations),
-            y=dual[:m_eq],
+            y=dual[:m],
             z=z,
             z_box=z_box if problem.has_bounds else None,
+            solver_time=solver_time,
         )

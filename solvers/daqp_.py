@@ -12,18 +12,25 @@ Warm start: ``Model.update`` keeps the working set of the previous solve when
 is only used on a cold set-up (``primal_start``); the Python ``update`` has no
 way to pass a primal iterate.
 
+Per-step cost: the stacked data ``H``, ``f``, ``[G; A]``, ``bupper``, ``blower`` live in
+buffers allocated at set-up; an update copies the problem's arrays into them in place
+(constant parts, e.g. ``-inf`` lower bounds of the ``G`` rows, are written once) and passes
+``H`` only when ``P`` differs from the kept copy, so DAQP re-factors ``H`` only then.
+
 API notes (daqp 0.11): ``Model.update`` silently ignores arrays whose shape
 differs from the set-up (no error), hence the structure key; every array must
-be writable (typed memoryviews reject read-only buffers), hence the copies.
+be writable (typed memoryviews reject read-only buffers), which the buffers are.
 """
 
 from __future__ import annotations
 
+from time import perf_counter
 from typing import Any, ClassVar
 
 import daqp
 import numpy as np
 
+from ._fast import refresh
 from .problem import Problem
 from .stateful import RawResult, StatefulBackend
 
@@ -61,6 +68,9 @@ class DaqpBackend(StatefulBackend):
     def __init__(self, *, tolerance: float | None = None, **settings: Any) -> None:
         super().__init__(tolerance=tolerance, **settings)
         self._model: Any = None
+        self._ms = self._p = 0  # rows of simple bounds and of G in DAQP's stacking
+        self._H = self._M = np.zeros((0, 0))
+        self._f = self._upper = self._lower = np.zeros(0)
 
     @classmethod
     def known_settings(cls) -> set[str]:
@@ -70,55 +80,70 @@ class DaqpBackend(StatefulBackend):
     def _release(self) -> None:
         self._model = None
 
-    @staticmethod
-    def _data(problem: Problem) -> dict[str, np.ndarray]:
-        n, p = problem.n, problem.n_in
-        blocks = [m for m in (problem.G, problem.A) if m is not None]
-        upper, lower = [], []
-        if problem.has_bounds:
-            upper.append(np.full(n, np.inf) if problem.ub is None else problem.ub)
-            lower.append(np.full(n, -np.inf) if problem.lb is None else problem.lb)
-        if problem.h is not None:
-            upper.append(problem.h)
-            lower.append(np.full(p, -np.inf))
-        if problem.b is not None:
-            upper.append(problem.b)
-            lower.append(problem.b)
-        return {
-            "H": problem.P.copy(),
-            "f": problem.q.copy(),
-            "A": np.vstack(blocks) if blocks else np.zeros((0, n)),
-            "bupper": np.concatenate(upper) if upper else np.zeros(0),
-            "blower": np.concatenate(lower) if lower else np.zeros(0),
-        }
+    def _fill(self, problem: Problem) -> None:
+        """Copy ``q``, ``G``, ``h``, ``A``, ``b``, ``lb``, ``ub`` into the set-up's buffers."""
+        ms, p = self._ms, self._p
+        self._f[:] = problem.q
+        if problem.G is not None:
+            self._M[:p] = problem.G
+            self._upper[ms : ms + p] = problem.h
+        if problem.A is not None:
+            self._M[p:] = problem.A
+            self._upper[ms + p :] = problem.b
+            self._lower[ms + p :] = problem.b
+        if problem.lb is not None:
+            self._lower[:ms] = problem.lb
+        if problem.ub is not None:
+            self._upper[:ms] = problem.ub
 
     def _setup(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
-        data = self._data(problem)
-        sense = np.zeros(data["bupper"].size, dtype=np.intc)
-        sense[sense.size - problem.n_eq :] = _SENSE_EQUALITY
+        n, p, m = problem.n, problem.n_in, problem.n_eq
+        ms = n if problem.has_bounds else 0
+        self._ms, self._p, rows = ms, p, ms + p + m
+        self._H = np.array(problem.P)  # DAQP's H, and the reference that tells P changed
+        self._f = np.empty(n)
+        self._M = np.empty((p + m, n))
+        self._upper, self._lower = np.full(rows, np.inf), np.full(rows, -np.inf)
+        self._fill(problem)
+        sense = np.zeros(rows, dtype=np.intc)
+        sense[rows - m :] = _SENSE_EQUALITY
         model = daqp.Model()
         model.settings = dict(self.settings)
-        flag, _ = model.setup(**data, sense=sense, primal_start=guess)
+        start = perf_counter()
+        flag, _ = model.setup(
+            H=self._H,
+            f=self._f,
+            A=self._M,
+            bupper=self._upper,
+            blower=self._lower,
+            sense=sense,
+            primal_start=guess,
+        )
         if flag < 0:
             return RawResult(None, f"setup failed: {EXIT_FLAGS.get(flag, flag)}")
         self._model = model
-        return self._run(problem)
+        return self._run(problem, start)
 
     def _update(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
-        flag = self._model.update(**self._data(problem))
+        self._fill(problem)
+        H = self._H if refresh(problem.P, self._H) else None
+        start = perf_counter()
+        flag = self._model.update(H=H, f=self._f, A=self._M, bupper=self._upper, blower=self._lower)
         if flag < 0:
             return RawResult(None, f"update failed: {EXIT_FLAGS.get(flag, flag)}")
-        return self._run(problem)
+        return self._run(problem, start)
 
-    def _run(self, problem: Problem) -> RawResult:
+    def _run(self, problem: Problem, start: float) -> RawResult:
         x, _, flag, info = self._model.solve()
-        lam = np.asarray(info["lam"], dtype=np.float64)
-        ms = problem.n if problem.has_bounds else 0
+        solver_time = perf_counter() - start
+        lam = info["lam"]
+        ms, p = self._ms, self._p
         return RawResult(
-            x=np.asarray(x, dtype=np.float64),
+            x=x,
             status=EXIT_FLAGS.get(flag, str(flag)),
-            iterations=int(info["iterations"]),
-            y=lam[ms + problem.n_in :],
-            z=lam[ms : ms + problem.n_in],
-            z_box=lam[:ms] if problem.has_bounds else None,
+            iterations=info["iterations"],
+            y=lam[ms + p :],
+            z=lam[ms : ms + p],
+            z_box=lam[:ms] if ms else None,
+            solver_time=solver_time,
         )

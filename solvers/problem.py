@@ -51,7 +51,8 @@ class Problem:
 
     On construction every array is copied to a read-only float64 C-contiguous array
     and validated; any inconsistency raises :class:`~solvers.ProblemShapeError`
-    whose message starts with the field name.
+    whose message starts with the field name. :meth:`trusted` skips both, for a
+    caller that owns preallocated arrays and rewrites them in place between solves.
 
     Parameters
     ----------
@@ -174,6 +175,59 @@ class Problem:
         if lb is not None and ub is not None and (ub < lb).any():
             _require("lb", lb <= ub, "must be <= ub")
         object.__setattr__(self, "_finite", tuple(finite))
+
+    @classmethod
+    def trusted(
+        cls,
+        P: np.ndarray,
+        q: np.ndarray,
+        A: np.ndarray | None = None,
+        b: np.ndarray | None = None,
+        G: np.ndarray | None = None,
+        h: np.ndarray | None = None,
+        lb: np.ndarray | None = None,
+        ub: np.ndarray | None = None,
+    ) -> Problem:
+        """Wrap arrays the caller built and vouches for, without validation or copies.
+
+        For a fixed-structure workspace that owns its data, e.g. a control loop
+        that overwrites preallocated arrays in place between solves: build one
+        trusted problem over those arrays once, mutate the arrays, and pass the
+        same problem to ``backend.solve`` every step. The problem keeps the very
+        arrays given (writable, shared with the caller), so every solution's
+        ``problem`` shows the data of the latest mutation, not of its own solve.
+
+        The caller owns what the constructor would check: every array float64
+        and C-contiguous, shapes consistent (``P`` (n, n), ``q``/``lb``/``ub``
+        (n,), ``A`` (m, n) with ``b`` (m,), ``G`` (p, n) with ``h`` (p,)), ``P``
+        symmetric, no NaN, ``h`` and ``ub`` never ``-inf``, ``lb`` never
+        ``+inf``, ``lb <= ub``. ``h = +inf`` rows (with any ``G`` row, zeros
+        included) are allowed, as in the regular constructor. Violations are not
+        detected here; they give wrong residuals, solver errors, or failed
+        solutions. As in the constructor, a zero-row ``A`` or ``G`` counts as
+        absent.
+
+        Parameters
+        ----------
+        P, q, A, b, G, h, lb, ub : ndarray
+            As in :class:`Problem`, but already float64 C-contiguous arrays.
+
+        Returns
+        -------
+        Problem
+            Sharing the given arrays.
+        """
+        problem = object.__new__(cls)
+        if A is not None and A.shape[0] == 0:
+            A = b = None
+        if G is not None and G.shape[0] == 0:
+            G = h = None
+        # Whether h, lb, ub are finite is not known (and may change with the data):
+        # (False, False, False) selects the code paths that handle infinite entries.
+        problem.__dict__.update(
+            P=P, q=q, A=A, b=b, G=G, h=h, lb=lb, ub=ub, _finite=(False, False, False)
+        )
+        return problem
 
     @property
     def n(self) -> int:

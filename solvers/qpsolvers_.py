@@ -12,8 +12,8 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
-import time
 from collections.abc import Iterator
+from time import perf_counter
 from typing import Any
 
 import numpy as np
@@ -144,10 +144,10 @@ class QpsolversBackend:
         Solution
             Checked by :meth:`Solution.checked`.
         """
-        start = time.perf_counter()
+        start = perf_counter()
         guess = check_initvals(problem, initvals)
-        solution = solve_guarded(self, problem, lambda: self._run(problem, guess))
-        solution.solve_time = time.perf_counter() - start
+        solution = solve_guarded(self, problem, self._run, problem, guess)
+        solution.solve_time = perf_counter() - start
         return solution
 
     def _run(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
@@ -165,7 +165,9 @@ class QpsolversBackend:
         qp = qpsolvers.Problem(P, np.array(problem.q), G, h, A, b, lb, ub)
         quiet = _quiet_c_stdout() if self.solver in CHATTY else contextlib.nullcontext()
         with quiet:
+            started = perf_counter()
             result = qpsolvers.solve_problem(qp, self.solver, initvals=guess, **self.settings)
+            solver_time = perf_counter() - started
         z = None
         if keep is not None and result.z is not None:
             z = np.zeros(problem.n_in)
@@ -177,4 +179,5 @@ class QpsolversBackend:
             y=result.y if problem.n_eq else None,
             z=z,
             z_box=result.z_box if problem.has_bounds else None,
+            solver_time=solver_time,
         )

@@ -8,9 +8,10 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from .exceptions import SolverFailure
+from .exceptions import ProblemShapeError, SolverFailure
+from .kkt import evaluate
 from .problem import Problem
-from .residuals import Residuals, kkt_residuals
+from .residuals import Residuals
 
 
 @dataclass(eq=False)
@@ -35,7 +36,8 @@ class Solution:
     iterations : int or None
         Solver iterations, when reported.
     solve_time : float
-        Wall-clock seconds around the solver call, data update included.
+        Wall-clock seconds of the whole ``backend.solve`` call: data update, solver,
+        residual check (and a cold retry, if any).
     y : ndarray, shape (m,), or None
         Equality multipliers (sign convention in :mod:`solvers.residuals`).
     z : ndarray, shape (p,), or None
@@ -49,6 +51,10 @@ class Solution:
         Why the solution was rejected; empty when ``found``.
     retried : bool
         True when a warm-started solve failed the check and was redone cold.
+    solver_time : float
+        Of ``solve_time``, the seconds inside the solver library's own calls (set-up or
+        data update, and solve; both attempts when ``retried``); 0.0 when the backend
+        does not measure it.
     """
 
     problem: Problem
@@ -65,6 +71,7 @@ class Solution:
     residuals: Residuals | None = None
     message: str = ""
     retried: bool = False
+    solver_time: float = 0.0
 
     @classmethod
     def checked(
@@ -81,6 +88,7 @@ class Solution:
         z: npt.ArrayLike | None = None,
         z_box: npt.ArrayLike | None = None,
         retried: bool = False,
+        solver_time: float = 0.0,
     ) -> Solution:
         """Build a solution and decide ``found`` from recomputed residuals.
 
@@ -90,17 +98,20 @@ class Solution:
         ``<= tolerance * (1 + s)`` with ``s = max(||P x||_inf, ||q||_inf)``
         (they are in gradient units). Without multipliers a feasible but
         non-optimal ``x`` could not be told from the optimum, so it is refused.
+        The residuals come from the compiled :mod:`solvers.kkt` kernel (one call,
+        no NumPy temporaries); the message is only formatted on rejection.
 
         Parameters
         ----------
         problem : Problem
             The problem that was solved.
         x : ndarray, shape (n,), or None
-            Primal answer of the solver.
-        backend, tolerance, status, iterations, solve_time, retried
+            Primal answer of the solver (copied).
+        backend, tolerance, status, iterations, solve_time, retried, solver_time
             Copied to the matching attributes.
         y, z, z_box : ndarray, optional
-            Multipliers, already converted to the package sign convention.
+            Multipliers, already converted to the package sign convention; kept as
+            given (not copied) when they are float64 C-contiguous arrays.
 
         Returns
         -------
@@ -108,32 +119,58 @@ class Solution:
             With ``residuals`` and, on rejection, a one-line ``message``.
         """
         solution = cls(
-            problem=problem,
-            x=None,
-            status=status,
-            found=False,
-            backend=backend,
-            tolerance=tolerance,
-            iterations=iterations,
-            solve_time=solve_time,
-            retried=retried,
-        )
+            problem, None, status, False, backend, tolerance, iterations, solve_time,
+            retried=retried, solver_time=solver_time,
+        )  # fmt: skip
         if x is None:
             solution.message = f"{backend} returned no solution (status {status!r})"
             return solution
-        said = f"{backend} said {status!r} but"
-        answer, flaw = _primal(problem, x)
-        solution.x = answer
-        if answer is None or flaw:
-            solution.message = f"{said} {flaw}"
+        try:
+            answer = np.array(x, dtype=np.float64)
+        except (TypeError, ValueError):
+            solution.message = f"{backend} said {status!r} but x is not a numeric array"
             return solution
-        solution.y, solution.z, solution.z_box = (_floats(v) for v in (y, z, z_box))
-        res, scale = kkt_residuals(problem, answer, solution.y, solution.z, solution.z_box)
-        solution.residuals = res
-        failed = _failed_checks(res, tolerance, scale)
-        solution.found = not failed
-        solution.message = f"{said} {', '.join(failed)}" if failed else ""
+        solution.x = answer
+        n = problem.q.shape[0]
+        if answer.shape != (n,):
+            solution.message = (
+                f"{backend} said {status!r} but x has shape {answer.shape}, expected ({n},)"
+            )
+            return solution
+        solution.y, solution.z, solution.z_box = _floats(y), _floats(z), _floats(z_box)
+        try:
+            duals, values = evaluate(problem, answer, solution.y, solution.z, solution.z_box)
+        except ProblemShapeError:
+            if math.isfinite(float(answer.sum())):
+                raise
+            values = (0.0,)
+        if not values[0]:
+            solution.y = solution.z = solution.z_box = None
+            solution.message = f"{backend} said {status!r} but x is not finite"
+            return solution
+        solution._judge(duals, values)
         return solution
+
+    def _judge(self, duals: bool, values: tuple[float, ...]) -> None:
+        """Set ``residuals``, ``found`` and (on rejection) ``message`` from kernel values."""
+        _, equality, inequality, bounds, stationarity, complementarity, scale = values
+        tolerance = self.tolerance
+        if not duals:
+            self.residuals = Residuals(equality, inequality, bounds)
+        else:
+            self.residuals = Residuals(equality, inequality, bounds, stationarity, complementarity)
+            dual_tol = tolerance * (1.0 + scale)
+            if (
+                equality <= tolerance
+                and inequality <= tolerance
+                and bounds <= tolerance
+                and stationarity <= dual_tol
+                and complementarity <= dual_tol
+            ):
+                self.found = True
+                return
+        failed = _failed_checks(self.residuals, tolerance, scale)
+        self.message = f"{self.backend} said {self.status!r} but {', '.join(failed)}"
 
     @classmethod
     def failure(
@@ -146,6 +183,7 @@ class Solution:
         message: str,
         solve_time: float = 0.0,
         retried: bool = False,
+        solver_time: float = 0.0,
     ) -> Solution:
         """Build a solution for a solve that produced no answer at all (e.g. an exception)."""
         return cls(
@@ -158,6 +196,7 @@ class Solution:
             solve_time=solve_time,
             message=message,
             retried=retried,
+            solver_time=solver_time,
         )
 
     def require(self) -> np.ndarray:
@@ -178,22 +217,13 @@ class Solution:
         return self.x
 
 
-def _primal(problem: Problem, x: npt.ArrayLike) -> tuple[np.ndarray | None, str]:
-    """``x`` as a float64 array (None if not numeric) and why it is unusable (``''`` if not)."""
-    try:
-        answer = np.array(x, dtype=np.float64)
-    except (TypeError, ValueError):
-        return None, "x is not a numeric array"
-    if answer.shape != (problem.n,):
-        return answer, f"x has shape {answer.shape}, expected ({problem.n},)"
-    if not math.isfinite(float(answer.sum())):
-        return answer, "x is not finite"
-    return answer, ""
-
-
 def _floats(value: npt.ArrayLike | None) -> np.ndarray | None:
-    """A multiplier as a float64 array, or None."""
-    return None if value is None else np.array(value, dtype=np.float64)
+    """A multiplier as a float64 C-contiguous array (as given if it already is), or None."""
+    if value is None or (
+        type(value) is np.ndarray and value.dtype == np.float64 and value.flags.c_contiguous
+    ):
+        return value  # type: ignore[return-value]
+    return np.ascontiguousarray(value, dtype=np.float64)
 
 
 def _failed_checks(res: Residuals, tolerance: float, scale: float) -> list[str]:

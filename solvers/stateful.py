@@ -10,9 +10,9 @@ judged by :meth:`Solution.checked <solvers.Solution.checked>`.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass
+from time import perf_counter
 from typing import Any, ClassVar
 
 import numpy as np
@@ -44,6 +44,9 @@ class RawResult:
         Inequality multipliers.
     z_box : ndarray, shape (n,), or None
         Bound multipliers (see :mod:`solvers.residuals` for the signs).
+    solver_time : float or None
+        Seconds inside the solver library's calls (set-up or update, and solve), if
+        the adapter measured them; otherwise the whole adapter call is timed.
     """
 
     x: np.ndarray | None
@@ -52,6 +55,7 @@ class RawResult:
     y: np.ndarray | None = None
     z: np.ndarray | None = None
     z_box: np.ndarray | None = None
+    solver_time: float | None = None
 
 
 def check_initvals(problem: Problem, initvals: np.ndarray | None) -> np.ndarray | None:
@@ -64,14 +68,18 @@ def check_initvals(problem: Problem, initvals: np.ndarray | None) -> np.ndarray 
     return guess
 
 
-def solve_guarded(backend: Backend, problem: Problem, run: Callable[[], RawResult]) -> Solution:
-    """Call ``run()`` and check its result; a solver exception becomes a failed Solution.
+def solve_guarded(
+    backend: Backend, problem: Problem, run: Callable[..., RawResult], *args: Any
+) -> Solution:
+    """Call ``run(*args)`` and check its result; a solver exception becomes a failed Solution.
 
     Exceptions in :data:`PROGRAMMING_ERRORS` are adapter bugs and raise
-    :class:`SolverError` instead.
+    :class:`SolverError` instead. The solution's ``solver_time`` is the result's
+    own ``solver_time`` when the adapter measured it, else the time of ``run``.
     """
+    start = perf_counter()
     try:
-        raw = run()
+        raw = run(*args)
     except SolverError:
         raise
     except PROGRAMMING_ERRORS as exc:
@@ -83,7 +91,9 @@ def solve_guarded(backend: Backend, problem: Problem, run: Callable[[], RawResul
             tolerance=backend.tolerance,
             status="exception",
             message=f"{backend.name} raised {type(exc).__name__}: {exc}",
+            solver_time=perf_counter() - start,
         )
+    solver_time = raw.solver_time
     return Solution.checked(
         problem,
         raw.x,
@@ -94,6 +104,7 @@ def solve_guarded(backend: Backend, problem: Problem, run: Callable[[], RawResul
         y=raw.y,
         z=raw.z,
         z_box=raw.z_box,
+        solver_time=perf_counter() - start if solver_time is None else solver_time,
     )
 
 
@@ -159,33 +170,45 @@ class StatefulBackend:
         Solution
             ``retried`` is True when the warm answer was rejected and redone cold.
         """
-        start = time.perf_counter()
-        guess = check_initvals(problem, initvals)
+        start = perf_counter()
+        guess = None if initvals is None else check_initvals(problem, initvals)
         structure = self._structure_of(problem)
-        warm = structure == self._structure
-        solution = self._attempt(problem, guess, warm, structure)
-        if warm and not solution.found:
-            solution = self._attempt(problem, guess, False, structure)
-            solution.retried = True
+        if structure == self._structure:
+            solution = solve_guarded(self, problem, self._update, problem, guess)
+            if not solution.found:
+                warm_time = solution.solver_time
+                solution = self._cold(problem, guess, structure)
+                solution.retried = True
+                solution.solver_time += warm_time
+        else:
+            solution = self._cold(problem, guess, structure)
         if not solution.found:
             self.reset()
-        solution.solve_time = time.perf_counter() - start
+        solution.solve_time = perf_counter() - start
         return solution
 
-    def _attempt(
-        self, problem: Problem, guess: np.ndarray | None, warm: bool, structure: Hashable
-    ) -> Solution:
-        if warm:
-            return solve_guarded(self, problem, lambda: self._update(problem, guess))
+    def _cold(self, problem: Problem, guess: np.ndarray | None, structure: Hashable) -> Solution:
+        """Drop the solver, set it up for ``problem`` and solve."""
         self._structure = None
         self._release()
-        solution = solve_guarded(self, problem, lambda: self._setup(problem, guess))
+        solution = solve_guarded(self, problem, self._setup, problem, guess)
         self._structure = structure
         return solution
 
     def _structure_of(self, problem: Problem) -> Hashable:
-        """Key that must be equal between two problems for a data update."""
-        return (problem.n, problem.n_eq, problem.n_in, problem.has_bounds)
+        """Key that must be equal between two problems for a data update.
+
+        The default is ``(n, n_eq, n_in, lb given, ub given)``, read straight from the
+        array shapes (no property calls: this runs on every solve).
+        """
+        A, G = problem.A, problem.G
+        return (
+            problem.q.shape[0],
+            0 if A is None else A.shape[0],
+            0 if G is None else G.shape[0],
+            problem.lb is not None,
+            problem.ub is not None,
+        )
 
     def _setup(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
         """Build the solver for ``problem`` from scratch and solve (cold start)."""

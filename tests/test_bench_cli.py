@@ -183,7 +183,7 @@ def test_a_real_sigint_stops_cleanly_and_keeps_what_finished(tmp_path: Path) -> 
     if not wired():
         pytest.skip("bench is not wired into dvqp.cli.main yet")
     out, scenes = tmp_path / "a.json", tmp_path / "s"
-    argv = ["bench", "--count", "40", "--backends", "pinv", "--json", str(out),
+    argv = ["bench", "--count", "400", "--backends", "pinv", "--json", str(out),
             "--save-scenes", str(scenes)]  # fmt: skip
     proc = subprocess.Popen([sys.executable, "-m", "dvqp", *argv], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)  # fmt: skip
@@ -196,4 +196,4 @@ def test_a_real_sigint_stops_cleanly_and_keeps_what_finished(tmp_path: Path) -> 
     assert proc.returncode == 130 and "Traceback" not in err
     assert err.splitlines()[-1] == "dvqp: interrupted"
     doc = strict_json(out)
-    assert doc["interrupted"] is True and 1 <= len(doc["results"]) < 40
+    assert doc["interrupted"] is True and 1 <= len(doc["results"]) < 400

@@ -25,142 +25,27 @@ first). ``dt`` (s) and the tool command are one-element and (4,) arrays updated 
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp.compiled import ownership
+from dvqp.compiled.buffers import (
+    Kernel,
+    ProximityBuffers,
+    SelfPairBuffers,
+    Slot,
+    StateBuffers,
+)
+
 if TYPE_CHECKING:
     from dvqp.geometry.obstacle import ObstacleSet
 
 Array = NDArray[np.float64]
 
-
-@dataclass(frozen=True)
-class Kernel:
-    """A compiled function and its bound arguments: calling it is ``function(*args)``.
-
-    ``args`` may hold :class:`Slot` placeholders (rows of the stacked ``G``/``h``/``A``/``b``
-    or a slice of the verification values), replaced by array views in :meth:`StepPlan.bind`.
-    """
-
-    function: Callable[..., Any]
-    args: tuple[Any, ...]
-
-
-@dataclass(frozen=True)
-class Slot:
-    """A placeholder for rows ``[start, stop)`` of one of the plan's stacked arrays."""
-
-    array: str
-    start: int
-    stop: int
-
-
-@dataclass(frozen=True)
-class StateBuffers:
-    """One configuration's kinematics, as :class:`~dvqp.kinematics.state.KinematicState` has it.
-
-    Attributes (all float64, written in place once per state)
-    ----------
-    q : (n,)
-        rad.
-    origins, axes : (k+1, 3)
-        Frame origins (m) and unit z axes of the k body points then the tool, base frame.
-    frame_jacobians : (k+1, 6, n)
-        ``[J_v; J_ω]``, base orientation (LOCAL_WORLD_ALIGNED).
-    guarded : (k+1, 3)
-        DV ``[l, z, h]`` (m) of the body points then the probe.
-    guarded_jacobians : (k+1, 3, n)
-        Their ``∂[l, z, h]/∂Q``.
-    tool : (4,)
-        ``[l, z, h, α]``.
-    tool_jacobian : (4, n)
-        ``J̄``.
-    """
-
-    q: Array
-    origins: Array
-    axes: Array
-    frame_jacobians: Array
-    guarded: Array
-    guarded_jacobians: Array
-    tool: Array
-    tool_jacobian: Array
-
-    @classmethod
-    def allocate(cls, n: int, k: int) -> StateBuffers:
-        """Zeroed buffers for n joints and k body points."""
-        m = k + 1
-        return cls(np.zeros(n), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 6, n)),
-                   np.zeros((m, 3)), np.zeros((m, 3, n)), np.zeros(4), np.zeros((4, n)))  # fmt: skip
-
-    def load(self, state: Any) -> None:
-        """Copy a :class:`~dvqp.kinematics.state.KinematicState` in (tests, fallbacks)."""
-        for name in self.__dataclass_fields__:
-            np.copyto(getattr(self, name), getattr(state, name))
-
-
-@dataclass(frozen=True)
-class ProximityBuffers:
-    """Signed distances of the guarded parts to J obstacles, as
-    :class:`~dvqp.geometry.proximity.Proximity` has them (rows in the obstacle set's order).
-
-    Attributes
-    ----------
-    point_distance, point_penalty : (J, k+1)
-    point_normal, point_penalty_gradient : (J, k+1, 2)
-    link_distance, link_penalty, link_t : (J, k)
-    link_normal, link_penalty_gradient : (J, k, 2)
-    """
-
-    point_distance: Array
-    point_normal: Array
-    point_penalty: Array
-    point_penalty_gradient: Array
-    link_distance: Array
-    link_normal: Array
-    link_penalty: Array
-    link_penalty_gradient: Array
-    link_t: Array
-
-    @classmethod
-    def allocate(cls, count: int, k: int) -> ProximityBuffers:
-        """Zeroed buffers for ``count`` obstacles and k body points."""
-        p, s = (count, k + 1), (count, k)
-        return cls(np.zeros(p), np.zeros((*p, 2)), np.zeros(p), np.zeros((*p, 2)),
-                   np.zeros(s), np.zeros((*s, 2)), np.zeros(s), np.zeros((*s, 2)), np.zeros(s))  # fmt: skip
-
-    def load(self, proximity: Any) -> None:
-        """Copy a :class:`~dvqp.geometry.proximity.Proximity` in (tests)."""
-        for side in ("point", "link"):
-            found = getattr(proximity, f"{side}s")
-            for name in ("distance", "normal", "penalty", "penalty_gradient"):
-                np.copyto(getattr(self, f"{side}_{name}"), getattr(found, name))
-        np.copyto(self.link_t, proximity.links.t)
-
-
-@dataclass(frozen=True)
-class SelfPairBuffers:
-    """The non-adjacent guarded link pairs ``(i, j)`` and their closest points, per state.
-
-    Attributes
-    ----------
-    i, j : (P,) int64
-        Link indices (constant).
-    distance, s, t : (P,)
-    normal : (P, 3)
-        Unit ``c_i − c_j``.
-    """
-
-    i: NDArray[np.int64]
-    j: NDArray[np.int64]
-    distance: Array
-    normal: Array
-    s: Array
-    t: Array
+__all__ = ["Kernel", "ProximityBuffers", "SelfPairBuffers", "Slot", "StateBuffers", "StepPlan"]
 
 
 @dataclass
@@ -245,11 +130,15 @@ class StepPlan:
         if found is not None:
             return found[1]
         buffers = ProximityBuffers.allocate(len(obstacles), self.k)
+        kernels = []
         for cls, shapes, indices in obstacles.groups():
-            kernel = cls.kernel(shapes, np.asarray(indices, dtype=np.int64), self, buffers)
+            make = ownership.own_kernel(cls, "kernel", ownership.SHAPE)
+            index = np.asarray(indices, dtype=np.int64)
+            kernel = None if make is None else make(shapes, index, self, buffers)
             if kernel is None:
                 return None
-            self.geometry.append(kernel)
+            kernels.append(kernel)
+        self.geometry.extend(kernels)
         self._proximity[id(obstacles)] = (obstacles, buffers)
         return buffers
 
@@ -262,11 +151,15 @@ class StepPlan:
             self.geometry.append(kernel)
         return self._pairs
 
-    def bind(self, kernel: Kernel) -> Kernel:
-        """``kernel`` with its :class:`Slot` arguments replaced by views of the stacked arrays
-        (allocated on the first call; no more rows may be asked for after it)."""
+    def finalize(self) -> None:
+        """Allocate the stacked arrays (once; no more rows may be asked for after it)."""
         if not self.stacked:
             self._allocate()
+
+    def bind(self, kernel: Kernel) -> Kernel:
+        """``kernel`` with its :class:`Slot` arguments replaced by views of the stacked arrays
+        (finalising the plan on the first call)."""
+        self.finalize()
         args = tuple(self._view(a) if isinstance(a, Slot) else a for a in kernel.args)
         return Kernel(kernel.function, args)
 

@@ -55,7 +55,9 @@ class ObstacleSet:
 
     def groups(self) -> list[tuple[type[Shape], list[Shape], tuple[int, ...]]]:
         """The shapes grouped by class: ``(class, shapes, their indices in the set)``."""
-        return [(c, shapes, idx) for (c, shapes), idx in zip(self._groups, self._indices, strict=True)]
+        return [
+            (c, shapes, idx) for (c, shapes), idx in zip(self._groups, self._indices, strict=True)
+        ]
 
     def points(self, lz: np.ndarray, period: float) -> ShapeDistances:
         """Every obstacle against m points ``lz`` (m, 2): arrays (J, m, ...)."""

@@ -9,7 +9,9 @@ left, i.e. ``Q̇ ≤ −a dt + sqrt(a² dt² + 2 a D)`` (and the mirror bound to
 
 The limit remembers the velocity of the last step it was told about: the resolution loop
 calls :meth:`AccelerationLimit.observe` after each accepted (sub)step and
-:meth:`AccelerationLimit.reset` at the start of a run (at rest).
+:meth:`AccelerationLimit.reset` at the start of a run (at rest). Both write into the same
+array for the limit's whole life, which the compiled kernel (:meth:`AccelerationLimit.kernel`)
+reads.
 """
 
 from __future__ import annotations
@@ -18,9 +20,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
+from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
+from dvqp.limits.bounds_kernels import acceleration_bounds
 from dvqp.limits.limit import Bounds
 
 DEFAULT_QDD_MAX = 10.0
@@ -50,16 +54,20 @@ class AccelerationLimit:
 
     @property
     def previous(self) -> NDArray[np.float64]:
-        """The last observed joint velocity, rad/s, shape (n,)."""
+        """The last observed joint velocity, rad/s, shape (n,).
+
+        The array is live: the same object for the limit's whole life, overwritten in place by
+        :meth:`observe` and :meth:`reset` (copy it to keep a value)."""
         return self._previous
 
     def reset(self) -> None:
-        """A run starts at rest."""
-        self._previous = np.zeros_like(self._previous)
+        """A run starts at rest (in place)."""
+        self._previous.fill(0.0)
 
     def observe(self, qdot: NDArray[np.float64], dt: float) -> None:
-        """The joint velocity (rad/s) applied over the step just taken."""
-        self._previous = np.array(qdot, dtype=np.float64)
+        """The joint velocity (rad/s, shape (n,)) applied over the step just taken, copied in
+        place."""
+        np.copyto(self._previous, qdot)
 
     def compute(self, state: KinematicState, dt: float) -> Bounds:
         """The box of this step, rad/s, shape (n,) each."""
@@ -70,6 +78,13 @@ class AccelerationLimit:
         lb = np.maximum(lb, -_braking(a, dt, state.q - self.q_min))
         # a joint that cannot brake in time any more keeps its position limit, not this bound
         return Bounds(np.minimum(lb, ub), ub)
+
+    def kernel(self, plan: StepPlan) -> Kernel:
+        """The box at ``plan.state.q`` around :attr:`previous` (read live at every call),
+        intersected into ``plan.lb``, ``plan.ub``."""
+        args = (plan.state.q, self.q_min, self.q_max, self.qdd_max, self._previous, plan.dt,
+                plan.lb, plan.ub)  # fmt: skip
+        return Kernel(acceleration_bounds, args)
 
 
 def _braking(a: NDArray[np.float64], dt: float, room: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -15,6 +15,11 @@ than one step's acceleration. A part deeper inside (it started there) may not ge
 no escape it might not be able to make is demanded; the objective pushes body points out of
 obstacles and toward the orbital level. A subclass implements :meth:`VelocityDamper.distances`;
 the base owns the right-hand side.
+
+The compiled step (:mod:`dvqp.compiled`) uses the scalar twin
+:func:`~dvqp.limits.damper_kernels.damper_value` of :func:`damper_rhs`, the same operations in
+the same order (equal bit for bit); a built-in damper's :meth:`~VelocityDamper.kernel` writes
+its rows with it.
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.excess import NO_EXCESS, Excess
@@ -121,6 +127,21 @@ class VelocityDamper:
         step is caught.
         """
         return self.distances(state)
+
+    def params(self, safe: float) -> tuple[float, float, float, float]:
+        """``(d_safe, γ, δ, a)``: the parameter tuple of the compiled damper kernels
+        (:mod:`dvqp.limits.damper_kernels`), with ``δ`` the tolerance."""
+        return (float(safe), self.gain, float(self.tolerance), self.deceleration)
+
+    def kernel(self, plan: StepPlan) -> Kernel | None:
+        """The compiled rows (see :class:`~dvqp.limits.limit.Limit`); a subclass without one
+        raises NotImplementedError, so the run takes the reference path."""
+        raise NotImplementedError(f"{type(self).__name__} has no compiled kernel")
+
+    def verifier(self, plan: StepPlan) -> Kernel | None:
+        """The compiled verification values (see :mod:`dvqp.limits.excess`); a subclass without
+        one raises NotImplementedError, so the run takes the reference path."""
+        raise NotImplementedError(f"{type(self).__name__} has no compiled verifier")
 
     def compute(self, state: KinematicState, dt: float) -> Constraint:
         """``−∂d/∂Q · Q̇ ≤ γ/dt · max(d − d_safe, −δ)``, one row per distance."""

@@ -8,6 +8,25 @@ actually reached, without linearisation, and keeps the worst :class:`Excess`.
 A limit is kept if its quantity stays at or above ``min(bound, value at the start of the
 run)``: a part that starts closer than its margin may stay there but may not get worse, and
 small excesses cannot add up from step to step.
+
+Compiled verification. A verified limit also provides ``verifier(plan)``: a
+:class:`~dvqp.compiled.plan.Kernel` that writes the limit's exact quantities at
+``plan.state`` into ``slot = plan.verified(limit, count, safe, tolerance)`` (None when there is
+nothing to check, e.g. a tilt limit with ``min_tilt = 0`` or a damper without obstacles;
+NotImplementedError when it cannot be compiled). With the values at the run's start,
+``floor = minimum(safe, values_at_start)`` (fixed for the run), the limit's
+:meth:`VerifiedLimit.excess` value at a state is ``max(floor − values)`` over its slice, its
+tolerance is ``tolerance``, and :func:`worst_excess` is the entry of largest
+``(floor − value) / tolerance`` over all slices. The values are:
+
+- a damper: its distances in the order of ``all_distances`` (m; safe ``d_safe``, tolerance
+  0.1 mm): an obstacle damper every point's clearance (J × (k+1), obstacle-major), then every
+  link's (J × k); the surface height the k body points' heights; the probe height the probe's;
+  self-collision every non-adjacent pair's distance;
+- joint positions ``[q_max − q, q − q_min]`` (2n, rad; safe 0, tolerance 1e-6 rad; ``inf`` on
+  an unlimited side, so ``floor − value = −inf`` there, never NaN);
+- the tilt ``asin(min(sin θ, 1))`` (one value, rad; safe ``asin(min(sin θ_min, 1))``,
+  tolerance 1e-3 rad).
 """
 
 from __future__ import annotations

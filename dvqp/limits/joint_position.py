@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
+from dvqp.limits.bounds_kernels import joint_position_bounds, joint_room_values
 from dvqp.limits.excess import Excess
 from dvqp.limits.limit import Bounds
 
@@ -48,3 +50,14 @@ class JointPositionLimit:
             float(over[i]), self.tolerance, label, "joint position", "rad", float(state.q[i]),
             float(bound),
         )  # fmt: skip
+
+    def kernel(self, plan: StepPlan) -> Kernel:
+        """The box at ``plan.state.q``, intersected into ``plan.lb``, ``plan.ub``."""
+        args = (plan.state.q, self.q_min, self.q_max, plan.dt, plan.lb, plan.ub)
+        return Kernel(joint_position_bounds, args)
+
+    def verifier(self, plan: StepPlan) -> Kernel:
+        """``[q_max − q, q − q_min]``, rad, shape (2n,), safe value 0 (``inf`` where a joint
+        is unlimited: never the worst)."""
+        slot = plan.verified(self, 2 * plan.n, 0.0, self.tolerance)
+        return Kernel(joint_room_values, (plan.state.q, self.q_min, self.q_max, slot))

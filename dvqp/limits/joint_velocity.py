@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
+from dvqp.limits.bounds_kernels import joint_velocity_bounds
 from dvqp.limits.limit import Bounds
 
 
@@ -22,3 +24,7 @@ class JointVelocityLimit:
     def compute(self, state: KinematicState, dt: float) -> Bounds:
         """The constant box (``state`` and ``dt`` are not used)."""
         return Bounds(-self.qd_max, self.qd_max.copy())
+
+    def kernel(self, plan: StepPlan) -> Kernel:
+        """The constant box, intersected into ``plan.lb``, ``plan.ub``."""
+        return Kernel(joint_velocity_bounds, (self.qd_max, plan.lb, plan.ub))

@@ -3,6 +3,23 @@
 A limit is any object with a ``name`` and ``compute(state, dt)`` returning one of the two (the
 :class:`Limit` protocol). :func:`dvqp.resolution.qp.build_qp` stacks the constraints in the
 order the limits are given and intersects the boxes.
+
+Compiled step. A limit may also provide ``kernel(plan)``, returning a
+:class:`~dvqp.compiled.plan.Kernel` built once for a :class:`~dvqp.compiled.plan.StepPlan`, or
+None when it adds nothing (a tilt limit with ``min_tilt = 0``, a damper without obstacles). It
+raises NotImplementedError when it cannot be compiled (a user's damper, an obstacle shape
+without a proximity kernel): the run then takes the reference path. A kernel of
+
+- a **box** intersects its bounds into ``plan.lb``, ``plan.ub`` in place (``lb = max(lb,
+  own)``, ``ub = min(ub, own)``); the engine resets them to ``∓inf`` before the step's bounds
+  kernels, which then leave the reference's intersected box;
+- **constraints** asks once for a fixed number of rows (``plan.constraint_rows(count)``) and
+  writes all of them at every step: the rows ``compute`` returns, in the same order, and every
+  row that ``compute`` would leave out at that state as ``G = 0``, ``h = +inf``.
+
+Kernels read the step ``dt`` from ``plan.dt[0]`` and the state from ``plan.state`` (obstacle
+dampers from ``plan.proximity(obstacles)``, self-collision from ``plan.self_pairs()``: the
+``plan.geometry`` kernels run before them), all bound once as views of the plan's buffers.
 """
 
 from __future__ import annotations

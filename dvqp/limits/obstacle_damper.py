@@ -14,11 +14,13 @@ from typing import ClassVar
 import numpy as np
 
 from dvqp import _validate
+from dvqp.compiled.plan import Kernel, ProximityBuffers, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.proximity import link_label, point_label, proximity
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
+from dvqp.limits.damper_kernels import clearance_values, obstacle_rows
 
 
 class ObstacleDamper(VelocityDamper):
@@ -104,3 +106,38 @@ class ObstacleDamper(VelocityDamper):
 
         values = np.concatenate([points.ravel(), links.ravel()])
         return Distances(values, None, self.margin, describe)
+
+    def kernel(self, plan: StepPlan) -> Kernel | None:
+        """``J (2k + 1)`` fixed rows: every (point, obstacle) pair then every (link, obstacle)
+        pair, obstacle-major, from the plan's proximity buffers of :attr:`obstacles` (its
+        shapes' kernels, in ``plan.geometry``, run before it); None with no obstacle.
+
+        Raises NotImplementedError when a shape has no compiled kernel."""
+        if not len(self.obstacles):
+            return None
+        near = _buffers(plan, self.obstacles)
+        G, h = plan.constraint_rows(len(self.obstacles) * (2 * plan.k + 1))
+        args = (near.point_distance, near.point_normal, near.link_distance, near.link_normal,
+                near.link_t, plan.state.guarded_jacobians, self.influence,
+                self.params(self.margin), plan.dt, G, h)  # fmt: skip
+        return Kernel(obstacle_rows, args)
+
+    def verifier(self, plan: StepPlan) -> Kernel | None:
+        """Every point's then every link's clearance, m, obstacle-major (as
+        :meth:`all_distances`), safe value ``margin``; None with no obstacle.
+
+        Raises NotImplementedError when a shape has no compiled kernel."""
+        if not len(self.obstacles):
+            return None
+        near = _buffers(plan, self.obstacles)
+        count = len(self.obstacles) * (2 * plan.k + 1)
+        slot = plan.verified(self, count, self.margin, self.tolerance)
+        return Kernel(clearance_values, (near.point_distance, near.link_distance, slot))
+
+
+def _buffers(plan: StepPlan, obstacles: ObstacleSet) -> ProximityBuffers:
+    """The plan's proximity buffers of ``obstacles``; NotImplementedError if not compiled."""
+    buffers = plan.proximity(obstacles)
+    if buffers is None:
+        raise NotImplementedError("an obstacle shape has no compiled proximity kernel")
+    return buffers

@@ -6,9 +6,11 @@ from typing import ClassVar
 
 import numpy as np
 
+from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
+from dvqp.limits.damper_kernels import height_rows, height_values
 
 
 class ProbeHeight(VelocityDamper):
@@ -47,3 +49,14 @@ class ProbeHeight(VelocityDamper):
             state.guarded[-1:, 2], state.guarded_jacobians[-1:, 2, :], self.floor,
             lambda: ("probe/height",),
         )  # fmt: skip
+
+    def kernel(self, plan: StepPlan) -> Kernel:
+        """The probe's row (guarded point k), from ``plan.state``."""
+        G, h = plan.constraint_rows(1)
+        s, params = plan.state, self.params(self.floor)
+        return Kernel(height_rows, (s.guarded, s.guarded_jacobians, plan.k, params, plan.dt, G, h))
+
+    def verifier(self, plan: StepPlan) -> Kernel:
+        """The probe's height, m (safe value ``floor``)."""
+        slot = plan.verified(self, 1, self.floor, self.tolerance)
+        return Kernel(height_values, (plan.state.guarded, plan.k, slot))

@@ -10,6 +10,10 @@ closest points; exact). With ``n = (c_i − c_j)/d`` and the frames' linear Jaco
 
 (the envelope theorem: moving the closest points along their segments does not change d to
 first order). One damper row per pair closer than ``margin + influence``.
+
+The compiled step computes the pairs' geometry once per state into the plan's pair buffers
+(:func:`pairs_kernel`, with the same in-place routine the reference path uses); the rows
+kernel (:meth:`SelfCollision.kernel`) reads them.
 """
 
 from __future__ import annotations
@@ -23,10 +27,13 @@ from numba import njit
 from numpy.typing import NDArray
 
 from dvqp import _validate
+from dvqp.compiled.plan import Kernel, SelfPairBuffers, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.geometry.proximity import link_label
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
+from dvqp.limits.damper_kernels import copy_values
+from dvqp.limits.self_collision_kernels import pair_distances_into, self_rows
 
 Array = NDArray[np.float64]
 
@@ -44,36 +51,22 @@ def pair_distances(o: Array, pi: NDArray[np.int64], pj: NDArray[np.int64]):  # t
     of the chain of points ``o``: segment ``o[pi] → o[pi+1]`` against ``o[pj] → o[pj+1]``.
 
     Ericson's clamped closest points (*Real-Time Collision Detection*, 5.1.9), exact for
-    parallel and degenerate segments too; compiled."""
+    parallel and degenerate segments too; compiled (:func:`pair_distances_into`, which the
+    compiled step calls in place)."""
     p = pi.shape[0]
     dist, normal, ss, tt = np.empty(p), np.empty((p, 3)), np.empty(p), np.empty(p)
-    eps = 1e-18
-    for m in range(p):
-        a, b, c, d = o[pi[m]], o[pi[m] + 1], o[pj[m]], o[pj[m] + 1]
-        d1, d2, r = b - a, d - c, a - c
-        aa, e, f = d1 @ d1, d2 @ d2, d2 @ r
-        if aa <= eps and e <= eps:
-            s, t = 0.0, 0.0
-        elif aa <= eps:
-            s, t = 0.0, min(max(f / e, 0.0), 1.0)
-        else:
-            cc = d1 @ r
-            if e <= eps:
-                s, t = min(max(-cc / aa, 0.0), 1.0), 0.0
-            else:
-                bb = d1 @ d2
-                denom = aa * e - bb * bb
-                s = min(max((bb * f - cc * e) / denom, 0.0), 1.0) if denom > eps * aa * e else 0.0
-                t = (bb * s + f) / e
-                if t < 0.0:
-                    s, t = min(max(-cc / aa, 0.0), 1.0), 0.0
-                elif t > 1.0:
-                    s, t = min(max((bb - cc) / aa, 0.0), 1.0), 1.0
-        diff = (a + s * d1) - (c + t * d2)
-        dist[m] = np.sqrt(diff @ diff)
-        normal[m] = diff / max(dist[m], 1e-15)
-        ss[m], tt[m] = s, t
+    pair_distances_into(o, pi, pj, dist, normal, ss, tt)
     return dist, normal, ss, tt
+
+
+def pairs_kernel(plan: StepPlan) -> tuple[SelfPairBuffers, Kernel]:
+    """The pair buffers of ``plan``'s k guarded links and the kernel that fills them in place
+    from ``plan.state.origins`` (once per state; see :meth:`StepPlan.self_pairs`)."""
+    i, j = link_pairs(plan.k)
+    p = i.shape[0]
+    pairs = SelfPairBuffers(i, j, np.zeros(p), np.zeros((p, 3)), np.zeros(p), np.zeros(p))
+    args = (plan.state.origins, i, j, pairs.distance, pairs.normal, pairs.s, pairs.t)
+    return pairs, Kernel(pair_distances_into, args)
 
 
 _CACHE_KEY = "self-collision pairs"
@@ -140,6 +133,27 @@ class SelfCollision(VelocityDamper):
         """Every non-adjacent pair's distance, m (no gradients), for verification."""
         dist, _, _, _, (i, j) = self._geometry(state)
         return Distances(dist, None, self.margin, _labels(i, j, state.k))
+
+    def kernel(self, plan: StepPlan) -> Kernel | None:
+        """One row per non-adjacent pair (``link_pairs(k)`` order), from the plan's pair
+        buffers (:meth:`StepPlan.self_pairs`, run before it); None with no pair."""
+        pairs = plan.self_pairs()
+        if pairs.i.shape[0] == 0:
+            return None
+        G, h = plan.constraint_rows(pairs.i.shape[0])
+        reach = self.margin + self.influence
+        return Kernel(self_rows, (pairs.i, pairs.j, pairs.distance, pairs.normal, pairs.s,
+                                  pairs.t, plan.state.frame_jacobians, reach,
+                                  self.params(self.margin), plan.dt, G, h))  # fmt: skip
+
+    def verifier(self, plan: StepPlan) -> Kernel | None:
+        """Every pair's distance, m (safe value ``margin``); None with no pair."""
+        pairs = plan.self_pairs()
+        count = pairs.i.shape[0]
+        if count == 0:
+            return None
+        slot = plan.verified(self, count, self.margin, self.tolerance)
+        return Kernel(copy_values, (pairs.distance, slot))
 
 
 def _labels(i: NDArray[np.int64], j: NDArray[np.int64], k: int) -> Callable[[], tuple[str, ...]]:

@@ -6,9 +6,11 @@ from typing import ClassVar
 
 import numpy as np
 
+from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
+from dvqp.limits.damper_kernels import height_rows, height_values
 
 
 class SurfaceHeight(VelocityDamper):
@@ -49,3 +51,15 @@ class SurfaceHeight(VelocityDamper):
             self.min_height,
             lambda: tuple(f"point{i + 1}/height" for i in range(k)),
         )
+
+    def kernel(self, plan: StepPlan) -> Kernel:
+        """k rows, one per body point (all always apply), from ``plan.state``."""
+        G, h = plan.constraint_rows(plan.k)
+        s = plan.state
+        params = self.params(self.min_height)
+        return Kernel(height_rows, (s.guarded, s.guarded_jacobians, 0, params, plan.dt, G, h))
+
+    def verifier(self, plan: StepPlan) -> Kernel:
+        """The k body points' heights, m (safe value ``h_min``)."""
+        slot = plan.verified(self, plan.k, self.min_height, self.tolerance)
+        return Kernel(height_values, (plan.state.guarded, 0, slot))

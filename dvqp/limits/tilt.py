@@ -17,9 +17,11 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
+from dvqp.limits.damper_kernels import tilt_rows, tilt_value
 from dvqp.limits.excess import Excess
 from dvqp.limits.limit import Constraint
 
@@ -111,3 +113,20 @@ class TiltLimit(VelocityDamper):
         actual, bound = math.asin(min(found.actual, 1.0)), math.asin(min(found.bound, 1.0))
         label = "probe/tilt" if bound - actual > 0.0 else ""
         return Excess(bound - actual, self.tolerance, label, "tilt", "rad", actual, bound)
+
+    def kernel(self, plan: StepPlan) -> Kernel | None:
+        """The probe's tilt row from ``plan.state``; None when the limit is off."""
+        if self.min_tilt == 0.0:
+            return None
+        G, h = plan.constraint_rows(1)
+        s, params = plan.state, self.params(math.sin(self.min_tilt))
+        return Kernel(tilt_rows, (s.origins, s.axes, s.frame_jacobians, params, plan.dt, G, h))
+
+    def verifier(self, plan: StepPlan) -> Kernel | None:
+        """The tilt ``asin(min(sin θ, 1))``, rad, safe value ``asin(min(sin θ_min, 1))``
+        (the folding :meth:`excess` uses); None when the limit is off."""
+        if self.min_tilt == 0.0:
+            return None
+        safe = math.asin(min(math.sin(self.min_tilt), 1.0))
+        slot = plan.verified(self, 1, safe, self.tolerance)
+        return Kernel(tilt_value, (plan.state.origins, plan.state.axes, slot))

@@ -14,6 +14,7 @@ from dvqp.limits.self_collision import self_distance
 from dvqp.limits.tilt import tilt
 from dvqp.motion.advance import Advance
 from dvqp.motion.trajectory import Trajectory
+from dvqp.resolution.step import Step
 
 PER_SAMPLE = ("w", "min_clearance", "probe_clearance", "tilt", "self_distance", "limit_excess")
 PER_STEP = ("solve_time", "solver_time", "step_time", "task_error")
@@ -46,6 +47,7 @@ class TrajectoryRecorder:
             "iterations": np.full(n_steps, -1, dtype=np.int64),
             "substeps": np.ones(n_steps, dtype=np.int64),
             "success": np.zeros(n_steps, dtype=bool),
+            "compiled": np.zeros(n_steps, dtype=bool),
             "limits_kept": np.ones(n_steps + 1, dtype=bool),
         }
         self.status: list[str] = []
@@ -69,14 +71,38 @@ class TrajectoryRecorder:
         else:
             a["min_clearance"][k] = a["probe_clearance"][k] = math.inf
 
+    def sample_values(
+        self, k: int, q: np.ndarray, tool: np.ndarray, guarded: np.ndarray, w: float,
+        excess: float, kept: bool, diagnostics: np.ndarray,
+    ) -> None:  # fmt: skip
+        """Sample k from the compiled step's buffers: ``guarded`` (k+1, 3) (the body points
+        then the probe), the worst excess value, and ``diagnostics`` = ``[tilt, self distance,
+        min clearance, probe clearance]``."""
+        a = self.arrays
+        a["q"][k], a["tool"][k], a["points"][k] = q, tool, guarded[:-1]
+        a["w"][k] = w
+        a["limit_excess"][k] = max(excess, 0.0)
+        a["limits_kept"][k] = kept
+        a["tilt"][k], a["self_distance"][k] = diagnostics[0], diagnostics[1]
+        a["min_clearance"][k], a["probe_clearance"][k] = diagnostics[2], diagnostics[3]
+
     def step(self, k: int, advance: Advance, step_time: float) -> None:
         """Step k (from sample k to k + 1) and its full wall time, s."""
-        a, step = self.arrays, advance.step
+        step = advance.step
+        self.step_values(k, step, advance.substeps, step_time)
+
+    def step_values(
+        self, k: int, step: Step, substeps: int, step_time: float, compiled: bool = False
+    ) -> None:
+        """Step k from its :class:`~dvqp.resolution.step.Step` (or anything with the same
+        fields), its substeps, its full wall time (s) and whether the compiled path took it."""
+        a = self.arrays
+        a["compiled"][k] = compiled
         a["solve_time"][k], a["step_time"][k] = step.solve_time, step_time
         a["solver_time"][k] = step.solver_time
         a["task_error"][k], a["success"][k] = step.task_error, step.success
         a["iterations"][k] = -1 if step.iterations is None else step.iterations
-        a["substeps"][k] = advance.substeps
+        a["substeps"][k] = substeps
         self.status.append(step.status)
         if step.success:
             a["qdot"][k] = step.qdot

@@ -7,33 +7,28 @@ toward a DV reference: ``ẋ = ẋ_d + K·(x_d − x)`` with l and α difference
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
+from dvqp.compiled.engine import compile_step
+from dvqp.compiled.run import run_compiled
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry.obstacle import ObstacleSet
-from dvqp.kinematics.developed_view import wrap, wrap_angle
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits.excess import NO_EXCESS
-from dvqp.motion.advance import MAX_HALVINGS, advance
+from dvqp.motion.advance import MAX_HALVINGS
 from dvqp.motion.recorder import TrajectoryRecorder
+from dvqp.motion.run import Run, dv_error, run_reference
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.step import Resolver
 
+ENGINES = ("auto", "compiled", "reference")
+"""How :func:`simulate` steps: see its ``engine`` parameter."""
 
-def dv_error(
-    reference: NDArray[np.float64], actual: NDArray[np.float64], radius: float
-) -> NDArray[np.float64]:
-    """``x_d − x`` of DV coordinates (…, 4) with l wrapped modulo 2πR and α modulo 2π."""
-    e = np.asarray(reference, dtype=float) - np.asarray(actual, dtype=float)
-    e[..., 0] = wrap(e[..., 0], radius)
-    e[..., 3] = wrap_angle(e[..., 3])
-    return e
+__all__ = ["ENGINES", "dv_error", "simulate"]
 
 
 def _check_commands(
@@ -66,6 +61,7 @@ def simulate(
     verify: bool | None = None,
     max_halvings: int = MAX_HALVINGS,
     progress: Callable[[int, int], None] | None = None,
+    engine: str = "auto",
 ) -> Trajectory:
     """Run the commands from ``q0`` and return the trajectory.
 
@@ -93,6 +89,10 @@ def simulate(
         Most times a step is halved to keep the limits.
     progress
         Called as ``progress(k, N)`` after each step.
+    engine
+        ``"auto"``: the compiled step (:mod:`dvqp.compiled`) when every part of the run has a
+        kernel, else the reference path; ``"compiled"`` (raise if it cannot be compiled) or
+        ``"reference"`` (Pinocchio and NumPy, the path the compiled one is tested against).
 
     Notes
     -----
@@ -106,33 +106,24 @@ def simulate(
     cmd, ref = _check_commands(commands, reference)
     obstacles = ObstacleSet() if obstacles is None else obstacles
     check = getattr(resolver, "holds_limits", True) if verify is None else verify
-    objective = resolver.spec.objective
-    state = start = KinematicState.compute(robot, robot.check_q(q0, "q0"), radius)
+    if engine not in ENGINES:
+        raise ParameterError("engine", f"must be one of {', '.join(ENGINES)}, got {engine!r}")
+    q_start = robot.check_q(q0, "q0")
+    KinematicState.compute(robot, q_start, radius)  # a singular start raises here
     resolver.reset()
     for limit in resolver.spec.limits:  # limits that remember motion start at rest
         reset = getattr(limit, "reset", None)
         if reset is not None:
             reset()
-    n_steps = cmd.shape[0]
-    record = TrajectoryRecorder(n_steps, robot.n, robot.n_points, obstacles)
-    started = time.perf_counter()
-    excess = NO_EXCESS
-    for i in range(n_steps + 1):
-        record.sample(i, state, objective.evaluate(state).value, excess)
-        if i == n_steps:
-            break
-        xdot = cmd[i]
-        if ref is not None and gain > 0.0:
-            xdot = xdot + gain * dv_error(ref[i], state.tool, radius)
-        moved = advance(
-            robot, radius, resolver, state, xdot, dt, start=start, verify=check,
-            max_halvings=max_halvings,
-        )  # fmt: skip
-        now = time.perf_counter()
-        record.step(i, moved, now - started)
-        started, state = now, moved.state
-        if moved.step.success:
-            excess = moved.excess
-        if progress is not None:
-            progress(i + 1, n_steps)
+    record = TrajectoryRecorder(cmd.shape[0], robot.n, robot.n_points, obstacles)
+    run = Run(robot, radius, resolver, q_start, cmd, ref, gain, dt, check, max_halvings, record,
+              progress)  # fmt: skip
+    compiled = None if engine == "reference" else compile_step(robot, radius, resolver,
+                                                                  obstacles, check)  # fmt: skip
+    if compiled is None and engine == "compiled":
+        raise ParameterError("engine", "a part of this run has no compiled kernel")
+    if compiled is None:
+        run_reference(run)
+    else:
+        run_compiled(compiled, run)
     return record.trajectory(dt, radius, getattr(resolver, "name", type(resolver).__name__))

@@ -13,6 +13,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
+from dvqp.compiled import ownership
+from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.state import KinematicState
@@ -70,6 +72,24 @@ class Objective:
             total = Term(sum(t.value for t in terms), gradient)
         state.cache[self] = total
         return total
+
+    def kernels(self, plan: StepPlan) -> list[Kernel] | None:
+        """The terms' compiled kernels, in order, or None if a term has none.
+
+        Each kernel ADDS its term's value and ``∂w/∂Q`` to ``plan.objective_value`` (1,) and
+        ``plan.objective_gradient`` (n,), which the caller zeroes once per state first; the
+        gain ``λ`` is not applied (the caller scales the gradient by :attr:`gain`). With no
+        term the list is empty (``w = 0``). None if a term has no ``kernel(plan)`` method or
+        its ``kernel`` returns None, or a subclass overrides ``evaluate`` but not ``kernel``
+        (:func:`dvqp.compiled.ownership.own_kernel`): the run then takes the reference path.
+        """
+        kernels = []
+        for term in self.terms:
+            ok, kernel = ownership.build(term, "kernel", ownership.TERM, plan)
+            if not ok or kernel is None:
+                return None
+            kernels.append(kernel)
+        return kernels
 
     def scaled_gradient(self, state: KinematicState) -> NDArray[np.float64]:
         """``g = λ ∂w/∂Q``, shape (n,): what the resolution step follows."""

@@ -5,9 +5,11 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.proximity import proximity
 from dvqp.kinematics.state import KinematicState
+from dvqp.objective import term_kernels
 from dvqp.objective.term import Term, per_point, point_gains
 
 
@@ -52,3 +54,17 @@ class ObstacleLinks:
         at_points[1:] += (a * t[..., None]).sum(axis=0)
         grad = -np.einsum("kc,kcn->n", at_points, state.point_jacobians[:, :2, :])
         return Term(value, grad)
+
+    def kernel(self, plan: StepPlan) -> Kernel | None:
+        """The compiled term (:func:`~dvqp.objective.term_kernels.obstacle_links`), reading
+        the plan's proximity buffers; None if a shape of the set has no kernel."""
+        near = plan.proximity(self.obstacles)
+        if near is None:
+            return None
+        k1 = np.array(per_point("k_obstacle", self.k_obstacle, plan.k), dtype=np.float64)
+        weights = np.array(self.obstacles.weights, dtype=np.float64)
+        args = (near.link_penalty, near.link_penalty_gradient, near.link_t, weights, k1,
+                plan.state.guarded_jacobians, np.zeros((plan.k, 2)))  # fmt: skip
+        return Kernel(
+            term_kernels.obstacle_links, (*args, plan.objective_value, plan.objective_gradient)
+        )

@@ -5,8 +5,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
+from dvqp.objective import term_kernels
 from dvqp.objective.term import Term, per_point, point_gains
 
 
@@ -36,3 +38,13 @@ class OrbitalLevel:
         value = -0.5 * float(kh @ (dh * dh))
         grad = -(kh * dh) @ state.point_jacobians[:, 2, :]
         return Term(value, grad)
+
+    def kernel(self, plan: StepPlan) -> Kernel:
+        """The compiled term (:func:`~dvqp.objective.term_kernels.orbital_level`): adds its
+        value and gradient to ``plan.objective_value`` and ``plan.objective_gradient``."""
+        kh = np.array(per_point("k_height", self.k_height, plan.k), dtype=np.float64)
+        s = plan.state
+        args = (s.guarded, s.guarded_jacobians, self.level, kh)
+        return Kernel(
+            term_kernels.orbital_level, (*args, plan.objective_value, plan.objective_gradient)
+        )

@@ -27,6 +27,13 @@ class ObjectiveTerm(Protocol):
 
     Implement ``name`` and :meth:`evaluate`; :class:`~dvqp.objective.Objective` adds the
     terms up.
+
+    Optionally, for the compiled step, a term may also have ``kernel(plan) ->
+    Kernel | None`` (not a member of this protocol): a :class:`~dvqp.compiled.plan.Kernel`
+    that ADDS the term's value and gradient to ``plan.objective_value`` (1,) and
+    ``plan.objective_gradient`` (n,) at the state in ``plan.state``, with the same math as
+    :meth:`evaluate`. A term without it (or returning None) makes the run take the reference
+    (uncompiled) path.
     """
 
     name: str

@@ -59,6 +59,8 @@ class QPResolver:
     def __init__(self, spec: StepSpec, backend: str | Callable[[], solvers.Backend]) -> None:
         self.spec = spec
         factory = (lambda: make_backend(backend)) if isinstance(backend, str) else backend
+        self.factory: Callable[[], solvers.Backend] = factory
+        """Makes a fresh backend (the compiled step sets up its own)."""
         self._strict = factory()
         self._relaxed = factory()
         self.name = backend if isinstance(backend, str) else self._strict.name
@@ -75,13 +77,13 @@ class QPResolver:
         dt = _validate.positive("dt", dt)
         strict = build_qp(self.spec, state, cmd, dt)
         solution = self._strict.solve(strict.problem)
-        solver_time, status = solution.solve_time, "optimal"
+        solver_time, status = solution.solver_time, "optimal"
         if not solution.found:
             parts = (strict.terms, strict.inequalities, strict.bounds)
             solution = self._relaxed.solve(
                 build_qp(self.spec, state, cmd, dt, relax=True, parts=parts).problem
             )
-            solver_time, status = solver_time + solution.solve_time, "relaxed"
+            solver_time, status = solver_time + solution.solver_time, "relaxed"
         if not solution.found or solution.x is None:
             return self._brake(strict.terms, strict.bounds, solution, start, solver_time)
         qdot = np.array(solution.x[: state.n])

@@ -60,6 +60,14 @@ class Task(Protocol):
         A label for reports.
     hard : bool
         True: an equality (relaxed only if it conflicts with the limits); False: a cost.
+
+    Notes
+    -----
+    Optionally, for the compiled step, a task may also have ``kernel(plan) -> Kernel`` (not a
+    member of this protocol): it asks for its rows once (``A, b = plan.task_rows(m)``) and
+    returns a :class:`~dvqp.compiled.plan.Kernel` that writes ``J`` into ``A`` and ``v``
+    into ``b`` each step, from ``plan.state``, ``plan.command`` and ``plan.dt``. A task
+    without it makes the run take the reference (uncompiled) path.
     """
 
     name: str

@@ -2,14 +2,19 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 from dvqp import _validate
+from dvqp.compiled.plan import Kernel, ProximityBuffers, StepPlan
 from dvqp.errors import ParameterError
+from dvqp.geometry.shapes import band_kernels
 from dvqp.geometry.shapes.shape import Array, Shape
+from dvqp.geometry.shapes.shape_kernels import proximity_outputs
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,3 +98,16 @@ class Band(Shape):
         # crossing the middle line the distance is −width/2 whatever the ends do: no gradient
         n[(k == 2) & (t > 0.0) & (t < 1.0)] = 0.0
         return d, t, n
+
+    @classmethod
+    def kernel(
+        cls, shapes: Sequence[Shape], indices: NDArray[np.int64], plan: StepPlan,
+        buffers: ProximityBuffers,
+    ) -> Kernel:  # fmt: skip
+        """:func:`~dvqp.geometry.shapes.band_kernels.bands`, the edges packed once."""
+        bands = [s for s in shapes if isinstance(s, Band)]
+        z_min = np.array([b.z_min for b in bands], dtype=np.float64)
+        z_max = np.array([b.z_max for b in bands], dtype=np.float64)
+        sizes = np.array([b.size for b in bands], dtype=np.float64)
+        args = (plan.state.guarded, plan.period, z_min, z_max, sizes, indices)
+        return Kernel(band_kernels.bands, (*args, *proximity_outputs(buffers)))

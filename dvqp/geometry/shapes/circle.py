@@ -10,7 +10,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp import _validate
+from dvqp.compiled.plan import Kernel, ProximityBuffers, StepPlan
+from dvqp.geometry.shapes import circle_kernels
 from dvqp.geometry.shapes.shape import Array, Shape, ShapeDistances, wrap_l
+from dvqp.geometry.shapes.shape_kernels import proximity_outputs
 
 _TINY = 1e-12
 
@@ -97,6 +100,16 @@ class Circle(Shape):
         t = ((s_start * seg).sum(axis=-1) / length2).clip(0.0, 1.0)
         r = s_start - t[..., None] * seg
         return _distances(r, np.sqrt((r * r).sum(axis=-1)), radii, t)
+
+    @classmethod
+    def kernel(
+        cls, shapes: Sequence[Shape], indices: NDArray[np.int64], plan: StepPlan,
+        buffers: ProximityBuffers,
+    ) -> Kernel:  # fmt: skip
+        """:func:`~dvqp.geometry.shapes.circle_kernels.circles`, centres and radii packed once."""
+        centers, radii = _pack(shapes)
+        args = (plan.state.guarded, plan.period, centers, radii, indices)
+        return Kernel(circle_kernels.circles, (*args, *proximity_outputs(buffers)))
 
 
 def _pack(shapes: Sequence[Shape]) -> tuple[Array, Array]:

@@ -9,6 +9,7 @@ cuts the pipe surface along ``(R sin((l − l0)/R))² + (z − z0)² = r²``: a 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -16,8 +17,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp import _validate
+from dvqp.compiled.plan import Kernel, ProximityBuffers, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.geometry.shapes.polygon import Polygon
+from dvqp.geometry.shapes.polygon_kernels import polygon_kernel
 from dvqp.geometry.shapes.shape import Array, Shape
 
 VERTICES = 256
@@ -100,3 +103,14 @@ class Inlet(Shape):
     def segment_distance(self, a: Array, b: Array, period: float) -> tuple[Array, Array, Array]:
         """Through the outline polygon."""
         return self.polygon.segment_distance(a, b, period)
+
+    @classmethod
+    def kernel(
+        cls, shapes: Sequence[Shape], indices: NDArray[np.int64], plan: StepPlan,
+        buffers: ProximityBuffers,
+    ) -> Kernel:  # fmt: skip
+        """The outline polygons' kernel (:func:`~dvqp.geometry.shapes.polygon_kernels.polygons`)
+        with the penalty size r of each inlet."""
+        inlets = [s for s in shapes if isinstance(s, Inlet)]
+        sizes = [i.size for i in inlets]
+        return polygon_kernel([i.polygon for i in inlets], sizes, indices, plan, buffers)

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 from dvqp import _validate
+from dvqp.compiled.plan import Kernel, ProximityBuffers, StepPlan
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry.shapes import polygon_geometry as geo
 from dvqp.geometry.shapes import polygon_kernels as kernels
@@ -97,6 +100,16 @@ class Polygon(Shape):
         return kernels.segments_signed_distance(
             la[:, 0], la[:, 1], lb[:, 0], lb[:, 1], self._vl, self._vz
         )
+
+    @classmethod
+    def kernel(
+        cls, shapes: Sequence[Shape], indices: NDArray[np.int64], plan: StepPlan,
+        buffers: ProximityBuffers,
+    ) -> Kernel:  # fmt: skip
+        """:func:`~dvqp.geometry.shapes.polygon_kernels.polygons`, vertices packed once."""
+        polygons = [s for s in shapes if isinstance(s, Polygon)]
+        sizes = [p.size for p in polygons]
+        return kernels.polygon_kernel(polygons, sizes, indices, plan, buffers)
 
 
 def _check_simple(v: Array) -> None:

@@ -3,16 +3,26 @@
 Loops over the edges are cheap compiled and costly in NumPy for the 256-vertex outline of a
 branch inlet, so the per-step geometry runs here. Vertices are in the polygon's local frame
 (l measured from its reference), as arrays ``vl, vz`` of shape (V,); points likewise.
+:func:`polygons` is the compiled step's proximity kernel of polygons and inlets.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
+from numpy.typing import NDArray
 
+from dvqp.compiled.plan import Kernel
 from dvqp.geometry.shapes.shape import Array
+from dvqp.geometry.shapes.shape_kernels import proximity_outputs, store, wrap
+
+if TYPE_CHECKING:
+    from dvqp.compiled.plan import ProximityBuffers, StepPlan
+    from dvqp.geometry.shapes.polygon import Polygon
 
 SAMPLES = 33
 """Samples along a segment that enters the polygon, before the golden-section search."""
@@ -26,7 +36,7 @@ def _point(pl: float, pz: float, vl: Array, vz: Array) -> tuple[float, float, fl
     n = vl.shape[0]
     best, cl, cz, inside, best_e = np.inf, 0.0, 0.0, False, 0
     for i in range(n):
-        j = (i + 1) % n
+        j = i + 1 if i + 1 < n else 0  # (i + 1) % n without an integer division
         el, ez = vl[j] - vl[i], vz[j] - vz[i]
         wl, wz = pl - vl[i], pz - vz[i]
         len2 = el * el + ez * ez
@@ -67,7 +77,7 @@ def points_signed_distance(pl: Array, pz: Array, vl: Array, vz: Array) -> tuple[
 def _crosses(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array) -> bool:
     n = vl.shape[0]
     for i in range(n):
-        j = (i + 1) % n
+        j = i + 1 if i + 1 < n else 0
         o1 = (bl - al) * (vz[i] - az) - (bz - az) * (vl[i] - al)
         o2 = (bl - al) * (vz[j] - az) - (bz - az) * (vl[j] - al)
         o3 = (vl[j] - vl[i]) * (az - vz[i]) - (vz[j] - vz[i]) * (al - vl[i])
@@ -131,6 +141,15 @@ def _deepest(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array): 
 
 
 @njit(cache=True)
+def _segment(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array):  # type: ignore[no-untyped-def]
+    """``(d, t, ∂d/∂l, ∂d/∂z)`` of one segment (see :func:`segments_signed_distance`)."""
+    res = _outside(al, az, bl, bz, vl, vz)
+    if res[0] < 0.0 or _crosses(al, az, bl, bz, vl, vz):
+        res = _deepest(al, az, bl, bz, vl, vz)
+    return res
+
+
+@njit(cache=True)
 def segments_signed_distance(
     al: Array, az: Array, bl: Array, bz: Array, vl: Array, vz: Array
 ) -> tuple[Array, Array, Array]:
@@ -140,8 +159,54 @@ def segments_signed_distance(
     m = al.shape[0]
     d, t, g = np.empty(m), np.empty(m), np.empty((m, 2))
     for k in range(m):
-        res = _outside(al[k], az[k], bl[k], bz[k], vl, vz)
-        if res[0] < 0.0 or _crosses(al[k], az[k], bl[k], bz[k], vl, vz):
-            res = _deepest(al[k], az[k], bl[k], bz[k], vl, vz)
-        d[k], t[k], g[k, 0], g[k, 1] = res
+        d[k], t[k], g[k, 0], g[k, 1] = _segment(al[k], az[k], bl[k], bz[k], vl, vz)
     return d, t, g
+
+
+@njit(cache=True)
+def polygons(
+    guarded: Array, period: float, vl: Array, vz: Array, starts: NDArray[np.int64],
+    l_ref: Array, sizes: Array, indices: NDArray[np.int64],
+    point_distance: Array, point_normal: Array, point_penalty: Array, point_gradient: Array,
+    link_distance: Array, link_normal: Array, link_penalty: Array, link_gradient: Array,
+    link_t: Array,
+) -> None:  # fmt: skip
+    """Polygons against the k+1 points and k links of ``guarded`` (k+1, 3), as
+    :meth:`~dvqp.geometry.shapes.polygon.Polygon.point_distance` and ``segment_distance``.
+
+    Polygon j has the local vertices ``vl, vz[starts[j]:starts[j + 1]]`` (m), reference
+    ``l_ref[j]`` and penalty size ``sizes[j]`` (m); its results go to row ``indices[j]``
+    (argument order: :mod:`dvqp.geometry.shapes.shape_kernels`).
+    """
+    m = guarded.shape[0]
+    for j in range(indices.shape[0]):
+        row, ref, rho = indices[j], l_ref[j], sizes[j]
+        pvl, pvz = vl[starts[j] : starts[j + 1]], vz[starts[j] : starts[j + 1]]
+        for i in range(m):
+            pl = wrap(guarded[i, 0] - ref, period)
+            d, nl, nz = _point(pl, guarded[i, 1], pvl, pvz)
+            store(point_distance, point_normal, point_penalty, point_gradient, row, i,
+                  d, nl, nz, rho)  # fmt: skip
+        for i in range(m - 1):
+            al = wrap(guarded[i, 0] - ref, period)
+            bl = al + wrap(guarded[i + 1, 0] - guarded[i, 0], period)
+            d, t, nl, nz = _segment(al, guarded[i, 1], bl, guarded[i + 1, 1], pvl, pvz)
+            store(link_distance, link_normal, link_penalty, link_gradient, row, i,
+                  d, nl, nz, rho)  # fmt: skip
+            link_t[row, i] = t
+
+
+def polygon_kernel(
+    shapes: Sequence[Polygon], sizes: Sequence[float], indices: NDArray[np.int64],
+    plan: StepPlan, buffers: ProximityBuffers,
+) -> Kernel:  # fmt: skip
+    """The kernel of :func:`polygons` for ``shapes`` with penalty sizes ``sizes`` (m), their
+    vertices packed once into flat arrays."""
+    counts = [p.local_vertices.shape[0] for p in shapes]
+    starts = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+    vl = np.concatenate([p.local_vertices[:, 0] for p in shapes])
+    vz = np.concatenate([p.local_vertices[:, 1] for p in shapes])
+    l_ref = np.array([p.l_ref for p in shapes], dtype=np.float64)
+    rho = np.array(sizes, dtype=np.float64)
+    args = (plan.state.guarded, plan.period, vl, vz, starts, l_ref, rho, indices)
+    return Kernel(polygons, (*args, *proximity_outputs(buffers)))

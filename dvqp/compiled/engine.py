@@ -1,0 +1,212 @@
+"""The compiled step of a run: evaluate a state, solve, integrate, verify — or hand back.
+
+:func:`compile_step` builds a :class:`CompiledStep` when every part of the resolver's spec
+(tasks, objective terms, limits, obstacle shapes) provides a kernel, the robot's joints are
+revolute or prismatic, and the resolver is the QP or the baseline; otherwise it returns None and
+the run takes the reference path. :meth:`CompiledStep.step` does the common step entirely on
+the plan's buffers: the resolver's answer, integrated and verified exactly against every limit
+(the same values, floors and tolerances as :func:`dvqp.limits.excess.worst_excess`). Whatever
+is not the common step — a QP the backend cannot solve (the relaxed retry, braking), a step
+that breaks a limit (halving), a large step whose straight motion must be checked at interior
+points, a singular configuration — returns None, and the caller runs the reference
+:func:`dvqp.motion.advance.advance` for that step, which decides exactly as before.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from dvqp.compiled.kinematics import CompiledModel
+from dvqp.compiled.pinv import CompiledPinv
+from dvqp.compiled.plan import Kernel, StepPlan
+from dvqp.compiled.qp import CompiledQP
+from dvqp.compiled.solve import Answer, limit_kernels, task_kernels, verifier_kernels
+from dvqp.geometry.obstacle import ObstacleSet
+from dvqp.kinematics.robot import Robot
+from dvqp.kinematics.state import KinematicState
+from dvqp.motion.advance import JOINT_STRIDE
+from dvqp.resolution.pinv import PseudoinverseResolver
+from dvqp.resolution.qp_resolver import QPResolver
+from dvqp.resolution.step import Resolver
+
+Array = NDArray[np.float64]
+
+
+@njit(cache=True)
+def worst_excess(values: Array, floor: Array, tolerance: Array, out: Array) -> None:
+    """``out = [value, ratio]`` of the largest ``(floor − value)/tolerance`` (−inf if none)."""
+    best_v, best_r = -math.inf, -math.inf
+    for i in range(values.shape[0]):
+        over = floor[i] - values[i]
+        ratio = over / tolerance[i]
+        if ratio > best_r:
+            best_v, best_r = over, ratio
+    out[0], out[1] = best_v, best_r
+
+
+@njit(cache=True)
+def integrate(q: Array, qdot: Array, dt: float, out: Array) -> float:
+    """``out = q + dt·Q̇``; returns the largest joint motion ``max |dt·Q̇|``, rad."""
+    largest = 0.0
+    for i in range(q.shape[0]):
+        delta = dt * qdot[i]
+        out[i] = q[i] + delta
+        largest = max(largest, abs(delta))
+    return largest
+
+
+@njit(cache=True)
+def summary(origins, axes, pairs, points, links, out) -> None:  # type: ignore[no-untyped-def]
+    """``out = [tilt, self distance, min clearance, probe clearance]`` of a state, as the
+    recorder's reference diagnostics (rad, m, m, m; inf where nothing is measured)."""
+    m = origins.shape[0] - 1
+    ox, oy = origins[m, 0], origins[m, 1]
+    u = (axes[m, 0] * ox + axes[m, 1] * oy) / math.hypot(ox, oy)
+    out[0] = math.acos(max(-1.0, min(1.0, u)))
+    out[1] = math.inf
+    for p in range(pairs.shape[0]):
+        out[1] = min(out[1], pairs[p])
+    out[2], out[3] = math.inf, math.inf
+    for j in range(points.shape[0]):
+        for i in range(points.shape[1]):
+            out[2] = min(out[2], points[j, i])
+        for i in range(links.shape[1]):
+            out[2] = min(out[2], links[j, i])
+        out[3] = min(out[3], points[j, points.shape[1] - 1], links[j, links.shape[1] - 1])
+
+
+@dataclass
+class CompiledStep:
+    """A resolver's step compiled for one run (see the module docstring; build it with
+    :func:`compile_step`)."""
+
+    robot: Robot
+    plan: StepPlan
+    kinematics: Kernel
+    per_state: list[Kernel]
+    tasks: list[Kernel]
+    solver: CompiledQP | CompiledPinv
+    summary: Kernel
+    resolver: Resolver
+    verify: bool
+    diagnostics: Array
+    """``[tilt, self distance, min clearance, probe clearance]`` of the loaded state."""
+    floor: Array = field(init=False)
+    excess: Array = field(default_factory=lambda: np.zeros(2), init=False)
+    """``[value, ratio]`` of the loaded state's worst excess against the run's start."""
+    _next: Array = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.floor = np.zeros_like(self.plan.stacked["values"])
+        self._next = np.zeros(self.plan.n)
+        self._observers = [
+            limit for limit in self.resolver.spec.limits if hasattr(limit, "observe")
+        ]
+
+    def load(self, q: Array) -> bool:
+        """Evaluate the state at ``q`` into the buffers; False if it is singular."""
+        s = self.plan.state
+        np.copyto(s.q, q)
+        k = self.kinematics
+        if k.function(*k.args) >= 0:
+            return False
+        plan = self.plan
+        plan.objective_value[0] = 0.0
+        plan.objective_gradient.fill(0.0)
+        for kernel in self.per_state:
+            kernel.function(*kernel.args)
+        st = plan.stacked
+        worst_excess(st["values"], self.floor, st["tolerance"], self.excess)
+        k = self.summary
+        k.function(*k.args)
+        return True
+
+    def start(self, q0: Array) -> None:
+        """Load the run's start: its verification floors are ``min(safe, value there)``."""
+        if not self.load(q0):
+            KinematicState.compute(self.robot, q0, self.plan.radius)  # raises the singularity
+        st = self.plan.stacked
+        np.minimum(st["safe"], st["values"], out=self.floor)
+        worst_excess(st["values"], self.floor, st["tolerance"], self.excess)
+        self.solver.reset()
+
+    @property
+    def broken(self) -> bool:
+        """The loaded state breaks a limit by more than its tolerance."""
+        return bool(self.excess[1] > 1.0)
+
+    def step(self, command: Array, dt: float) -> Answer | None:
+        """The common step from the loaded state: solve, integrate, load and verify the end.
+
+        Returns the answer (the buffers then hold the end state), or None: the buffers are
+        then undefined and the caller runs the reference step from the saved ``q`` and loads
+        its end.
+        """
+        plan = self.plan
+        np.copyto(plan.command, command)
+        plan.dt[0] = dt
+        started = time.perf_counter()
+        for kernel in self.tasks:
+            kernel.function(*kernel.args)
+        answer = self.solver.solve()
+        if answer is None:
+            return None
+        answer.solve_time = time.perf_counter() - started
+        largest = integrate(plan.state.q, answer.qdot, dt, self._next)
+        if self.verify and math.ceil(largest / JOINT_STRIDE) - 1 > 0:
+            return None  # a large step: the reference checks its straight motion
+        if not self.load(self._next) or (self.verify and self.broken):
+            return None
+        for limit in self._observers:
+            limit.observe(answer.qdot, dt)
+        return answer
+
+
+def compile_step(
+    robot: Robot, radius: float, resolver: Resolver, obstacles: ObstacleSet, verify: bool
+) -> CompiledStep | None:
+    """The compiled step of ``resolver`` for a run, or None if a part cannot be compiled."""
+    model = CompiledModel.of(robot)
+    if model is None:
+        return None
+    spec = resolver.spec
+    plan = StepPlan(robot.n, robot.n_points, radius)
+    objective = spec.objective.kernels(plan)
+    tasks = task_kernels(spec, plan)
+    verifiers = verifier_kernels(spec, plan)
+    near = plan.proximity(obstacles)
+    if objective is None or tasks is None or verifiers is None or near is None:
+        return None
+    solver = _solver(resolver, plan)
+    if solver is None:
+        return None
+    pairs = plan.self_pairs()
+    diagnostics = np.zeros(4)
+    s = plan.state
+    summary_kernel = Kernel(summary, (s.origins, s.axes, pairs.distance, near.point_distance,
+                                      near.link_distance, diagnostics))  # fmt: skip
+    per_state = [plan.bind(k) for k in (*plan.geometry, *objective, *verifiers)]
+    step = CompiledStep(robot, plan, model.kernel(plan), per_state,
+                        [plan.bind(k) for k in tasks], solver, summary_kernel, resolver,
+                        verify, diagnostics)  # fmt: skip
+    return step
+
+
+def _solver(resolver: Resolver, plan: StepPlan) -> CompiledQP | CompiledPinv | None:
+    spec = resolver.spec
+    gain = spec.objective.gain
+    if isinstance(resolver, PseudoinverseResolver):
+        plan.finalize()
+        return CompiledPinv(spec, plan, resolver.damping, gain)
+    if isinstance(resolver, QPResolver):
+        rows = limit_kernels(spec, plan)
+        if rows is None:
+            return None
+        return CompiledQP(spec, plan, resolver.factory, rows, gain)
+    return None

@@ -1,0 +1,106 @@
+"""The paper's baseline (eq. 18) compiled: pseudoinverse plus null-space projection of ``∇w``."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from dvqp.compiled.plan import StepPlan
+from dvqp.compiled.solve import Answer, task_error
+from dvqp.resolution.pinv import SINGULAR_RCOND
+from dvqp.resolution.spec import StepSpec
+
+Array = NDArray[np.float64]
+
+
+@njit(cache=True)
+def pinv_step(A: Array, b: Array, g: Array, inv_w: Array, damping: float, out: Array) -> int:
+    """``out = W⁻¹g + J̄_W⁺ (ẋ − J̄ W⁻¹ g)`` (see :func:`~dvqp.resolution.pinv.weighted_pinv_step`)
+    by a Cholesky factor of ``J̄ W⁻¹ J̄ᵀ + μ² I``; returns 0, or 1 if that is not (safely)
+    positive definite (the caller then lets the reference path raise its error)."""
+    m, n = A.shape
+    gram, rhs = np.empty((m, m)), np.empty(m)
+    for r in range(m):
+        v = b[r]
+        for c in range(n):
+            v -= A[r, c] * inv_w[c] * g[c]
+        rhs[r] = v
+        for s in range(r + 1):
+            acc = 0.0
+            for c in range(n):
+                acc += A[r, c] * inv_w[c] * A[s, c]
+            gram[r, s] = acc
+        gram[r, r] += damping * damping
+    lo, hi = math.inf, 0.0
+    for j in range(m):  # Cholesky, lower, in place
+        d = gram[j, j]
+        for p in range(j):
+            d -= gram[j, p] * gram[j, p]
+        if not d > 0.0:
+            return 1
+        piv = math.sqrt(d)
+        gram[j, j] = piv
+        lo, hi = min(lo, d), max(hi, d)
+        for r in range(j + 1, m):
+            v = gram[r, j]
+            for p in range(j):
+                v -= gram[r, p] * gram[j, p]
+            gram[r, j] = v / piv
+    if damping == 0.0 and lo <= SINGULAR_RCOND * hi:
+        return 1
+    for r in range(m):  # forward then back substitution
+        v = rhs[r]
+        for p in range(r):
+            v -= gram[r, p] * rhs[p]
+        rhs[r] = v / gram[r, r]
+    for r in range(m - 1, -1, -1):
+        v = rhs[r]
+        for p in range(r + 1, m):
+            v -= gram[p, r] * rhs[p]
+        rhs[r] = v / gram[r, r]
+    for c in range(n):
+        v = g[c]
+        for r in range(m):
+            v += A[r, c] * rhs[r]
+        out[c] = inv_w[c] * v
+    return 0
+
+
+class CompiledPinv:
+    """The baseline's step (diagonal ``W``, no soft tasks) in one kernel.
+
+    Parameters
+    ----------
+    spec, plan
+        The run's spec and plan.
+    damping
+        ``μ``.
+    gain
+        ``λ``.
+    """
+
+    def __init__(self, spec: StepSpec, plan: StepPlan, damping: float, gain: float) -> None:
+        self.plan = plan
+        self.inv_w = 1.0 / spec.diagonal(plan.n)
+        self.damping = damping
+        self.gain = gain
+        self.g = np.zeros(plan.n)
+        self.x = np.zeros(plan.n)
+
+    def solve(self) -> Answer | None:
+        """The baseline step (the tasks' rows are written already); None if the Gram matrix
+        is (nearly) singular."""
+        plan, st = self.plan, self.plan.stacked
+        np.multiply(plan.objective_gradient, self.gain, out=self.g)
+        started = time.perf_counter()
+        if pinv_step(st["A"], st["b"], self.g, self.inv_w, self.damping, self.x) != 0:
+            return None
+        spent = time.perf_counter() - started
+        return Answer(self.x, task_error(st["A"], st["b"], self.x), None, spent)
+
+    def reset(self) -> None:
+        """Nothing to forget."""

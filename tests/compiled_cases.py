@@ -1,0 +1,114 @@
+"""Obstacle sets and configurations shared by the compiled-kernel tests.
+
+Each case is a robot, a pipe radius, an obstacle set and configurations near a start
+configuration. The mixed sets are built around the guarded points of their start state, the
+shape classes interleaved (circle, band, circle, polygon, inlet, ...), so that small offsets
+put points and links inside every class and the rows of a class are not contiguous.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+import dvqp
+from dvqp import KinematicState, ObstacleSet, Robot
+from dvqp.compiled import Kernel, StepPlan
+from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon, Shape
+from tests.common import LINK_LENGTHS, PIPE_RADIUS, Q0
+
+SCENES = Path(__file__).resolve().parent.parent / "scenes"
+BUNDLED_WITH_OBSTACLES = ("paper-two-inlets", "paper-inlets", "pipe-rack", "many-obstacles")
+SEAM_SHIFT = 2.6
+"""rad added to joint 1 (the carriage round the pipe) so that body point 4 sits at l ≈ πR."""
+
+
+@dataclass(frozen=True)
+class Case:
+    """A robot in a pipe of ``radius`` (m) among ``obstacles``, near ``q0`` (rad)."""
+
+    robot: Robot
+    radius: float
+    obstacles: ObstacleSet
+    q0: NDArray[np.float64]
+
+    def configurations(self, count: int, spread: float, seed: int = 0) -> NDArray[np.float64]:
+        """``q0`` and ``count − 1`` uniform offsets of at most ``spread`` rad, (count, n)."""
+        rng = np.random.default_rng(seed)
+        offsets = rng.uniform(-spread, spread, size=(count, self.q0.shape[0]))
+        offsets[0] = 0.0
+        return self.q0 + offsets
+
+    def state(self, q: NDArray[np.float64]) -> KinematicState:
+        """The reference kinematics at ``q``."""
+        return KinematicState.compute(self.robot, q, self.radius)
+
+
+class Dot(Circle):
+    """A circle class without a compiled kernel (:meth:`Shape.kernel` returns None)."""
+
+    kernel = classmethod(Shape.kernel.__func__)  # type: ignore[assignment, attr-defined]
+
+
+def scene_case(name: str) -> Case:
+    """A bundled scene's robot, pipe, obstacles and start configuration."""
+    scene = dvqp.load_scene(SCENES / f"{name}.toml")
+    return Case(scene.robot, scene.pipe_radius, scene.obstacles, np.array(scene.q0))
+
+
+def mixed_case(robot: Robot, seam: bool = False) -> Case:
+    """Shapes of every class, interleaved, around the guarded points at the start (with
+    ``seam``: the arm turned round the pipe so that it straddles ``l = ±πR``)."""
+    q0 = np.array(Q0)
+    if seam:
+        q0[0] += SEAM_SHIFT
+    g = KinematicState.compute(robot, q0, PIPE_RADIUS).guarded[:, :2]
+    period = 2.0 * math.pi * PIPE_RADIUS
+    link3 = g[3] + 0.5 * np.array([_wrap(g[4, 0] - g[3, 0], period), g[4, 1] - g[3, 1]])
+    link1 = g[1] + 0.5 * np.array([_wrap(g[2, 0] - g[1, 0], period), g[2, 1] - g[1, 1]])
+    box = np.array([[-0.03, -0.02], [0.035, -0.025], [0.03, 0.03], [-0.025, 0.02]])
+    shapes = [
+        Circle(g[1] + [0.01, -0.02], 0.05, 20.0),
+        Band(g[2, 1] - 0.03, g[2, 1] + 0.02, 10.0),
+        Circle(link3 + np.array([0.0, 0.01]), 0.04, 15.0),
+        Polygon(g[4] + box, 5.0),
+        Inlet(g[0] + [0.02, 0.01], 0.06, PIPE_RADIUS, 8.0),
+        Circle(g[0] + [-0.4, 0.3], 0.03, 3.0),  # never reached
+        Polygon(link1 + 1.5 * box[::-1], 12.0),  # clockwise
+        Band(g[5, 1] + 0.005, g[5, 1] + 0.04, 2.0),
+        Inlet(g[3] + [0.01, -0.015], 0.05, PIPE_RADIUS, 6.0),
+    ]
+    return Case(robot, PIPE_RADIUS, ObstacleSet(shapes), q0)
+
+
+def paper_robot() -> Robot:
+    """The paper's 13-DOF arm."""
+    return Robot.ndt13(LINK_LENGTHS)
+
+
+def run(plan: StepPlan, kernels: list[Kernel]) -> None:
+    """Bind and call ``kernels`` in order."""
+    for kernel in kernels:
+        bound = plan.bind(kernel)
+        bound.function(*bound.args)
+
+
+def spoil(*arrays: NDArray[np.float64]) -> None:
+    """Fill ``arrays`` with NaN, so that an entry a kernel forgets shows."""
+    for a in arrays:
+        a.fill(np.nan)
+
+
+def bound_kernels(plan: StepPlan, build: Callable[[StepPlan], list[Kernel]]) -> list[Kernel]:
+    """``build(plan)``, then the plan's geometry kernels followed by those, bound."""
+    kernels = build(plan)
+    return [plan.bind(k) for k in (*plan.geometry, *kernels)]
+
+
+def _wrap(dl: float, period: float) -> float:
+    return (dl + 0.5 * period) % period - 0.5 * period
