@@ -1,8 +1,6 @@
 """``python -m dvqp``: the command line (see :mod:`dvqp.cli`)."""
 
-import sys
-
-from dvqp.cli import main
+from dvqp.cli.main import command
 
 if __name__ == "__main__":
-    sys.exit(main())
+    command()

@@ -80,6 +80,7 @@ def plan(
     limits: Sequence[Limit] = (),
     progress: Callable[[int, int], None] | None = None,
     engine: str = "auto",
+    notice: Callable[[str], None] | None = None,
 ) -> Trajectory:
     """Run a scene with a resolver and return its trajectory.
 
@@ -100,6 +101,9 @@ def plan(
     engine
         ``"auto"`` (compiled where every part has a kernel), ``"compiled"`` or
         ``"reference"``: see :func:`dvqp.motion.simulate.simulate`.
+    notice
+        Called with one line if compiling the step takes long (the first run of a
+        composition); see :func:`dvqp.motion.simulate.simulate`.
 
     Raises
     ------
@@ -113,7 +117,7 @@ def plan(
     traj = simulate(
         scene.robot, scene.pipe_radius, resolver, scene.q0, c.velocity, scene.dt,
         obstacles=scene.obstacles, reference=c.reference[:-1] if c.feedback_gain > 0 else None,
-        feedback_gain=c.feedback_gain, progress=progress, engine=engine,
+        feedback_gain=c.feedback_gain, progress=progress, engine=engine, notice=notice,
     )  # fmt: skip
     error = dv_error(c.reference, traj.tool, scene.pipe_radius)
     return dataclasses.replace(traj, tracking_error=error, scene_text=scene.text)

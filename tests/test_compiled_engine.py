@@ -122,3 +122,23 @@ def test_a_part_without_a_kernel_sends_the_run_to_the_reference_path() -> None:
 def test_an_unknown_engine_is_refused() -> None:
     with pytest.raises(ParameterError, match="engine"):
         dvqp.plan(scene("paper-two-inlets"), "pinv", engine="fast")
+
+
+class _ScaledOrbitalLevel(dvqp.objective.OrbitalLevel):
+    """Overrides the math but not the kernel: its inherited kernel would be wrong."""
+
+    def evaluate(self, state: KinematicState) -> dvqp.Term:
+        term = super().evaluate(state)
+        return dvqp.Term(2.0 * term.value, 2.0 * term.gradient)
+
+
+def test_a_subclass_that_changes_the_math_but_not_the_kernel_is_not_compiled() -> None:
+    s = scene("paper-two-inlets")
+    spec = s.spec()
+    terms = (_ScaledOrbitalLevel(0.08), *spec.objective.terms[1:])
+    objective = dvqp.Objective(terms, gain=spec.objective.gain)
+    custom = dvqp.StepSpec(spec.tasks, objective, spec.limits, spec.weights, spec.task_weight)
+    resolver = make_resolver("daqp", custom)
+    assert compile_step(s.robot, s.pipe_radius, resolver, s.obstacles, True) is None
+    assert compile_step(s.robot, s.pipe_radius, make_resolver("daqp", spec), s.obstacles,
+                        True) is not None  # fmt: skip

@@ -239,8 +239,8 @@ def test_the_pair_buffers_are_the_reference_pairs(robot: Robot, state0: Kinemati
         expected = pair_distances(np.ascontiguousarray(state.origins), i, j)
         for got, want in zip(
             (pairs.distance, pairs.normal, pairs.s, pairs.t), expected, strict=True
-        ):
-            np.testing.assert_array_equal(got, want)
+        ):  # the same kernel, compiled in another caller: LLVM may round differently
+            np.testing.assert_allclose(got, want, rtol=0, atol=1e-15)
 
 
 def test_the_scalar_damper_value_is_damper_rhs_bit_for_bit() -> None:

@@ -30,7 +30,8 @@ if TYPE_CHECKING:
 
 FIELDS = (
     "scene", "file", "backend", "success", "steps", "failures", "relaxed", "braking", "substepped",
-    "median_step_us", "p95_step_us", "ratio_to_pinv", "max_task_error", "min_clearance",
+    "median_step_us", "p95_step_us", "median_solver_us", "median_rest_us", "median_iterations",
+    "compiled_steps", "ratio_to_pinv", "max_task_error", "min_clearance",
     "closest", "min_probe_clearance", "min_tilt", "min_self_distance", "closest_pair",
     "max_joint_acceleration", "max_limit_excess", "worst_limit",
     "max_joint_limit_violation", "max_velocity_limit_violation", "final_tracking_error", "error",
@@ -65,7 +66,9 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
         (steps not solved or that broke a limit even in substeps); ``relaxed`` (steps whose
         task gave way to a limit) and ``braking`` (steps where the limits conflicted among
         themselves and the arm slowed down toward rest); ``substepped`` (steps split to keep
-        a limit); median and 95th-percentile full step time (µs); the largest task error
+        a limit); median and 95th-percentile full step time (µs), the medians of the solver
+        call alone and of the rest of the step (µs), of the solver's iterations, and the
+        number of steps the compiled path took (``compiled_steps``); the largest task error
         ``‖J̄Q̇ − ẋ‖∞`` of the succeeded steps; the smallest clearance of any guarded part
         (m) and the part and obstacle that have it (``closest``); the probe's own smallest
         clearance (m); the smallest probe tilt from radial (rad); the smallest distance
@@ -89,6 +92,7 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
         "substepped": int(np.sum(traj.substeps > 1)) if traj.substeps.size else None,
         "median_step_us": _finite(np.median(steps_us)) if traj.n_steps else None,
         "p95_step_us": _finite(np.percentile(steps_us, 95)) if traj.n_steps else None,
+        **_solver_figures(traj),
         "ratio_to_pinv": None,
         "max_task_error": _finite(np.max(traj.task_error[ok])) if np.any(ok) else None,
         **_clearances(scene, traj),
@@ -96,6 +100,22 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
         "final_tracking_error": final_errors(traj)[0] if traj.tracking_error.size else None,
         "final_tool": [float(v) for v in traj.tool[-1]],
         "error": why,
+    }
+
+
+def _solver_figures(traj: Trajectory) -> Row:
+    """Medians of the solver call alone (µs), of the rest of the step (µs) and of the solver's
+    iterations (None where not reported), and the steps the compiled path took."""
+    if not traj.n_steps or not traj.solver_time.size:
+        return {"median_solver_us": None, "median_rest_us": None, "median_iterations": None,
+                "compiled_steps": None}  # fmt: skip
+    solver_us = traj.solver_time * 1e6
+    counted = traj.iterations[traj.iterations >= 0]
+    return {
+        "median_solver_us": _finite(np.median(solver_us)),
+        "median_rest_us": _finite(np.median(traj.step_time * 1e6 - solver_us)),
+        "median_iterations": _finite(np.median(counted)) if counted.size else None,
+        "compiled_steps": int(traj.compiled.sum()) if traj.compiled.size else None,
     }
 
 

@@ -21,7 +21,9 @@ if TYPE_CHECKING:
 TABLE = (  # (row key, header, format)
     ("scene", "scene", "{}"), ("backend", "backend", "{}"), ("success", "ok", "{}"),
     ("steps", "steps", "{}"), ("median_step_us", "med us", "{:.0f}"),
-    ("p95_step_us", "p95 us", "{:.0f}"), ("ratio_to_pinv", "x pinv", "{:.2f}"),
+    ("p95_step_us", "p95 us", "{:.0f}"), ("median_solver_us", "solver us", "{:.1f}"),
+    ("median_rest_us", "rest us", "{:.1f}"), ("median_iterations", "iters", "{:.0f}"),
+    ("ratio_to_pinv", "x pinv", "{:.2f}"),
     ("max_task_error", "task err", "{:.1e}"), ("min_clearance", "clearance m", "{:+.4f}"),
     ("closest", "closest", "{}"), ("min_self_distance", "self m", "{:.3f}"),
     ("max_joint_acceleration", "qdd", "{:.3g}"), ("max_limit_excess", "excess", "{:.2g}"),
@@ -84,7 +86,10 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         f"acceleration    max |qdd| {_num(row['max_joint_acceleration'], '{:.3g} rad/s^2')}",
         f"limits          {_worst(row, bool(traj.limits_kept.all()))}",
         f"step time       median {_num(row['median_step_us'], '{:.0f}')} us, "
-        f"p95 {_num(row['p95_step_us'], '{:.0f}')} us",
+        f"p95 {_num(row['p95_step_us'], '{:.0f}')} us ({_steps_compiled(row)})",
+        f"solver          {_num(row['median_solver_us'], '{:.1f}')} us a step in the solver "
+        f"call ({_num(row['median_iterations'], '{:.0f}')} iterations), "
+        f"{_num(row['median_rest_us'], '{:.1f}')} us the rest (medians)",
         f"final tool DV   l = {tool[0]:.4f} m, z = {tool[1]:.4f} m, h = {tool[2]:.4f} m, "
         f"alpha = {tool[3]:.4f} rad",
     ]
@@ -95,6 +100,13 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
     if output is not None:
         lines.append(f"saved           {output}")
     return "\n".join(lines)
+
+
+def _steps_compiled(row: Row) -> str:
+    """``"compiled 759 of 759 steps"``."""
+    if row["compiled_steps"] is None:
+        return "compiled -"
+    return f"compiled {row['compiled_steps']} of {row['steps']} steps"
 
 
 def _result(row: Row) -> str:

@@ -25,10 +25,14 @@ class Kernel:
 
     ``args`` may hold :class:`Slot` placeholders (rows of the stacked ``G``/``h``/``A``/``b``
     or a slice of the verification values), replaced by array views in :meth:`StepPlan.bind`.
+    Arguments are arrays (float64 of 1–3 dimensions, int64 vectors, bool matrices; C-contiguous
+    so that :func:`~dvqp.compiled.fusion.fuse` can pack them) and Python scalars. A ``checked``
+    kernel returns an int: −1 when all is well, anything else stops the sequence it runs in.
     """
 
     function: Callable[..., Any]
     args: tuple[Any, ...]
+    checked: bool = False
 
 
 @dataclass(frozen=True)

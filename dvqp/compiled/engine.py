@@ -16,17 +16,20 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from dvqp.compiled.fusion import fuse
 from dvqp.compiled.kinematics import CompiledModel
 from dvqp.compiled.pinv import CompiledPinv
 from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.compiled.qp import CompiledQP
-from dvqp.compiled.solve import Answer, limit_kernels, task_kernels, verifier_kernels
+from dvqp.compiled.record import sample_kernel
+from dvqp.compiled.solve import Answer, finish, limit_kernels, task_kernels, verifier_kernels
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
@@ -51,17 +54,6 @@ def worst_excess(values: Array, floor: Array, tolerance: Array, out: Array) -> N
 
 
 @njit(cache=True)
-def integrate(q: Array, qdot: Array, dt: float, out: Array) -> float:
-    """``out = q + dt·Q̇``; returns the largest joint motion ``max |dt·Q̇|``, rad."""
-    largest = 0.0
-    for i in range(q.shape[0]):
-        delta = dt * qdot[i]
-        out[i] = q[i] + delta
-        largest = max(largest, abs(delta))
-    return largest
-
-
-@njit(cache=True)
 def summary(origins, axes, pairs, points, links, out) -> None:  # type: ignore[no-untyped-def]
     """``out = [tilt, self distance, min clearance, probe clearance]`` of a state, as the
     recorder's reference diagnostics (rad, m, m, m; inf where nothing is measured)."""
@@ -81,51 +73,56 @@ def summary(origins, axes, pairs, points, links, out) -> None:  # type: ignore[n
         out[3] = min(out[3], points[j, points.shape[1] - 1], links[j, links.shape[1] - 1])
 
 
+@njit(cache=True)
+def clear(value: Array, gradient: Array) -> None:
+    """Zero the objective's accumulators before its terms add to them."""
+    value[0] = 0.0
+    gradient[:] = 0.0
+
+
 @dataclass
 class CompiledStep:
     """A resolver's step compiled for one run (see the module docstring; build it with
-    :func:`compile_step`)."""
+    :func:`compile_step`).
+
+    Attributes
+    ----------
+    evaluate : callable
+        One fused call evaluating the state at ``plan.state.q``: kinematics, geometry,
+        objective, verification values, worst excess, diagnostics; −1, or the index of a
+        singular frame.
+    prepare : callable
+        One fused call writing the tasks' rows and the solver's data (the QP, or the
+        baseline's step); −1, or a failure status.
+    excess : ndarray, shape (2,)
+        ``[value, ratio]`` of the loaded state's worst excess against the run's start.
+    diagnostics : ndarray, shape (4,)
+        ``[tilt, self distance, min clearance, probe clearance]`` of the loaded state.
+    """
 
     robot: Robot
     plan: StepPlan
-    kinematics: Kernel
-    per_state: list[Kernel]
-    tasks: list[Kernel]
-    solver: CompiledQP | CompiledPinv
-    summary: Kernel
     resolver: Resolver
     verify: bool
+    solver: CompiledQP | CompiledPinv
+    evaluate: Callable[[], int]
+    prepare: Callable[[], int]
+    floor: Array
+    excess: Array
     diagnostics: Array
-    """``[tilt, self distance, min clearance, probe clearance]`` of the loaded state."""
-    floor: Array = field(init=False)
-    excess: Array = field(default_factory=lambda: np.zeros(2), init=False)
-    """``[value, ratio]`` of the loaded state's worst excess against the run's start."""
-    _next: Array = field(init=False)
+    index: NDArray[np.int64]
+    """Row of the recorder's sample arrays that :attr:`evaluate` writes (if it records)."""
+    _finish: Array = field(default_factory=lambda: np.zeros(2), init=False)
 
     def __post_init__(self) -> None:
-        self.floor = np.zeros_like(self.plan.stacked["values"])
-        self._next = np.zeros(self.plan.n)
         self._observers = [
             limit for limit in self.resolver.spec.limits if hasattr(limit, "observe")
         ]
 
     def load(self, q: Array) -> bool:
         """Evaluate the state at ``q`` into the buffers; False if it is singular."""
-        s = self.plan.state
-        np.copyto(s.q, q)
-        k = self.kinematics
-        if k.function(*k.args) >= 0:
-            return False
-        plan = self.plan
-        plan.objective_value[0] = 0.0
-        plan.objective_gradient.fill(0.0)
-        for kernel in self.per_state:
-            kernel.function(*kernel.args)
-        st = plan.stacked
-        worst_excess(st["values"], self.floor, st["tolerance"], self.excess)
-        k = self.summary
-        k.function(*k.args)
-        return True
+        np.copyto(self.plan.state.q, q)
+        return self.evaluate() == -1
 
     def start(self, q0: Array) -> None:
         """Load the run's start: its verification floors are ``min(safe, value there)``."""
@@ -133,7 +130,7 @@ class CompiledStep:
             KinematicState.compute(self.robot, q0, self.plan.radius)  # raises the singularity
         st = self.plan.stacked
         np.minimum(st["safe"], st["values"], out=self.floor)
-        worst_excess(st["values"], self.floor, st["tolerance"], self.excess)
+        self.evaluate()  # again, against the floors: the excess (and sample) of the start
         self.solver.reset()
 
     @property
@@ -152,16 +149,20 @@ class CompiledStep:
         np.copyto(plan.command, command)
         plan.dt[0] = dt
         started = time.perf_counter()
-        for kernel in self.tasks:
-            kernel.function(*kernel.args)
-        answer = self.solver.solve()
+        status = self.prepare()
+        prepared = time.perf_counter()
+        answer = self.solver.solve(status)
         if answer is None:
             return None
         answer.solve_time = time.perf_counter() - started
-        largest = integrate(plan.state.q, answer.qdot, dt, self._next)
-        if self.verify and math.ceil(largest / JOINT_STRIDE) - 1 > 0:
+        if self.solver.solves_in_prepare:  # the baseline's linear algebra ran in prepare
+            answer.solver_time = prepared - started
+        st, out = plan.stacked, self._finish
+        finish(st["A"], st["b"], answer.qdot, plan.state.q, dt, out)
+        answer.task_error = float(out[0])
+        if self.verify and out[1] > JOINT_STRIDE:
             return None  # a large step: the reference checks its straight motion
-        if not self.load(self._next) or (self.verify and self.broken):
+        if self.evaluate() != -1 or (self.verify and self.broken):
             return None
         for limit in self._observers:
             limit.observe(answer.qdot, dt)
@@ -169,9 +170,14 @@ class CompiledStep:
 
 
 def compile_step(
-    robot: Robot, radius: float, resolver: Resolver, obstacles: ObstacleSet, verify: bool
-) -> CompiledStep | None:
-    """The compiled step of ``resolver`` for a run, or None if a part cannot be compiled."""
+    robot: Robot, radius: float, resolver: Resolver, obstacles: ObstacleSet, verify: bool,
+    samples: Mapping[str, np.ndarray] | None = None,
+) -> CompiledStep | None:  # fmt: skip
+    """The compiled step of ``resolver`` for a run, or None if a part cannot be compiled.
+
+    ``obstacles`` are those whose clearances the diagnostics measure; ``samples`` (the
+    recorder's arrays, :data:`dvqp.compiled.record.SAMPLED`), if given, receive every
+    evaluated state at row :attr:`CompiledStep.index`."""
     model = CompiledModel.of(robot)
     if model is None:
         return None
@@ -186,16 +192,24 @@ def compile_step(
     solver = _solver(resolver, plan)
     if solver is None:
         return None
-    pairs = plan.self_pairs()
-    diagnostics = np.zeros(4)
-    s = plan.state
-    summary_kernel = Kernel(summary, (s.origins, s.axes, pairs.distance, near.point_distance,
-                                      near.link_distance, diagnostics))  # fmt: skip
-    per_state = [plan.bind(k) for k in (*plan.geometry, *objective, *verifiers)]
-    step = CompiledStep(robot, plan, model.kernel(plan), per_state,
-                        [plan.bind(k) for k in tasks], solver, summary_kernel, resolver,
-                        verify, diagnostics)  # fmt: skip
-    return step
+    pairs, st, s = plan.self_pairs(), plan.stacked, plan.state
+    floor, excess, diagnostics = np.zeros_like(st["values"]), np.zeros(2), np.zeros(4)
+    evaluate = [
+        model.kernel(plan),
+        Kernel(clear, (plan.objective_value, plan.objective_gradient)),
+        *plan.geometry, *objective, *verifiers,
+        Kernel(worst_excess, (st["values"], floor, st["tolerance"], excess)),
+        Kernel(summary, (s.origins, s.axes, pairs.distance, near.point_distance,
+                         near.link_distance, diagnostics)),
+    ]  # fmt: skip
+    index = np.zeros(1, dtype=np.int64)
+    if samples is not None:
+        value = plan.objective_value
+        evaluate.append(sample_kernel(index, samples, s, value, excess, diagnostics))
+    prepare = [plan.bind(k) for k in tasks] + solver.kernels
+    return CompiledStep(robot, plan, resolver, verify, solver,
+                        fuse([plan.bind(k) for k in evaluate]), fuse(prepare), floor, excess,
+                        diagnostics, index)  # fmt: skip
 
 
 def _solver(resolver: Resolver, plan: StepPlan) -> CompiledQP | CompiledPinv | None:

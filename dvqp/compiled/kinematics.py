@@ -108,12 +108,15 @@ class CompiledModel:
         """The kernel filling ``plan.state`` from ``plan.state.q``; it returns −1, or the index
         of a frame on the pipe axis (singular)."""
         s = plan.state
-        work = np.zeros((self.parents.shape[0] + 2, 4, 4))  # oMi, then scratch
+        count = self.parents.shape[0]
+        work = np.zeros((count + 2, 4, 4))  # oMi, then two scratch transforms
+        world = np.zeros((count, 3))  # the joints' motion axes in the base frame
         return Kernel(
             kinematics,
             (self.parents, self.placements, self.kinds, self.axes, self.index, self.frame_joint,
-             self.frame_placement, self.support, work, plan.radius, s.q, s.origins, s.axes,
+             self.frame_placement, self.support, work, world, plan.radius, s.q, s.origins, s.axes,
              s.frame_jacobians, s.guarded, s.guarded_jacobians, s.tool, s.tool_jacobian),
+            checked=True,
         )  # fmt: skip
 
 
@@ -156,8 +159,9 @@ def _compose(a: Array, b: Array, out: Array) -> None:
 
 
 @njit(cache=True)
-def _frames(parents, placements, kinds, axes, index, q, work, scratch) -> None:  # type: ignore[no-untyped-def]
-    """``work[j] = oMi[j]`` for every joint (``scratch``: (2, 4, 4))."""
+def _frames(parents, placements, kinds, axes, index, q, work, scratch, world) -> None:  # type: ignore[no-untyped-def]
+    """``work[j] = oMi[j]`` and ``world[j]`` its motion axis in the base frame, for every
+    joint (``scratch``: (2, 4, 4))."""
     motion, placed = scratch[0], scratch[1]
     work[0] = 0.0
     for r in range(4):
@@ -166,19 +170,20 @@ def _frames(parents, placements, kinds, axes, index, q, work, scratch) -> None: 
         _motion(kinds[j], axes[j], q[index[j]], motion)
         _compose(work[parents[j]], placements[j], placed)
         _compose(placed, motion, work[j])
+        rot, u = work[j], axes[j]
+        for r in range(3):
+            world[j, r] = rot[r, 0] * u[0] + rot[r, 1] * u[1] + rot[r, 2] * u[2]
 
 
 @njit(cache=True)
-def _frame_jacobian(f, origin, joint_frames, kinds, axes, index, support, jac) -> None:  # type: ignore[no-untyped-def]
+def _frame_jacobian(f, origin, joint_frames, world, kinds, index, support, jac) -> None:  # type: ignore[no-untyped-def]
     """``[J_v; J_ω]`` (6, n) of the point ``origin`` moved by the joints supporting frame f."""
     jac[:, :] = 0.0
     for j in range(1, kinds.shape[0]):
         if not support[f, j]:
             continue
-        rot, u = joint_frames[j], axes[j]
-        w0 = rot[0, 0] * u[0] + rot[0, 1] * u[1] + rot[0, 2] * u[2]
-        w1 = rot[1, 0] * u[0] + rot[1, 1] * u[1] + rot[1, 2] * u[2]
-        w2 = rot[2, 0] * u[0] + rot[2, 1] * u[1] + rot[2, 2] * u[2]
+        rot = joint_frames[j]
+        w0, w1, w2 = world[j, 0], world[j, 1], world[j, 2]
         c = index[j]
         if kinds[j] == 1:
             jac[0, c], jac[1, c], jac[2, c] = w0, w1, w2
@@ -193,18 +198,19 @@ def _frame_jacobian(f, origin, joint_frames, kinds, axes, index, support, jac) -
 @njit(cache=True)
 def kinematics(  # type: ignore[no-untyped-def]
     parents, placements, kinds, axes, index, frame_joint, frame_placement, support, work,
-    radius, q, origins, frame_axes, frame_jacobians, guarded, guarded_jacobians, tool, tool_jac,
+    world, radius, q, origins, frame_axes, frame_jacobians, guarded, guarded_jacobians, tool,
+    tool_jac,
 ) -> int:  # fmt: skip
     """Frames, Jacobians and DV coordinates in place (see :class:`CompiledModel.kernel`)."""
     count = parents.shape[0]
-    _frames(parents, placements, kinds, axes, index, q, work[:count], work[count:])
+    _frames(parents, placements, kinds, axes, index, q, work[:count], work[count:], world)
     m, n = frame_joint.shape[0], q.shape[0]
     pose = work[count]
     for f in range(m):
         _compose(work[frame_joint[f]], frame_placement[f], pose)
         origins[f] = pose[:3, 3]
         frame_axes[f] = pose[:3, 2]
-        _frame_jacobian(f, origins[f], work, kinds, axes, index, support, frame_jacobians[f])
+        _frame_jacobian(f, origins[f], work, world, kinds, index, support, frame_jacobians[f])
     for f in range(m):
         x, y = origins[f, 0], origins[f, 1]
         rho2 = x * x + y * y

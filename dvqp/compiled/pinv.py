@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-from dvqp.compiled.plan import StepPlan
-from dvqp.compiled.solve import Answer, task_error
+from dvqp.compiled.plan import Kernel, StepPlan
+from dvqp.compiled.solve import Answer, scale
 from dvqp.resolution.pinv import SINGULAR_RCOND
 from dvqp.resolution.spec import StepSpec
 
@@ -20,7 +19,7 @@ Array = NDArray[np.float64]
 @njit(cache=True)
 def pinv_step(A: Array, b: Array, g: Array, inv_w: Array, damping: float, out: Array) -> int:
     """``out = W⁻¹g + J̄_W⁺ (ẋ − J̄ W⁻¹ g)`` (see :func:`~dvqp.resolution.pinv.weighted_pinv_step`)
-    by a Cholesky factor of ``J̄ W⁻¹ J̄ᵀ + μ² I``; returns 0, or 1 if that is not (safely)
+    by a Cholesky factor of ``J̄ W⁻¹ J̄ᵀ + μ² I``; returns −1, or 1 if that is not (safely)
     positive definite (the caller then lets the reference path raise its error)."""
     m, n = A.shape
     gram, rhs = np.empty((m, m)), np.empty(m)
@@ -67,7 +66,7 @@ def pinv_step(A: Array, b: Array, g: Array, inv_w: Array, damping: float, out: A
         for r in range(m):
             v += A[r, c] * rhs[r]
         out[c] = inv_w[c] * v
-    return 0
+    return -1
 
 
 class CompiledPinv:
@@ -76,31 +75,33 @@ class CompiledPinv:
     Parameters
     ----------
     spec, plan
-        The run's spec and plan.
+        The run's spec and plan (finalised).
     damping
         ``μ``.
     gain
         ``λ``.
     """
 
+    solves_in_prepare = True
+    """The step is computed by :attr:`kernels` (fused into the engine's prepare call)."""
+
     def __init__(self, spec: StepSpec, plan: StepPlan, damping: float, gain: float) -> None:
         self.plan = plan
-        self.inv_w = 1.0 / spec.diagonal(plan.n)
-        self.damping = damping
-        self.gain = gain
-        self.g = np.zeros(plan.n)
-        self.x = np.zeros(plan.n)
+        st = plan.stacked
+        g, self.x = np.zeros(plan.n), np.zeros(plan.n)
+        inv_w = 1.0 / spec.diagonal(plan.n)
+        self.kernels = [
+            Kernel(scale, (plan.objective_gradient, gain, g)),
+            Kernel(pinv_step, (st["A"], st["b"], g, inv_w, float(damping), self.x), True),
+        ]
+        """What computes the step once the tasks' rows are written."""
 
-    def solve(self) -> Answer | None:
-        """The baseline step (the tasks' rows are written already); None if the Gram matrix
-        is (nearly) singular."""
-        plan, st = self.plan, self.plan.stacked
-        np.multiply(plan.objective_gradient, self.gain, out=self.g)
-        started = time.perf_counter()
-        if pinv_step(st["A"], st["b"], self.g, self.inv_w, self.damping, self.x) != 0:
+    def solve(self, status: int) -> Answer | None:
+        """The step computed by :attr:`kernels` (``status`` −1), or None if the Gram matrix
+        was (nearly) singular."""
+        if status != -1:
             return None
-        spent = time.perf_counter() - started
-        return Answer(self.x, task_error(st["A"], st["b"], self.x), None, spent)
+        return Answer(self.x, 0.0, None, 0.0)
 
     def reset(self) -> None:
         """Nothing to forget."""

@@ -161,7 +161,7 @@ class StepPlan:
         (finalising the plan on the first call)."""
         self.finalize()
         args = tuple(self._view(a) if isinstance(a, Slot) else a for a in kernel.args)
-        return Kernel(kernel.function, args)
+        return Kernel(kernel.function, args, kernel.checked)
 
     def _allocate(self) -> None:
         s = self._sizes

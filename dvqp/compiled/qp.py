@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 import solvers
 from dvqp.compiled.plan import Kernel, StepPlan
-from dvqp.compiled.solve import Answer, task_error
+from dvqp.compiled.solve import Answer, open_box, scale
 from dvqp.resolution.spec import StepSpec
 
 Array = NDArray[np.float64]
@@ -64,13 +64,15 @@ class CompiledQP:
         ``λ``.
     """
 
+    solves_in_prepare = False
+    """:attr:`kernels` only assemble the QP; :meth:`solve` calls the backend."""
+
     def __init__(
         self, spec: StepSpec, plan: StepPlan, factory: Callable[[], solvers.Backend],
         rows: list[Kernel], gain: float,
     ) -> None:  # fmt: skip
         self.plan = plan
-        self.rows = [plan.bind(k) for k in rows]
-        self.gain = gain
+        plan.finalize()
         n, st = plan.n, plan.stacked
         m, p = st["A"].shape[0], st["G"].shape[0]
         self.cost = np.zeros(n)
@@ -92,16 +94,19 @@ class CompiledQP:
         )  # fmt: skip
         self.strict_backend, self.relaxed_backend = factory(), factory()
         self.brake = np.zeros(n)
+        self.kernels = [
+            Kernel(scale, (plan.objective_gradient, -gain, self.cost)),
+            Kernel(open_box, (plan.lb, plan.ub)),
+            *(plan.bind(k) for k in rows),
+        ]
+        """What assembles the QP once the tasks' rows are written: the cost, the bounds and
+        the limits' rows."""
 
-    def solve(self) -> Answer | None:
-        """Assemble (the tasks' rows are written already) and solve this step's QP: strict,
-        else relaxed, else braking; None when even braking is impossible (crossed bounds)."""
+    def solve(self, status: int) -> Answer | None:
+        """Solve this step's QP (assembled by :attr:`kernels`, whose ``status`` is −1):
+        strict, else relaxed, else braking; None when even braking is impossible (crossed
+        bounds)."""
         plan = self.plan
-        np.multiply(plan.objective_gradient, -self.gain, out=self.cost)
-        plan.lb.fill(-math.inf)
-        plan.ub.fill(math.inf)
-        for kernel in self.rows:
-            kernel.function(*kernel.args)
         strict = self.problem
         solution = self.strict_backend.solve(strict)
         spent, status = solution.solver_time, "optimal"
@@ -118,8 +123,7 @@ class CompiledQP:
             x, status = self.brake, "braking"
         else:
             x = solution.x[: plan.n]
-        error = task_error(strict.A, strict.b, x)
-        return Answer(x, error, solution.iterations, spent, status)
+        return Answer(x, 0.0, solution.iterations, spent, status)
 
     def reset(self) -> None:
         """Forget the backends' warm starts."""

@@ -76,6 +76,32 @@ def verifier_kernels(spec: StepSpec, plan: StepPlan) -> list[Kernel] | None:
 
 
 @njit(cache=True)
+def scale(source: Array, factor: float, out: Array) -> None:
+    """``out = factor · source`` (e.g. the QP's linear cost ``−λ ∂w/∂Q``)."""
+    for i in range(source.shape[0]):
+        out[i] = factor * source[i]
+
+
+@njit(cache=True)
+def open_box(lb: Array, ub: Array) -> None:
+    """``lb = −inf``, ``ub = +inf``: the bounds kernels then intersect into them."""
+    for i in range(lb.shape[0]):
+        lb[i], ub[i] = -np.inf, np.inf
+
+
+@njit(cache=True)
+def finish(A: Array, b: Array, x: Array, q: Array, dt: float, out: Array) -> None:
+    """``out = [‖A x − b‖∞, max |dt·x|]`` and ``q += dt·x`` (the step integrated in place)."""
+    out[0] = task_error(A, b, x)
+    largest = 0.0
+    for i in range(q.shape[0]):
+        delta = dt * x[i]
+        q[i] += delta
+        largest = max(largest, abs(delta))
+    out[1] = largest
+
+
+@njit(cache=True)
 def task_error(A: Array, b: Array, x: Array) -> float:
     """``‖A x − b‖∞`` over the first ``A.shape[1]`` entries of x."""
     worst = 0.0

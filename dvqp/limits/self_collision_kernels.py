@@ -31,18 +31,22 @@ def pair_distances_into(
     eps = 1e-18
     for m in range(pi.shape[0]):
         a, b, c, d = o[pi[m]], o[pi[m] + 1], o[pj[m]], o[pj[m] + 1]
-        d1, d2, r = b - a, d - c, a - c
-        aa, e, f = d1 @ d1, d2 @ d2, d2 @ r
+        d1x, d1y, d1z = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+        d2x, d2y, d2z = d[0] - c[0], d[1] - c[1], d[2] - c[2]
+        rx, ry, rz = a[0] - c[0], a[1] - c[1], a[2] - c[2]
+        aa = d1x * d1x + d1y * d1y + d1z * d1z
+        e = d2x * d2x + d2y * d2y + d2z * d2z
+        f = d2x * rx + d2y * ry + d2z * rz
         if aa <= eps and e <= eps:
             s, t = 0.0, 0.0
         elif aa <= eps:
             s, t = 0.0, min(max(f / e, 0.0), 1.0)
         else:
-            cc = d1 @ r
+            cc = d1x * rx + d1y * ry + d1z * rz
             if e <= eps:
                 s, t = min(max(-cc / aa, 0.0), 1.0), 0.0
             else:
-                bb = d1 @ d2
+                bb = d1x * d2x + d1y * d2y + d1z * d2z
                 denom = aa * e - bb * bb
                 s = min(max((bb * f - cc * e) / denom, 0.0), 1.0) if denom > eps * aa * e else 0.0
                 t = (bb * s + f) / e
@@ -50,9 +54,12 @@ def pair_distances_into(
                     s, t = min(max(-cc / aa, 0.0), 1.0), 0.0
                 elif t > 1.0:
                     s, t = min(max((bb - cc) / aa, 0.0), 1.0), 1.0
-        diff = (a + s * d1) - (c + t * d2)
-        dist[m] = np.sqrt(diff @ diff)
-        normal[m] = diff / max(dist[m], 1e-15)
+        x = (a[0] + s * d1x) - (c[0] + t * d2x)
+        y = (a[1] + s * d1y) - (c[1] + t * d2y)
+        z = (a[2] + s * d1z) - (c[2] + t * d2z)
+        dist[m] = np.sqrt(x * x + y * y + z * z)
+        scale = max(dist[m], 1e-15)
+        normal[m, 0], normal[m, 1], normal[m, 2] = x / scale, y / scale, z / scale
         ss[m], tt[m] = s, t
 
 

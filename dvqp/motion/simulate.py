@@ -7,7 +7,9 @@ toward a DV reference: ``ẋ = ẋ_d + K·(x_d − x)`` with l and α difference
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import contextlib
+import threading
+from collections.abc import Callable, Iterator
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -28,7 +30,26 @@ from dvqp.resolution.step import Resolver
 ENGINES = ("auto", "compiled", "reference")
 """How :func:`simulate` steps: see its ``engine`` parameter."""
 
-__all__ = ["ENGINES", "dv_error", "simulate"]
+COMPILE_NOTICE_SECONDS = 1.0
+"""s: compiling the step for longer than this is announced through ``notice``."""
+COMPILE_NOTICE = "compiling the step (first run; cached after)"
+
+__all__ = ["COMPILE_NOTICE", "ENGINES", "dv_error", "simulate"]
+
+
+@contextlib.contextmanager
+def _noticed(notice: Callable[[str], None] | None) -> Iterator[None]:
+    """Call ``notice`` if the block still runs after :data:`COMPILE_NOTICE_SECONDS`."""
+    if notice is None:
+        yield
+        return
+    timer = threading.Timer(COMPILE_NOTICE_SECONDS, notice, (COMPILE_NOTICE,))
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
 
 
 def _check_commands(
@@ -62,6 +83,7 @@ def simulate(
     max_halvings: int = MAX_HALVINGS,
     progress: Callable[[int, int], None] | None = None,
     engine: str = "auto",
+    notice: Callable[[str], None] | None = None,
 ) -> Trajectory:
     """Run the commands from ``q0`` and return the trajectory.
 
@@ -93,6 +115,10 @@ def simulate(
         ``"auto"``: the compiled step (:mod:`dvqp.compiled`) when every part of the run has a
         kernel, else the reference path; ``"compiled"`` (raise if it cannot be compiled) or
         ``"reference"`` (Pinocchio and NumPy, the path the compiled one is tested against).
+    notice
+        Called with one line (e.g. for a progress bar) if compiling the step takes longer than
+        :data:`COMPILE_NOTICE_SECONDS`: the first run of a composition of tasks, terms, limits
+        and shapes compiles it; later runs load it from the cache.
 
     Notes
     -----
@@ -118,8 +144,11 @@ def simulate(
     record = TrajectoryRecorder(cmd.shape[0], robot.n, robot.n_points, obstacles)
     run = Run(robot, radius, resolver, q_start, cmd, ref, gain, dt, check, max_halvings, record,
               progress)  # fmt: skip
-    compiled = None if engine == "reference" else compile_step(robot, radius, resolver,
-                                                                  obstacles, check)  # fmt: skip
+    compiled = (
+        None
+        if engine == "reference"
+        else compile_step(robot, radius, resolver, obstacles, check, samples=record.arrays)
+    )
     if compiled is None and engine == "compiled":
         raise ParameterError("engine", "a part of this run has no compiled kernel")
     if compiled is None:

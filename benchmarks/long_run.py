@@ -1,0 +1,81 @@
+"""A 10 000-step JOG with DAQP, recording included: wall time once compiled, and memory.
+
+Usage::
+
+    python benchmarks/long_run.py [--steps 10000] [--backend daqp] [--repeat 3]
+
+The scene is ``scenes/paper-two-inlets.toml`` with its JOG replaced by a back-and-forth along
+the weld (±5 cm/s, 1 s each way) long enough for ``--steps`` steps of 5 ms. A first run pays
+compiling (or loading the compiled code from the cache); the next ``--repeat`` runs are timed
+(``dvqp.plan`` as a whole: set-up, every step, the trajectory). Memory is traced with
+``tracemalloc`` over one run of N and one of 2N steps: the peak beyond the trajectory's own
+arrays must not grow with the number of steps.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+
+import dvqp
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def scene_with(steps: int) -> dvqp.Scene:
+    """The paper scene with a back-and-forth JOG of ``steps`` steps of 5 ms."""
+    text = (ROOT / "scenes" / "paper-two-inlets.toml").read_text(encoding="utf-8")
+    head = re.split(r"\n\[\[motion\.jog\]\]", text)[0]
+    seconds = steps * 0.005
+    legs = []
+    for i in range(int(np.ceil(seconds))):
+        sign = 1.0 if i % 2 == 0 else -1.0
+        duration = min(1.0, seconds - i)
+        legs.append(f"\n[[motion.jog]]\nduration = {duration}\n"
+                    f"velocity = [{0.05 * sign}, 0.0, 0.0, 0.0]\n")  # fmt: skip
+    return dvqp.scenes.loads(head + "".join(legs), f"long-{steps}.toml")
+
+
+def traced_peak(scene: dvqp.Scene, backend: str) -> tuple[int, int]:
+    """Peak traced memory of one run (bytes) and its trajectory's array bytes."""
+    tracemalloc.start()
+    traj = dvqp.plan(scene, backend)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    arrays = sum(v.nbytes for v in vars(traj).values() if isinstance(v, np.ndarray))
+    return peak, arrays
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--steps", type=int, default=10_000)
+    parser.add_argument("--backend", default="daqp")
+    parser.add_argument("--repeat", type=int, default=3)
+    args = parser.parse_args(argv)
+    scene = scene_with(args.steps)
+    started = time.perf_counter()
+    first = dvqp.plan(scene, args.backend)
+    print(f"first run (compiles or loads the cache): {time.perf_counter() - started:.3f} s, "
+          f"{first.n_steps} steps, {int(first.compiled.sum())} compiled")  # fmt: skip
+    times = []
+    for _ in range(args.repeat):
+        started = time.perf_counter()
+        traj = dvqp.plan(scene, args.backend)
+        times.append(time.perf_counter() - started)
+    print(f"{traj.n_steps} steps with {args.backend}: median {np.median(times):.3f} s "
+          f"({np.median(times) / traj.n_steps * 1e6:.1f} us/step) over {args.repeat} runs; "
+          f"failed steps {int((~traj.success).sum())}")  # fmt: skip
+    for steps in (args.steps, 2 * args.steps):
+        peak, arrays = traced_peak(scene_with(steps), args.backend)
+        print(f"{steps} steps: traced peak {peak / 1e6:.2f} MB, trajectory arrays "
+              f"{arrays / 1e6:.2f} MB, beyond them {(peak - arrays) / 1e6:.2f} MB")  # fmt: skip
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,192 @@
+"""Several kernels in one compiled call: a generated driver over one bag of arrays.
+
+Calling a numba function from Python unboxes each array argument (about 50 ns each): a
+step's twenty kernels with some ninety arrays would spend more time crossing into compiled
+code than computing. :func:`fuse` packs every argument of a sequence of kernels once into a
+:class:`Bag` (a numba StructRef holding typed lists of the same arrays, shared, not copied,
+and arrays of the scalar arguments), and generates a driver ``driver(bag)`` that calls the
+kernels in order with their arguments taken from the bag: one call, one cheap unboxing.
+
+The driver's source depends only on which kernels run and where their arguments sit in the
+bag, not on the values, so runs of the same composition share it. It is written to a cache
+directory (``$DVQP_CACHE_DIR``, else ``$XDG_CACHE_HOME/dvqp`` or ``~/.cache/dvqp``) under a name
+that is a hash of its source, and compiled with numba's on-disk cache: the first run of a
+composition compiles it (about 1–3 s), later runs load it. Where that is not possible (an
+argument of another type, a kernel that is not a module-level numba function, a cache
+directory that cannot be written), :func:`fuse` returns a plain loop over the kernels instead:
+slower, same results.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import os
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numba
+import numpy as np
+from numba import typed, types
+from numba.core.registry import CPUDispatcher
+from numba.experimental import structref
+
+from dvqp.compiled.buffers import Kernel
+
+KINDS = {
+    (np.dtype(np.float64), 1): "f1",
+    (np.dtype(np.float64), 2): "f2",
+    (np.dtype(np.float64), 3): "f3",
+    (np.dtype(np.int64), 1): "i1",
+    (np.dtype(np.bool_), 1): "b1",
+    (np.dtype(np.bool_), 2): "b2",
+}
+"""Array kinds a bag holds (dtype, ndim -> field), C-contiguous only."""
+_FIELDS = (*KINDS.values(), "fs", "ns")
+
+
+@structref.register
+class BagType(types.StructRef):
+    """numba type of :class:`Bag`."""
+
+    def preprocess_fields(self, fields):  # type: ignore[no-untyped-def]
+        return tuple((name, types.unliteral(typ)) for name, typ in fields)
+
+
+class Bag(structref.StructRefProxy):
+    """Typed lists of arrays (one per kind of :data:`KINDS`), the float scalars ``fs`` and
+    the integer scalars ``ns`` of a fused sequence of kernels."""
+
+    def __new__(cls, *fields: Any) -> Bag:
+        return structref.StructRefProxy.__new__(cls, *fields)  # type: ignore[no-any-return]
+
+
+structref.define_proxy(Bag, BagType, list(_FIELDS))
+
+_ITEM_TYPES = {
+    "f1": types.float64[::1],
+    "f2": types.float64[:, ::1],
+    "f3": types.float64[:, :, ::1],
+    "i1": types.int64[::1],
+    "b1": types.boolean[::1],
+    "b2": types.boolean[:, ::1],
+}
+
+
+def cache_dir() -> Path:
+    """Where generated drivers (and numba's cache of them) are kept."""
+    found = os.environ.get("DVQP_CACHE_DIR")
+    if found:
+        return Path(found)
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "dvqp"
+
+
+def _place(arg: Any, lists: dict[str, list[Any]], fs: list[float], ns: list[int]) -> str | None:
+    """Put one argument in the bag; its expression in the driver, or None if unsupported
+    (supported: the arrays of :data:`KINDS`, bool, int and float scalars, tuples of floats)."""
+    if isinstance(arg, np.ndarray):
+        kind = KINDS.get((arg.dtype, arg.ndim))
+        if kind is None or not arg.flags.c_contiguous:
+            return None
+        # a read-only array is a constant of the run (dvqp freezes its parameters): packed as
+        # a copy, since the bag's lists hold writable arrays
+        lists[kind].append(arg if arg.flags.writeable else arg.copy())
+        return f"{kind}[{len(lists[kind]) - 1}]"
+    if isinstance(arg, bool | np.bool_):
+        ns.append(int(arg))
+        return f"ns[{len(ns) - 1}] != 0"
+    if isinstance(arg, int | np.integer):
+        ns.append(int(arg))
+        return f"ns[{len(ns) - 1}]"
+    if isinstance(arg, float | np.floating):
+        fs.append(float(arg))
+        return f"fs[{len(fs) - 1}]"
+    if isinstance(arg, tuple) and arg and all(isinstance(a, float) for a in arg):
+        items = [_place(a, lists, fs, ns) for a in arg]
+        return f"({', '.join(items)},)"  # type: ignore[arg-type]
+    return None
+
+
+def _source(kernels: Sequence[Kernel], lists: dict[str, list[Any]], fs: list[float],
+            ns: list[int]) -> str | None:  # fmt: skip
+    """The driver's source, filling the bag's lists; None if a kernel cannot be fused."""
+    head = ["from numba import njit", ""]
+    body = [f"    {k} = bag.{k}" for k in _FIELDS]
+    for i, kernel in enumerate(kernels):
+        f = kernel.function
+        py = getattr(f, "py_func", None)
+        if not isinstance(f, CPUDispatcher) or py is None:
+            return None
+        if getattr(sys.modules.get(py.__module__), py.__name__, None) is not f:
+            return None
+        head.append(f"from {py.__module__} import {py.__name__} as _k{i}")
+        args = [_place(a, lists, fs, ns) for a in kernel.args]
+        if any(a is None for a in args):
+            return None
+        call = f"_k{i}({', '.join(args)})"  # type: ignore[arg-type]
+        if kernel.checked:
+            body += [f"    status = {call}", "    if status != -1:", "        return status"]
+        else:
+            body.append(f"    {call}")
+    return "\n".join([*head, "", "", "@njit(cache=True)", "def driver(bag):", *body,
+                      "    return -1", ""])  # fmt: skip
+
+
+def _load(source: str) -> Callable[..., int] | None:
+    """Write ``source`` under its hash (once) and import its driver; None if impossible."""
+    digest = hashlib.sha256(source.encode()).hexdigest()[:20]
+    folder = cache_dir() / "fused"
+    path = folder / f"driver_{digest}.py"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        if not path.exists():  # never rewritten: numba's cache keys on the file's stamp
+            part = folder / f".driver_{digest}.{os.getpid()}.tmp"
+            part.write_text(source, encoding="utf-8")
+            os.replace(part, path)
+        name = f"dvqp_fused_driver_{digest}"
+        module = sys.modules.get(name)
+        if module is None:
+            spec = importlib.util.spec_from_file_location(name, path)
+            if spec is None or spec.loader is None:
+                return None
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+            sys.modules[name] = module
+    except OSError:
+        return None
+    return module.driver  # type: ignore[no-any-return]
+
+
+def _loop(kernels: Sequence[Kernel]) -> Callable[[], int]:
+    calls = [(k.function, k.args, k.checked) for k in kernels]
+
+    def run() -> int:
+        for function, args, checked in calls:
+            status = function(*args)
+            if checked and status != -1:
+                return int(status)
+        return -1
+
+    return run
+
+
+def fuse(kernels: Sequence[Kernel]) -> Callable[[], int]:
+    """One call running ``kernels`` in order; it returns −1, or the first status other than
+    −1 of a ``checked`` kernel (which stops the sequence there)."""
+    lists: dict[str, list[Any]] = {k: [] for k in KINDS.values()}
+    fs: list[float] = []
+    ns: list[int] = []
+    source = _source(kernels, lists, fs, ns)
+    driver = None if source is None else _load(source)
+    if driver is None:
+        return _loop(kernels)
+    fields = [typed.List.empty_list(_ITEM_TYPES[k]) for k in KINDS.values()]
+    for field, kind in zip(fields, KINDS.values(), strict=True):
+        for array in lists[kind]:
+            field.append(array)
+    bag = Bag(*fields, np.array(fs, dtype=np.float64), np.array(ns, dtype=np.int64))
+    driver.compile((numba.typeof(bag),))  # now, not in the first step (or load the cache)
+    return lambda: driver(bag)  # type: ignore[no-any-return]
