@@ -8,8 +8,9 @@ The scene is ``scenes/paper-two-inlets.toml`` with its JOG replaced by a back-an
 the weld (±5 cm/s, 1 s each way) long enough for ``--steps`` steps of 5 ms. A first run pays
 compiling (or loading the compiled code from the cache); the next ``--repeat`` runs are timed
 (``dvqp.plan`` as a whole: set-up, every step, the trajectory). Memory is traced with
-``tracemalloc`` over one run of N and one of 2N steps: the peak beyond the trajectory's own
-arrays must not grow with the number of steps.
+``tracemalloc`` during one run: the memory in use at a quarter and at three quarters of the
+steps (everything is preallocated: it must not grow per step), and the peak, which includes
+the recorder's arrays and the trajectory built from them at the end.
 """
 
 from __future__ import annotations
@@ -41,14 +42,22 @@ def scene_with(steps: int) -> dvqp.Scene:
     return dvqp.scenes.loads(head + "".join(legs), f"long-{steps}.toml")
 
 
-def traced_peak(scene: dvqp.Scene, backend: str) -> tuple[int, int]:
-    """Peak traced memory of one run (bytes) and its trajectory's array bytes."""
+def traced(scene: dvqp.Scene, backend: str) -> tuple[int, int, int, int]:
+    """Memory in use (bytes) at 1/4 and 3/4 of the steps, the peak, and the trajectory's
+    array bytes."""
+    marks: dict[int, int] = {}
+
+    def progress(k: int, n: int) -> None:
+        if k in (n // 4, 3 * n // 4):
+            marks[k] = tracemalloc.get_traced_memory()[0]
+
     tracemalloc.start()
-    traj = dvqp.plan(scene, backend)
+    traj = dvqp.plan(scene, backend, progress=progress)
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
     arrays = sum(v.nbytes for v in vars(traj).values() if isinstance(v, np.ndarray))
-    return peak, arrays
+    quarter, three = (marks[k] for k in sorted(marks))
+    return quarter, three, peak, arrays
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -70,10 +79,11 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{traj.n_steps} steps with {args.backend}: median {np.median(times):.3f} s "
           f"({np.median(times) / traj.n_steps * 1e6:.1f} us/step) over {args.repeat} runs; "
           f"failed steps {int((~traj.success).sum())}")  # fmt: skip
-    for steps in (args.steps, 2 * args.steps):
-        peak, arrays = traced_peak(scene_with(steps), args.backend)
-        print(f"{steps} steps: traced peak {peak / 1e6:.2f} MB, trajectory arrays "
-              f"{arrays / 1e6:.2f} MB, beyond them {(peak - arrays) / 1e6:.2f} MB")  # fmt: skip
+    quarter, three, peak, arrays = traced(scene, args.backend)
+    growth = (three - quarter) / (traj.n_steps // 2)
+    print(f"memory in use: {quarter / 1e6:.2f} MB at 1/4 of the steps, {three / 1e6:.2f} MB at "
+          f"3/4 ({growth:.1f} bytes per step); peak {peak / 1e6:.2f} MB, the trajectory's "
+          f"arrays {arrays / 1e6:.2f} MB")  # fmt: skip
     return 0
 
 

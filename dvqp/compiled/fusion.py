@@ -2,10 +2,11 @@
 
 Calling a numba function from Python unboxes each array argument (about 50 ns each): a
 step's twenty kernels with some ninety arrays would spend more time crossing into compiled
-code than computing. :func:`fuse` packs every argument of a sequence of kernels once into a
-:class:`Bag` (a numba StructRef holding typed lists of the same arrays, shared, not copied,
-and arrays of the scalar arguments), and generates a driver ``driver(bag)`` that calls the
-kernels in order with their arguments taken from the bag: one call, one cheap unboxing.
+code than computing. :func:`fuse` generates a module with a :class:`Bag` type for the
+kernels' arguments (a numba StructRef holding one tuple of arrays per kind — the same arrays,
+shared, not copied — and arrays of the scalar arguments), a ``pack`` function that builds it
+once, and a driver ``driver(bag)`` that calls the kernels in order with their arguments taken
+from the bag: one call, one cheap unboxing.
 
 The driver's source depends only on which kernels run and where their arguments sit in the
 bag, not on the values, so runs of the same composition share it. It is written to a cache
@@ -29,7 +30,7 @@ from typing import Any
 
 import numba
 import numpy as np
-from numba import typed, types
+from numba import types
 from numba.core.registry import CPUDispatcher
 from numba.experimental import structref
 
@@ -44,34 +45,30 @@ KINDS = {
     (np.dtype(np.bool_), 2): "b2",
 }
 """Array kinds a bag holds (dtype, ndim -> field), C-contiguous only."""
-_FIELDS = (*KINDS.values(), "fs", "ns")
 
 
 @structref.register
 class BagType(types.StructRef):
-    """numba type of :class:`Bag`."""
+    """numba type of :class:`Bag` (its fields are set by each generated module)."""
 
     def preprocess_fields(self, fields):  # type: ignore[no-untyped-def]
         return tuple((name, types.unliteral(typ)) for name, typ in fields)
 
 
 class Bag(structref.StructRefProxy):
-    """Typed lists of arrays (one per kind of :data:`KINDS`), the float scalars ``fs`` and
-    the integer scalars ``ns`` of a fused sequence of kernels."""
-
-    def __new__(cls, *fields: Any) -> Bag:
-        return structref.StructRefProxy.__new__(cls, *fields)  # type: ignore[no-any-return]
+    """One tuple of arrays per kind of :data:`KINDS` in use, the float scalars ``fs`` and the
+    integer scalars ``ns`` of a fused sequence of kernels (built by the generated ``pack``)."""
 
 
-structref.define_proxy(Bag, BagType, list(_FIELDS))
+structref.define_boxing(BagType, Bag)
 
 _ITEM_TYPES = {
-    "f1": types.float64[::1],
-    "f2": types.float64[:, ::1],
-    "f3": types.float64[:, :, ::1],
-    "i1": types.int64[::1],
-    "b1": types.boolean[::1],
-    "b2": types.boolean[:, ::1],
+    "f1": "types.Array(types.float64, 1, 'C')",
+    "f2": "types.Array(types.float64, 2, 'C')",
+    "f3": "types.Array(types.float64, 3, 'C')",
+    "i1": "types.Array(types.int64, 1, 'C')",
+    "b1": "types.Array(types.boolean, 1, 'C')",
+    "b2": "types.Array(types.boolean, 2, 'C')",
 }
 
 
@@ -112,9 +109,10 @@ def _place(arg: Any, lists: dict[str, list[Any]], fs: list[float], ns: list[int]
 
 def _source(kernels: Sequence[Kernel], lists: dict[str, list[Any]], fs: list[float],
             ns: list[int]) -> str | None:  # fmt: skip
-    """The driver's source, filling the bag's lists; None if a kernel cannot be fused."""
-    head = ["from numba import njit", ""]
-    body = [f"    {k} = bag.{k}" for k in _FIELDS]
+    """The module's source, filling the bag's lists; None if a kernel cannot be fused."""
+    head = ["from numba import njit, types", "from numba.experimental import structref", "",
+            "from dvqp.compiled.fusion import BagType", ""]  # fmt: skip
+    body: list[str] = []
     for i, kernel in enumerate(kernels):
         f = kernel.function
         py = getattr(f, "py_func", None)
@@ -131,12 +129,30 @@ def _source(kernels: Sequence[Kernel], lists: dict[str, list[Any]], fs: list[flo
             body += [f"    status = {call}", "    if status != -1:", "        return status"]
         else:
             body.append(f"    {call}")
-    return "\n".join([*head, "", "", "@njit(cache=True)", "def driver(bag):", *body,
-                      "    return -1", ""])  # fmt: skip
+    return "\n".join([*head, *_bag_source(lists), "", "", "@njit(cache=True)", "def driver(bag):",
+                      *(f"    {k} = bag.{k}" for k in _fields(lists)), *body, "    return -1",
+                      ""])  # fmt: skip
 
 
-def _load(source: str) -> Callable[..., int] | None:
-    """Write ``source`` under its hash (once) and import its driver; None if impossible."""
+def _fields(lists: dict[str, list[Any]]) -> list[str]:
+    """The bag's fields: the kinds in use, then the scalars."""
+    return [k for k in KINDS.values() if lists[k]] + ["fs", "ns"]
+
+
+def _bag_source(lists: dict[str, list[Any]]) -> list[str]:
+    """``BAG`` (the StructRef type of this bag) and ``pack(...)``, which builds one."""
+    fields = [f'("{k}", types.UniTuple({_ITEM_TYPES[k]}, {len(lists[k])}))'
+              for k in KINDS.values() if lists[k]]  # fmt: skip
+    fields += ['("fs", types.Array(types.float64, 1, "C"))',
+               '("ns", types.Array(types.int64, 1, "C"))']  # fmt: skip
+    names = _fields(lists)
+    return ["", "BAG = BagType([", *(f"    {f}," for f in fields), "])", "", "",
+            "@njit(cache=True)", f"def pack({', '.join(names)}):", "    bag = structref.new(BAG)",
+            *(f"    bag.{k} = {k}" for k in names), "    return bag"]  # fmt: skip
+
+
+def _load(source: str) -> Any | None:
+    """Write ``source`` under its hash (once) and import it; None if impossible."""
     digest = hashlib.sha256(source.encode()).hexdigest()[:20]
     folder = cache_dir() / "fused"
     path = folder / f"driver_{digest}.py"
@@ -157,7 +173,7 @@ def _load(source: str) -> Callable[..., int] | None:
             sys.modules[name] = module
     except OSError:
         return None
-    return module.driver  # type: ignore[no-any-return]
+    return module
 
 
 def _loop(kernels: Sequence[Kernel]) -> Callable[[], int]:
@@ -180,13 +196,11 @@ def fuse(kernels: Sequence[Kernel]) -> Callable[[], int]:
     fs: list[float] = []
     ns: list[int] = []
     source = _source(kernels, lists, fs, ns)
-    driver = None if source is None else _load(source)
-    if driver is None:
+    module = None if source is None else _load(source)
+    if module is None:
         return _loop(kernels)
-    fields = [typed.List.empty_list(_ITEM_TYPES[k]) for k in KINDS.values()]
-    for field, kind in zip(fields, KINDS.values(), strict=True):
-        for array in lists[kind]:
-            field.append(array)
-    bag = Bag(*fields, np.array(fs, dtype=np.float64), np.array(ns, dtype=np.int64))
+    parts = [tuple(lists[k]) for k in KINDS.values() if lists[k]]
+    bag = module.pack(*parts, np.array(fs, dtype=np.float64), np.array(ns, dtype=np.int64))
+    driver = module.driver
     driver.compile((numba.typeof(bag),))  # now, not in the first step (or load the cache)
     return lambda: driver(bag)  # type: ignore[no-any-return]

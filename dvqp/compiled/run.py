@@ -73,7 +73,7 @@ def _record(record: TrajectoryRecorder, i: int, answer: Answer, elapsed: float) 
     a["task_error"][i] = answer.task_error
     a["iterations"][i] = -1 if answer.iterations is None else answer.iterations
     a["success"][i] = a["compiled"][i] = True
-    record.status.append(answer.status)
+    record.status[i] = answer.status
 
 
 def _reference_step(

@@ -50,7 +50,7 @@ class TrajectoryRecorder:
             "compiled": np.zeros(n_steps, dtype=bool),
             "limits_kept": np.ones(n_steps + 1, dtype=bool),
         }
-        self.status: list[str] = []
+        self.status = np.full(n_steps, "", dtype=object)  # preallocated: no growth per step
 
     def sample(self, k: int, state: KinematicState, w: float, excess: Excess) -> None:
         """Sample k: configuration, tool and body points, objective value, clearances, tilt,
@@ -103,7 +103,7 @@ class TrajectoryRecorder:
         a["task_error"][k], a["success"][k] = step.task_error, step.success
         a["iterations"][k] = -1 if step.iterations is None else step.iterations
         a["substeps"][k] = substeps
-        self.status.append(step.status)
+        self.status[k] = step.status
         if step.success:
             a["qdot"][k] = step.qdot
 
