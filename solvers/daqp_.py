@@ -12,10 +12,26 @@ Warm start: ``Model.update`` keeps the working set of the previous solve when
 is only used on a cold set-up (``primal_start``); the Python ``update`` has no
 way to pass a primal iterate.
 
-Per-step cost: the stacked data ``H``, ``f``, ``[G; A]``, ``bupper``, ``blower`` live in
-buffers allocated at set-up; an update copies the problem's arrays into them in place
-(constant parts, e.g. ``-inf`` lower bounds of the ``G`` rows, are written once) and passes
-``H`` only when ``P`` differs from the kept copy, so DAQP re-factors ``H`` only then.
+Per-step cost (~8 µs on a dvqp-sized QP, of which ~4 µs in DAQP's ``update`` and
+``solve``): the stacked data ``H``, ``f``, ``[G; A]``, ``bupper``, ``blower`` live in one
+buffer allocated at set-up. An update copies the problem's arrays into it in one compiled
+call (:func:`solvers._fast.stack`; constant parts, e.g. ``-inf`` lower bounds of the ``G``
+rows, are written once), which also tells whether ``P`` changed; ``H`` is passed only then,
+so DAQP re-factors it only then. ``bupper``/``blower`` are not passed: the model keeps
+pointers to the very buffers given at set-up (``Model.setup`` does not copy float64
+C-contiguous arrays), and passing ``f`` and ``A`` makes DAQP recompute ``v``, ``M`` and
+then ``d`` from both bounds. Should a DAQP version copy the bounds instead, the stale bounds
+would make the warm answer fail the check, and the cold retry would still solve it right.
+
+The check (:func:`solvers._kkt.stacked`) runs on that buffer, the bitwise copy of the
+problem's data the solve used (DAQP only reads it), with the same compiled code as
+:meth:`Solution.checked <solvers.Solution.checked>` on the problem's own arrays: three
+arrays to pass instead of twelve. ``Model.solve`` returns fresh copies of ``x`` and
+``lam``, which the solution keeps without copying them again (``y``, ``z``, ``z_box`` are
+views of ``lam``). Both compiled calls skip numba's argument typing
+(:func:`solvers._fast.direct`): ``stack`` gets views of the problem's arrays, checked once
+per problem object (:func:`solvers._fast.pinned`; a problem whose arrays do not qualify is
+copied with NumPy), ``stacked`` gets DAQP's answers once the typed call accepted them.
 
 API notes (daqp 0.11): ``Model.update`` silently ignores arrays whose shape
 differs from the set-up (no error), hence the structure key; every array must
@@ -24,14 +40,17 @@ be writable (typed memoryviews reject read-only buffers), which the buffers are.
 
 from __future__ import annotations
 
+from collections.abc import Hashable
 from time import perf_counter
 from typing import Any, ClassVar
 
 import daqp
 import numpy as np
 
-from ._fast import refresh
+from ._fast import EMPTY_MATRIX, EMPTY_VECTOR, direct, pinned, refresh, stack
+from ._kkt import HAS_LB, HAS_UB, MISFITTING, stacked
 from .problem import Problem
+from .solution import Solution, judged
 from .stateful import RawResult, StatefulBackend
 
 #: DAQP exit flags, from DAQP's ``constants.h``.
@@ -48,6 +67,9 @@ EXIT_FLAGS = {
 }
 
 _SENSE_EQUALITY = 5
+#: The compiled calls without numba's argument typing (see _fast.direct): stack gets views
+#: checked by _fast.pinned, stacked this model's answers once the dispatch typed them.
+_STACK, _STACKED = direct(stack), direct(stacked)
 
 
 class DaqpBackend(StatefulBackend):
@@ -68,9 +90,15 @@ class DaqpBackend(StatefulBackend):
     def __init__(self, *, tolerance: float | None = None, **settings: Any) -> None:
         super().__init__(tolerance=tolerance, **settings)
         self._model: Any = None
-        self._ms = self._p = 0  # rows of simple bounds and of G in DAQP's stacking
+        self._n = self._p = self._m = self._ms = 0  # DAQP's n, rows of G, A, simple bounds
+        self._data = np.zeros(0)  # H, f, M, upper, lower one after the other (see _setup)
         self._H = self._M = np.zeros((0, 0))
         self._f = self._upper = self._lower = np.zeros(0)
+        self._layout: tuple[int, ...] = ()  # n, p, m, ms and HAS_LB | HAS_UB as given
+        self._cuts: tuple[slice | None, ...] = ()  # y, z, z_box in DAQP's lam
+        self._bound: Problem | None = None  # the problem whose arguments of stack are kept
+        self._stack: tuple[Any, ...] | None = None
+        self._check: Any = stacked  # _STACKED once this model's answers are known to fit
 
     @classmethod
     def known_settings(cls) -> set[str]:
@@ -78,7 +106,32 @@ class DaqpBackend(StatefulBackend):
         return set(daqp.Model().settings)
 
     def _release(self) -> None:
-        self._model = None
+        self._model = self._bound = self._stack = None
+
+    def _structure_of(self, problem: Problem) -> Hashable:
+        """The base key, kept while the same problem object comes back (it holds the same
+        arrays, whose shapes a trusted problem's caller keeps fixed)."""
+        if problem is self._bound and self._structure is not None:
+            return self._structure
+        return super()._structure_of(problem)
+
+    def _bind(self, problem: Problem) -> None:
+        """Keep the arguments of :func:`~solvers._fast.stack` for ``problem``: views of its
+        arrays (fixed objects, rewritten in place from one solve to the next), or None (copy
+        with NumPy) if one is not a float64 C-contiguous array of the right dimension."""
+        A, G, lb, ub, empty = problem.A, problem.G, problem.lb, problem.ub, EMPTY_VECTOR
+        views = [
+            pinned(array, ndim)
+            for array, ndim in (
+                (problem.P, 2), (problem.q, 1),
+                (EMPTY_MATRIX if A is None else A, 2), (empty if A is None else problem.b, 1),
+                (EMPTY_MATRIX if G is None else G, 2), (empty if G is None else problem.h, 1),
+                (empty if lb is None else lb, 1), (empty if ub is None else ub, 1),
+            )
+        ]  # fmt: skip
+        self._bound = problem
+        fit = all(view is not None for view in views)
+        self._stack = (*views, self._data, *self._layout[:4]) if fit else None
 
     def _fill(self, problem: Problem) -> None:
         """Copy ``q``, ``G``, ``h``, ``A``, ``b``, ``lb``, ``ub`` into the set-up's buffers."""
@@ -96,15 +149,21 @@ class DaqpBackend(StatefulBackend):
         if problem.ub is not None:
             self._upper[:ms] = problem.ub
 
-    def _setup(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
+    def _setup(self, problem: Problem, guess: np.ndarray | None) -> RawResult | Solution:
         n, p, m = problem.n, problem.n_in, problem.n_eq
         ms = n if problem.has_bounds else 0
-        self._ms, self._p, rows = ms, p, ms + p + m
-        self._H = np.array(problem.P)  # DAQP's H, and the reference that tells P changed
-        self._f = np.empty(n)
-        self._M = np.empty((p + m, n))
-        self._upper, self._lower = np.full(rows, np.inf), np.full(rows, -np.inf)
-        self._fill(problem)
+        self._n, self._p, self._m, self._ms, rows = n, p, m, ms, ms + p + m
+        flags = (0 if problem.lb is None else HAS_LB) | (0 if problem.ub is None else HAS_UB)
+        self._layout = (n, p, m, ms, flags)  # the trailing arguments of _kkt.stacked
+        self._cuts = slice(ms + p, None), slice(ms, ms + p), slice(0, ms) if ms else None
+        # One buffer, so that an update passes a single array to the compiled copy.
+        data = self._data = np.empty(n * (n + 1 + p + m) + 2 * rows)
+        ends = np.cumsum([n * n, n, (p + m) * n, rows])
+        H, self._f, M, self._upper, self._lower = np.split(data, ends)
+        self._H, self._M = H.reshape(n, n), M.reshape(p + m, n)
+        self._upper[:], self._lower[:] = np.inf, -np.inf
+        self._bound, self._check = None, stacked
+        self._load(problem)  # H: DAQP's, and the reference that tells P changed
         sense = np.zeros(rows, dtype=np.intc)
         sense[rows - m :] = _SENSE_EQUALITY
         model = daqp.Model()
@@ -124,26 +183,55 @@ class DaqpBackend(StatefulBackend):
         self._model = model
         return self._run(problem, start)
 
-    def _update(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
-        self._fill(problem)
-        H = self._H if refresh(problem.P, self._H) else None
+    def _load(self, problem: Problem) -> int:
+        """Copy ``problem`` into the set-up's buffers; return whether ``P`` changed."""
+        if problem is not self._bound:
+            self._bind(problem)
+        arguments = self._stack
+        changed = -2 if arguments is None else _STACK(*arguments)
+        if changed < 0:
+            self._fill(problem)  # NumPy names a misfit it sees
+            if changed == -1 or problem.P.shape != self._H.shape:
+                raise ValueError("the problem's arrays do not fit the set-up's sizes")
+            changed = refresh(problem.P, self._H)
+        return changed
+
+    def _update(self, problem: Problem, guess: np.ndarray | None) -> RawResult | Solution:
+        if problem is not self._bound:
+            self._bind(problem)
+        arguments = self._stack
+        changed = -2 if arguments is None else _STACK(*arguments)
+        if changed < 0:  # the NumPy copy, or the error that names a misfit
+            changed = self._load(problem)
         start = perf_counter()
-        flag = self._model.update(H=H, f=self._f, A=self._M, bupper=self._upper, blower=self._lower)
+        # f and A suffice: DAQP then recomputes v, M and d, reading both bounds through its
+        # pointers to the set-up's buffers, which were rewritten in place.
+        if changed:
+            flag = self._model.update(H=self._H, f=self._f, A=self._M)
+        else:
+            flag = self._model.update(f=self._f, A=self._M)
         if flag < 0:
             return RawResult(None, f"update failed: {EXIT_FLAGS.get(flag, flag)}")
         return self._run(problem, start)
 
-    def _run(self, problem: Problem, start: float) -> RawResult:
+    def _run(self, problem: Problem, start: float) -> Solution:
         x, _, flag, info = self._model.solve()
         solver_time = perf_counter() - start
         lam = info["lam"]
-        ms, p = self._ms, self._p
-        return RawResult(
-            x=x,
-            status=EXIT_FLAGS.get(flag, str(flag)),
-            iterations=info["iterations"],
-            y=lam[ms + p :],
-            z=lam[ms : ms + p],
-            z_box=lam[:ms] if ms else None,
-            solver_time=solver_time,
-        )
+        # The check runs on the copy of the problem's data that the solve used (DAQP only
+        # reads these buffers): the very values it would give on the problem's own arrays.
+        check = self._check
+        try:
+            values = check(self._data, x, lam, *self._layout)
+        except TypeError:  # not float64 vectors: Solution.adopt sorts it out
+            values = MISFITTING
+        else:
+            if check is stacked:  # numba's dispatch typed this model's answers: skip it now
+                self._check = _STACKED
+        y, z, box = self._cuts
+        # Model.solve returns fresh copies of x and lam: the solution keeps them uncopied.
+        return judged(
+            problem, values, x, lam[y], lam[z], None if box is None else lam[box],
+            self.name, self.tolerance, EXIT_FLAGS.get(flag) or str(flag), info["iterations"],
+            solver_time,
+        )  # fmt: skip

@@ -173,3 +173,39 @@ def residuals(
     if point.shape != (problem.n,):
         raise ProblemShapeError(f"x: expected shape ({problem.n},), got {point.shape}")
     return kkt_residuals(problem, point, y, z, z_box)[0]
+
+
+def failed_checks(res: Residuals, tolerance: float, scale: float) -> list[str]:
+    """One phrase per residual above its tolerance, and one if optimality is unchecked.
+
+    Parameters
+    ----------
+    res : Residuals
+        The recomputed residuals.
+    tolerance : float
+        Absolute tolerance on the primal residuals.
+    scale : float
+        Gradient scale ``max(||P x||_inf, ||q||_inf)``; the dual residuals (stationarity,
+        complementarity) are held to ``tolerance * (1 + scale)``.
+
+    Returns
+    -------
+    list of str
+        Empty when the solution is accepted.
+    """
+    dual_tol = tolerance * (1.0 + scale)
+    checks = [
+        ("equality", res.equality, tolerance),
+        ("inequality", res.inequality, tolerance),
+        ("bounds", res.bounds, tolerance),
+        ("stationarity", res.stationarity, dual_tol),
+        ("complementarity", res.complementarity, dual_tol),
+    ]
+    failed = [
+        f"{name} residual {value:.1e} > tol {tol:.2g}"
+        for name, value, tol in checks
+        if value is not None and not value <= tol
+    ]
+    if res.stationarity is None:  # a feasible x is not yet an optimal one
+        failed.append("no multipliers were returned, so optimality cannot be checked")
+    return failed

@@ -8,10 +8,11 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from ._kkt import DUALS, FINITE, MISFIT, MISFITTING
 from .exceptions import ProblemShapeError, SolverFailure
-from .kkt import evaluate
+from .kkt import evaluate, floats, quick
 from .problem import Problem
-from .residuals import Residuals
+from .residuals import Residuals, failed_checks
 
 
 @dataclass(eq=False)
@@ -118,59 +119,60 @@ class Solution:
         Solution
             With ``residuals`` and, on rejection, a one-line ``message``.
         """
-        solution = cls(
-            problem, None, status, False, backend, tolerance, iterations, solve_time,
-            retried=retried, solver_time=solver_time,
-        )  # fmt: skip
+        about = (status, False, backend, tolerance, iterations, solve_time)
+        times = {"retried": retried, "solver_time": solver_time}
         if x is None:
-            solution.message = f"{backend} returned no solution (status {status!r})"
-            return solution
+            message = f"{backend} returned no solution (status {status!r})"
+            return cls(problem, None, *about, message=message, **times)
         try:
             answer = np.array(x, dtype=np.float64)
         except (TypeError, ValueError):
-            solution.message = f"{backend} said {status!r} but x is not a numeric array"
-            return solution
-        solution.x = answer
+            message = f"{backend} said {status!r} but x is not a numeric array"
+            return cls(problem, None, *about, message=message, **times)
         n = problem.q.shape[0]
         if answer.shape != (n,):
-            solution.message = (
-                f"{backend} said {status!r} but x has shape {answer.shape}, expected ({n},)"
-            )
-            return solution
-        solution.y, solution.z, solution.z_box = _floats(y), _floats(z), _floats(z_box)
+            message = f"{backend} said {status!r} but x has shape {answer.shape}, expected ({n},)"
+            return cls(problem, answer, *about, message=message, **times)
+        y, z, z_box = floats(y), floats(z), floats(z_box)
+        values = quick(problem, answer, y, z, z_box)  # None: a misfit, which evaluate names
         try:
-            duals, values = evaluate(problem, answer, solution.y, solution.z, solution.z_box)
+            values = values or evaluate(problem, answer, y, z, z_box)
         except ProblemShapeError:
             if math.isfinite(float(answer.sum())):
                 raise
-            values = (0.0,)
-        if not values[0]:
-            solution.y = solution.z = solution.z_box = None
-            solution.message = f"{backend} said {status!r} but x is not finite"
-            return solution
-        solution._judge(duals, values)
-        return solution
+            values = _NOT_FINITE
+        return _verdict(
+            cls(problem, answer, *about, y, z, z_box, None, "", retried, solver_time), values
+        )
 
-    def _judge(self, duals: bool, values: tuple[float, ...]) -> None:
-        """Set ``residuals``, ``found`` and (on rejection) ``message`` from kernel values."""
-        _, equality, inequality, bounds, stationarity, complementarity, scale = values
-        tolerance = self.tolerance
-        if not duals:
-            self.residuals = Residuals(equality, inequality, bounds)
-        else:
-            self.residuals = Residuals(equality, inequality, bounds, stationarity, complementarity)
-            dual_tol = tolerance * (1.0 + scale)
-            if (
-                equality <= tolerance
-                and inequality <= tolerance
-                and bounds <= tolerance
-                and stationarity <= dual_tol
-                and complementarity <= dual_tol
-            ):
-                self.found = True
-                return
-        failed = _failed_checks(self.residuals, tolerance, scale)
-        self.message = f"{self.backend} said {self.status!r} but {', '.join(failed)}"
+    @classmethod
+    def adopt(
+        cls,
+        problem: Problem,
+        x: np.ndarray | None,
+        *,
+        backend: str,
+        tolerance: float,
+        status: str,
+        iterations: int | None = None,
+        y: np.ndarray | None = None,
+        z: np.ndarray | None = None,
+        z_box: np.ndarray | None = None,
+        solver_time: float = 0.0,
+    ) -> Solution:
+        """:meth:`checked` for arrays handed over: ``x`` becomes the solution's, uncopied.
+
+        For an adapter whose ``x`` is a fresh array that nothing else writes to, and whose
+        multipliers the next solve does not overwrite. When ``x`` and the multipliers are
+        float64 C-contiguous vectors of the problem's sizes, one compiled call checks them
+        with no Python-side conversion; anything else goes through :meth:`checked` (which
+        copies ``x``). Both give the same verdict, residuals and message.
+        """
+        values = None if x is None else quick(problem, x, y, z, z_box)
+        return judged(
+            problem, MISFITTING if values is None else values, x, y, z, z_box,
+            backend, tolerance, status, iterations, solver_time,
+        )  # fmt: skip
 
     @classmethod
     def failure(
@@ -186,18 +188,8 @@ class Solution:
         solver_time: float = 0.0,
     ) -> Solution:
         """Build a solution for a solve that produced no answer at all (e.g. an exception)."""
-        return cls(
-            problem=problem,
-            x=None,
-            status=status,
-            found=False,
-            backend=backend,
-            tolerance=tolerance,
-            solve_time=solve_time,
-            message=message,
-            retried=retried,
-            solver_time=solver_time,
-        )
+        return cls(problem, None, status, False, backend, tolerance, None, solve_time,
+                   message=message, retried=retried, solver_time=solver_time)  # fmt: skip
 
     def require(self) -> np.ndarray:
         """Return ``x`` if the solution was found, else raise :class:`SolverFailure`.
@@ -217,46 +209,85 @@ class Solution:
         return self.x
 
 
-def _floats(value: npt.ArrayLike | None) -> np.ndarray | None:
-    """A multiplier as a float64 C-contiguous array (as given if it already is), or None."""
-    if value is None or (
-        type(value) is np.ndarray and value.dtype == np.float64 and value.flags.c_contiguous
-    ):
-        return value  # type: ignore[return-value]
-    return np.ascontiguousarray(value, dtype=np.float64)
+#: Kernel values standing for a non-finite ``x`` whose multipliers could not be checked.
+_NOT_FINITE = (0.0,) + (math.nan,) * 6
+_ACCEPTABLE = FINITE | DUALS  # the kernel's code of a finite x with every multiplier
+_new = object.__new__
 
 
-def _failed_checks(res: Residuals, tolerance: float, scale: float) -> list[str]:
-    """One phrase per residual above its tolerance, and one if optimality is unchecked.
-
-    Parameters
-    ----------
-    res : Residuals
-        The recomputed residuals.
-    tolerance : float
-        Absolute tolerance on the primal residuals.
-    scale : float
-        Gradient scale ``max(||P x||_inf, ||q||_inf)``; the dual residuals (stationarity,
-        complementarity) are held to ``tolerance * (1 + scale)``.
-
-    Returns
-    -------
-    list of str
-        Empty when the solution is accepted.
-    """
+def _passed(values: tuple[float, ...], tolerance: float) -> Residuals | None:
+    """The residuals of kernel ``values`` that pass every check, else None."""
+    code, equality, inequality, bounds, stationarity, complementarity, scale = values
     dual_tol = tolerance * (1.0 + scale)
-    checks = [
-        ("equality", res.equality, tolerance),
-        ("inequality", res.inequality, tolerance),
-        ("bounds", res.bounds, tolerance),
-        ("stationarity", res.stationarity, dual_tol),
-        ("complementarity", res.complementarity, dual_tol),
-    ]
-    failed = [
-        f"{name} residual {value:.1e} > tol {tol:.2g}"
-        for name, value, tol in checks
-        if value is not None and not value <= tol
-    ]
-    if res.stationarity is None:  # a feasible x is not yet an optimal one
-        failed.append("no multipliers were returned, so optimality cannot be checked")
-    return failed
+    if not (
+        code == _ACCEPTABLE
+        and equality <= tolerance
+        and inequality <= tolerance
+        and bounds <= tolerance
+        and stationarity <= dual_tol
+        and complementarity <= dual_tol
+    ):
+        return None
+    residuals = _new(Residuals)  # a frozen dataclass, filled without its slower __init__
+    residuals.__dict__.update(
+        equality=equality, inequality=inequality, bounds=bounds,
+        stationarity=stationarity, complementarity=complementarity,
+    )  # fmt: skip
+    return residuals
+
+
+def _verdict(solution: Solution, values: tuple[float, ...]) -> Solution:
+    """Set ``residuals``, ``found`` and (on rejection) ``message`` from kernel values."""
+    tolerance = solution.tolerance
+    residuals = _passed(values, tolerance)
+    if residuals is not None:
+        solution.residuals, solution.found = residuals, True
+        return solution
+    code, equality, inequality, bounds, stationarity, complementarity, scale = values
+    if code == _ACCEPTABLE:
+        solution.residuals = Residuals(equality, inequality, bounds, stationarity, complementarity)
+    elif code == FINITE:
+        solution.residuals = Residuals(equality, inequality, bounds)
+    else:
+        solution.y = solution.z = solution.z_box = None
+        solution.message = f"{solution.backend} said {solution.status!r} but x is not finite"
+        return solution
+    failed = failed_checks(solution.residuals, tolerance, scale)
+    solution.message = f"{solution.backend} said {solution.status!r} but {', '.join(failed)}"
+    return solution
+
+
+def judged(
+    problem: Problem,
+    values: tuple[float, ...],
+    x: np.ndarray,
+    y: np.ndarray | None,
+    z: np.ndarray | None,
+    z_box: np.ndarray | None,
+    backend: str,
+    tolerance: float,
+    status: str,
+    iterations: int | None,
+    solver_time: float,
+) -> Solution:
+    """:meth:`Solution.adopt` with the kernel ``values`` an adapter computed itself.
+
+    For an adapter's per-step path: ``values`` come from :func:`solvers._kkt.kernel` or
+    :func:`solvers._kkt.stacked` on ``problem``'s data with ``x``, ``y``, ``z``, ``z_box``
+    (arrays handed over, kept uncopied). On :data:`~solvers._kkt.MISFIT` (e.g. a wrong
+    shape) this is :meth:`Solution.checked`, which copies ``x`` and names the problem.
+    """
+    residuals = _passed(values, tolerance)
+    if residuals is not None:
+        return Solution(problem, x, status, True, backend, tolerance, iterations, 0.0,
+                        y, z, z_box, residuals, "", False, solver_time)  # fmt: skip
+    if values[0] == MISFIT:
+        return Solution.checked(
+            problem, x, backend=backend, tolerance=tolerance, status=status,
+            iterations=iterations, y=y, z=z, z_box=z_box, solver_time=solver_time,
+        )  # fmt: skip
+    return _verdict(
+        Solution(problem, x, status, False, backend, tolerance, iterations, 0.0,
+                 y, z, z_box, None, "", False, solver_time),
+        values,
+    )  # fmt: skip

@@ -5,7 +5,8 @@ gives the direct adapters (``osqp``, ``clarabel``, ``daqp``, ``proxqp``) one
 set-up / update / retry-cold policy: a subclass builds the solver in
 :meth:`~StatefulBackend._setup`, pushes new data into it in
 :meth:`~StatefulBackend._update`, and returns a :class:`RawResult`, which is then
-judged by :meth:`Solution.checked <solvers.Solution.checked>`.
+judged by :meth:`Solution.checked <solvers.Solution.checked>` (or a :class:`Solution` it
+judged itself, e.g. with :meth:`Solution.adopt <solvers.Solution.adopt>`).
 """
 
 from __future__ import annotations
@@ -69,18 +70,20 @@ def check_initvals(problem: Problem, initvals: np.ndarray | None) -> np.ndarray 
 
 
 def solve_guarded(
-    backend: Backend, problem: Problem, run: Callable[..., RawResult], *args: Any
+    backend: Backend, problem: Problem, run: Callable[..., RawResult | Solution], *args: Any
 ) -> Solution:
     """Call ``run(*args)`` and check its result; a solver exception becomes a failed Solution.
 
     Exceptions in :data:`PROGRAMMING_ERRORS` are adapter bugs and raise
     :class:`SolverError` instead. The solution's ``solver_time`` is the result's
-    own ``solver_time`` when the adapter measured it, else the time of ``run``.
+    own ``solver_time`` when the adapter measured it, else the time of ``run``. A
+    :class:`Solution` returned by ``run`` (an adapter that checked its answer itself, see
+    :meth:`Solution.adopt <solvers.Solution.adopt>`) is returned as is.
     """
     start = perf_counter()
     try:
         raw = run(*args)
-    except SolverError:
+    except (SolverError, ProblemShapeError):  # adapter bug, or a problem that is not one
         raise
     except PROGRAMMING_ERRORS as exc:
         raise SolverError(f"{backend.name}: adapter error: {type(exc).__name__}: {exc}") from exc
@@ -93,6 +96,8 @@ def solve_guarded(
             message=f"{backend.name} raised {type(exc).__name__}: {exc}",
             solver_time=perf_counter() - start,
         )
+    if isinstance(raw, Solution):
+        return raw
     solver_time = raw.solver_time
     return Solution.checked(
         problem,
@@ -114,7 +119,8 @@ class StatefulBackend:
     Subclass it to add a backend: define ``name``, ``default_tolerance`` and
     ``default_settings``, and implement :meth:`_setup` (cold: build the solver
     from scratch), :meth:`_update` (warm: push new data into the existing
-    solver), both returning a :class:`RawResult`, and :meth:`_release`;
+    solver), both returning a :class:`RawResult` (or a :class:`Solution` they checked
+    themselves, see :func:`solve_guarded`), and :meth:`_release`;
     override :meth:`_structure_of` when the solver needs more than the problem
     sizes to stay unchanged. If a warm answer fails :meth:`Solution.checked`,
     the problem is solved once more cold and the solution is flagged
@@ -210,11 +216,11 @@ class StatefulBackend:
             problem.ub is not None,
         )
 
-    def _setup(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
+    def _setup(self, problem: Problem, guess: np.ndarray | None) -> RawResult | Solution:
         """Build the solver for ``problem`` from scratch and solve (cold start)."""
         raise NotImplementedError
 
-    def _update(self, problem: Problem, guess: np.ndarray | None) -> RawResult:
+    def _update(self, problem: Problem, guess: np.ndarray | None) -> RawResult | Solution:
         """Push ``problem``'s data into the existing solver and solve (warm start)."""
         raise NotImplementedError
 

@@ -147,7 +147,8 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
     captured = capsys.readouterr()
     lines = captured.out.splitlines()
     assert lines[0].split() == ["scene", "backend", "ok", "steps", "med", "us", "p95", "us",
-                                "solver", "us", "rest", "us", "iters", "x", "pinv", "task", "err", "clearance", "m", "closest", "self", "m",
+                                "solver", "us", "rest", "us", "iters", "x", "pinv", "task",
+                                "err", "clearance", "m", "closest", "self", "m",
                                 "qdd", "excess", "q",
                                 "viol", "rad", "qd", "viol", "rad/s", "relaxed", "split",
                                 "fails"]  # fmt: skip

@@ -49,20 +49,6 @@ if TYPE_CHECKING:
 __all__ = ["format_table", "main"]
 
 
-def command() -> None:
-    """The ``dvqp`` executable: :func:`main`, then exit with its code. After an interrupt
-    (130) the process ends at once, streams flushed, without the interpreter's final clean-up:
-    numba's and LLVM's objects caught mid-way by the interrupt may fail to be destroyed and
-    would print noise (or crash) after ``dvqp: interrupted``."""
-    code = main()
-    if code == 130:
-        for stream in (sys.stdout, sys.stderr):
-            with contextlib.suppress(Exception):
-                stream.flush()
-        os._exit(130)
-    sys.exit(code)
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line with ``argv`` (default ``sys.argv[1:]``); return the exit code."""
     parser = _parser()
