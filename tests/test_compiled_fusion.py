@@ -1,0 +1,98 @@
+"""Fused kernels run as the plain loop does, stop at a checked status, and fall back safely."""
+
+from __future__ import annotations
+
+import signal
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numba import njit
+
+from dvqp.compiled import Kernel
+from dvqp.compiled.fusion import fuse
+from dvqp.compiled.interrupts import deferred
+
+
+@njit(cache=True)
+def add_scaled(source, factor, out):  # type: ignore[no-untyped-def]
+    for i in range(out.shape[0]):
+        out[i] += factor * source[i]
+
+
+@njit(cache=True)
+def status_if_negative(values, limit):  # type: ignore[no-untyped-def]
+    for i in range(values.shape[0]):
+        if values[i] < limit:
+            return i
+    return -1
+
+
+@njit(cache=True)
+def fill_matrix(rows, value, flags, out):  # type: ignore[no-untyped-def]
+    for r in range(out.shape[0]):
+        for c in range(out.shape[1]):
+            out[r, c] = value * rows[r] if flags[r] else 0.0
+
+
+def kernels(source: np.ndarray, out: np.ndarray, matrix: np.ndarray) -> list[Kernel]:
+    rows = np.arange(3, dtype=np.int64)
+    flags = np.array([True, False, True])
+    frozen = np.array([1.0, 2.0, 3.0])
+    frozen.flags.writeable = False  # a constant of the run: packed as a copy
+    return [
+        Kernel(add_scaled, (source, 2.0, out)),
+        Kernel(add_scaled, (frozen, -1.0, out)),
+        Kernel(status_if_negative, (out, -5.0), True),
+        Kernel(fill_matrix, (rows, 0.5, flags, matrix)),
+    ]
+
+
+def test_a_fused_call_equals_the_kernels_called_in_turn() -> None:
+    source, out, matrix = np.array([1.0, -1.0, 4.0]), np.zeros(3), np.zeros((3, 2))
+    run = fuse(kernels(source, out, matrix))
+    assert run() == -1
+    np.testing.assert_array_equal(out, 2.0 * source - [1.0, 2.0, 3.0])
+    np.testing.assert_array_equal(matrix, [[0.0, 0.0], [0.0, 0.0], [1.0, 1.0]])
+    source[:] = [0.0, 1.0, 0.0]  # the arrays are shared, not copied: new data is seen
+    run()
+    np.testing.assert_array_equal(out, [0.0, -4.0, 2.0])  # accumulated over both calls
+
+
+def test_a_checked_kernel_stops_the_sequence_with_its_status() -> None:
+    source, out, matrix = np.array([-9.0, 0.0, 0.0]), np.zeros(3), np.full((3, 2), 7.0)
+    assert fuse(kernels(source, out, matrix))() == 0  # out[0] = -19 < -5
+    assert (matrix == 7.0).all()  # the kernel after it did not run
+
+
+def test_without_a_writable_cache_the_kernels_run_in_a_plain_loop(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("not a directory")
+    monkeypatch.setenv("DVQP_CACHE_DIR", str(blocker))
+    source, out, matrix = np.array([1.0, -1.0, 4.0]), np.zeros(3), np.zeros((3, 2))
+    run = fuse(kernels(source, out, matrix))
+    assert run() == -1
+    np.testing.assert_array_equal(out, 2.0 * source - [1.0, 2.0, 3.0])
+
+
+def test_a_kernel_that_is_not_a_module_level_numba_function_runs_unfused() -> None:
+    calls: list[int] = []
+
+    def python_kernel(out: np.ndarray) -> None:
+        calls.append(1)
+        out[0] = 42.0
+
+    out = np.zeros(3)
+    run = fuse([Kernel(add_scaled, (np.ones(3), 1.0, out)), Kernel(python_kernel, (out,))])
+    assert run() == -1 and calls == [1] and out[0] == 42.0
+
+
+def test_an_interrupt_during_a_deferred_block_is_raised_after_it() -> None:
+    done = []
+    with pytest.raises(KeyboardInterrupt), deferred():
+        signal.raise_signal(signal.SIGINT)
+        done.append("the block ran to its end")
+    assert done == ["the block ran to its end"]
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
