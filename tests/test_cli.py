@@ -352,7 +352,7 @@ def test_ctrl_c_while_saving_leaves_no_half_written_file(
     assert [p.name for p in tmp_path.iterdir()] == ["small.toml"]
 
 
-LONG = "[[motion.jog]]\nduration = 1500.0\nvelocity = [0.0, 0.0, 0.0, 0.0]"  # 3e5 steps, ~3 min
+LONG = "[[motion.jog]]\nduration = 7500.0\nvelocity = [0.0, 0.0, 0.0, 0.0]"  # 1.5e6 steps
 
 
 @pytest.mark.parametrize(
@@ -372,7 +372,7 @@ def test_a_real_sigint_stops_cleanly_with_exit_130(tmp_path: Path, args: list[st
                             stderr=subprocess.PIPE, text=True)  # fmt: skip
     assert proc.stderr is not None
     note = proc.stderr.readline()  # announced before the run starts
-    assert note.startswith(f"dvqp: note: {scene}: about 3e+05 steps"), note
+    assert note.startswith(f"dvqp: note: {scene}: about 1.5e+06 steps"), note
     time.sleep(0.3)
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=60)
@@ -388,7 +388,7 @@ def test_a_run_too_big_for_the_memory_is_refused_before_it_starts(
     scene = write_scene(tmp_path, motion=LONG)
     assert main(["plan", scene, "--backend", "pinv", "-o", str(tmp_path / "t.npz")]) == 2
     assert capsys.readouterr().err == (
-        f"dvqp: {scene}: motion: about 3e+05 steps: roughly 3 min and 0.18 GB, more than this "
+        f"dvqp: {scene}: motion: about 1.5e+06 steps: roughly 2.5 min and 0.9 GB, more than this "
         "machine's 0.1 GB allow: use a larger dt or a shorter motion\n"
     )
     assert [p.name for p in tmp_path.iterdir()] == ["small.toml"]

@@ -26,8 +26,9 @@ from dvqp.motion.jog import jog_step_count
 if TYPE_CHECKING:
     from dvqp import Scene
 
-STEP_SECONDS = 6e-4
-"""Typical time of one step (kinematics, objective and a QP), s: the estimate's rate."""
+STEP_SECONDS = 1e-4
+"""Typical time of one step, s: the estimate's rate. A compiled step with DAQP takes about
+25 µs, the slower backends and steps taken by the reference path a few times more."""
 LONG_RUN_SECONDS = 120.0
 """Runs estimated to take longer than this are announced before they start, s."""
 MEMORY_SHARE = 0.8
