@@ -9,8 +9,9 @@ from dvqp.errors import ParameterError, ShapeError
 
 
 def vector(name: str, value: ArrayLike, n: int | None = None) -> NDArray[np.float64]:
-    """Return ``value`` as a finite float64 vector of length ``n`` (any length if None)."""
-    arr = np.asarray(value, dtype=np.float64)
+    """Return ``value`` as a finite float64 vector of length ``n`` (any length if None), a copy
+    (so that marking it read-only never freezes the caller's array)."""
+    arr = np.array(value, dtype=np.float64)
     if arr.ndim != 1 or (n is not None and arr.shape[0] != n):
         raise ShapeError(name, (-1 if n is None else n,), arr.shape)
     if not np.isfinite(arr).all():

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import importlib
 import signal
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -96,3 +98,44 @@ def test_an_interrupt_during_a_deferred_block_is_raised_after_it() -> None:
         done.append("the block ran to its end")
     assert done == ["the block ran to its end"]
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+KERNEL_SOURCE = """
+from numba import njit
+
+
+@njit(cache=True)
+def scaled(out):
+    out[0] = {factor} * 2.0
+"""
+
+
+def test_a_changed_kernel_gets_a_new_driver_not_the_cached_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("DVQP_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    module = tmp_path / "user_kernels_for_fusion.py"
+    results = []
+    for factor in (3.0, 7.5):
+        module.write_text(KERNEL_SOURCE.format(factor=factor), encoding="utf-8")
+        sys.modules.pop("user_kernels_for_fusion", None)
+        user = importlib.import_module("user_kernels_for_fusion")
+        out = np.zeros(1)
+        fuse([Kernel(user.scaled, (out,))])()
+        results.append(out[0])
+    assert results == [6.0, 15.0]
+    assert len(list((tmp_path / "cache" / "fused").glob("driver_*.py"))) == 2
+
+
+def test_a_cache_folder_others_may_write_is_not_used(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    shared = tmp_path / "shared"
+    shared.mkdir(mode=0o777)
+    shared.chmod(0o777)
+    monkeypatch.setenv("DVQP_CACHE_DIR", str(shared))
+    out = np.zeros(3)
+    fuse([Kernel(add_scaled, (np.ones(3), 1.0, out))])()
+    np.testing.assert_array_equal(out, np.ones(3))  # computed, by the plain loop
+    assert not (shared / "fused").exists()

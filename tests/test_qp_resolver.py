@@ -19,6 +19,7 @@ from dvqp import simulate as run
 from dvqp.errors import BackendError
 from dvqp.limits import (
     AccelerationLimit,
+    Bounds,
     JointPositionLimit,
     JointVelocityLimit,
     ObstacleDamper,
@@ -180,6 +181,26 @@ def test_braking_stays_inside_the_joint_bounds(state0: KinematicState, robot: Ro
     step = resolver.resolve(state0, np.array([0.01, 0, 0, 0]), DT)
     assert step.status == "braking"
     np.testing.assert_allclose(step.qdot, 0.5 - 2.0 * DT)
+
+
+class _Box:
+    """A user's bounds limit (rad/s)."""
+
+    name = "box"
+
+    def __init__(self, lb: float, ub: float) -> None:
+        self.lb, self.ub = lb, ub
+
+    def compute(self, state: KinematicState, dt: float) -> Bounds:
+        return Bounds(np.full(state.n, self.lb), np.full(state.n, self.ub))
+
+
+def test_bounds_that_cross_fail_the_step_and_name_the_joint(state0: KinematicState) -> None:
+    resolver = QPResolver(spec_with(np.zeros(13), limits=(_Box(0.2, 1.0), _Box(-1.0, 0.1))),
+                          "daqp")  # fmt: skip
+    step = resolver.resolve(state0, np.zeros(4), DT)
+    assert not step.success and np.all(step.qdot == 0.0)
+    assert step.status == "failed: the bounds on joint1's velocity cross (0.2 > 0.1 rad/s)"
 
 
 def test_unknown_backend_lists_the_installed_ones(robot: Robot) -> None:

@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from dvqp.compiled import ownership
 from dvqp.compiled.fusion import fuse
 from dvqp.compiled.kinematics import CompiledModel
 from dvqp.compiled.pinv import CompiledPinv
@@ -34,8 +35,10 @@ from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
 from dvqp.motion.advance import JOINT_STRIDE
+from dvqp.objective.objective import Objective
 from dvqp.resolution.pinv import PseudoinverseResolver
 from dvqp.resolution.qp_resolver import QPResolver
+from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 
 Array = NDArray[np.float64]
@@ -48,8 +51,10 @@ def worst_excess(values: Array, floor: Array, tolerance: Array, out: Array) -> N
     for i in range(values.shape[0]):
         over = floor[i] - values[i]
         ratio = over / tolerance[i]
-        if ratio > best_r:
+        if ratio > best_r or ratio != ratio:  # a NaN is the worst (never "kept")
             best_v, best_r = over, ratio
+            if ratio != ratio:
+                break
     out[0], out[1] = best_v, best_r
 
 
@@ -136,7 +141,7 @@ class CompiledStep:
     @property
     def broken(self) -> bool:
         """The loaded state breaks a limit by more than its tolerance."""
-        return bool(self.excess[1] > 1.0)
+        return not self.excess[1] <= 1.0
 
     def step(self, command: Array, dt: float) -> Answer | None:
         """The common step from the loaded state: solve, integrate, load and verify the end.
@@ -215,10 +220,12 @@ def compile_step(
 def _solver(resolver: Resolver, plan: StepPlan) -> CompiledQP | CompiledPinv | None:
     spec = resolver.spec
     gain = spec.objective.gain
-    if isinstance(resolver, PseudoinverseResolver):
+    if not ownership.exact(spec, StepSpec) or not ownership.exact(spec.objective, Objective):
+        return None
+    if ownership.exact(resolver, PseudoinverseResolver):
         plan.finalize()
         return CompiledPinv(spec, plan, resolver.damping, gain)
-    if isinstance(resolver, QPResolver):
+    if ownership.exact(resolver, QPResolver):
         rows = limit_kernels(spec, plan)
         if rows is None:
             return None

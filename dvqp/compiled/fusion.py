@@ -20,9 +20,11 @@ slower, same results.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib.util
 import os
+import stat
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -81,6 +83,44 @@ def cache_dir() -> Path:
     return Path(base) / "dvqp"
 
 
+@functools.cache
+def _package_fingerprint() -> str:
+    """A hash of dvqp's own source and the compiler's versions: a driver compiled against
+    other kernels' code is never reused (numba's cache of a driver only checks the driver's
+    file, not the code it calls)."""
+    digest = hashlib.sha256(f"{numba.__version__} {sys.version}".encode())
+    root = Path(__file__).resolve().parent.parent
+    for path in sorted(root.rglob("*.py")):
+        digest.update(path.read_bytes())
+    return digest.hexdigest()[:20]
+
+
+def _module_fingerprint(module: str) -> str | None:
+    """A hash of a kernel's module source, or None if it has no file (e.g. ``__main__``
+    of an interactive session): such a kernel is not fused."""
+    if module.split(".")[0] == "dvqp":
+        return "dvqp"
+    if module == "__main__":
+        return None
+    path = getattr(sys.modules.get(module), "__file__", None)
+    if path is None:
+        return None
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()[:20]
+    except OSError:
+        return None
+
+
+def _private_folder(folder: Path) -> bool:
+    """Create ``folder`` (mode 0700) if needed; True if it is a directory of this user that
+    nobody else may write (generated code is imported from it), where that can be told."""
+    folder.mkdir(parents=True, exist_ok=True, mode=0o700)
+    info = folder.stat()
+    if not hasattr(os, "getuid"):
+        return True
+    return info.st_uid == os.getuid() and not info.st_mode & (stat.S_IWGRP | stat.S_IWOTH)
+
+
 def _place(arg: Any, lists: dict[str, list[Any]], fs: list[float], ns: list[int]) -> str | None:
     """Put one argument in the bag; its expression in the driver, or None if unsupported
     (supported: the arrays of :data:`KINDS`, bool, int and float scalars, tuples of floats)."""
@@ -112,6 +152,7 @@ def _source(kernels: Sequence[Kernel], lists: dict[str, list[Any]], fs: list[flo
     """The module's source, filling the bag's lists; None if a kernel cannot be fused."""
     head = ["from numba import njit, types", "from numba.experimental import structref", "",
             "from dvqp.compiled.fusion import BagType", ""]  # fmt: skip
+    prints = {"dvqp": _package_fingerprint()}
     body: list[str] = []
     for i, kernel in enumerate(kernels):
         f = kernel.function
@@ -120,6 +161,10 @@ def _source(kernels: Sequence[Kernel], lists: dict[str, list[Any]], fs: list[flo
             return None
         if getattr(sys.modules.get(py.__module__), py.__name__, None) is not f:
             return None
+        found = _module_fingerprint(py.__module__)
+        if found is None:
+            return None
+        prints[py.__module__] = found
         head.append(f"from {py.__module__} import {py.__name__} as _k{i}")
         args = [_place(a, lists, fs, ns) for a in kernel.args]
         if any(a is None for a in args):
@@ -129,7 +174,9 @@ def _source(kernels: Sequence[Kernel], lists: dict[str, list[Any]], fs: list[flo
             body += [f"    status = {call}", "    if status != -1:", "        return status"]
         else:
             body.append(f"    {call}")
-    return "\n".join([*head, *_bag_source(lists), "", "", "@njit(cache=True)", "def driver(bag):",
+    stamp = [f"# {name}: {value}" for name, value in sorted(prints.items())]
+    return "\n".join(["# the code this driver was generated against", *stamp, *head,
+                      *_bag_source(lists), "", "", "@njit(cache=True)", "def driver(bag):",
                       *(f"    {k} = bag.{k}" for k in _fields(lists)), *body, "    return -1",
                       ""])  # fmt: skip
 
@@ -154,14 +201,17 @@ def _bag_source(lists: dict[str, list[Any]]) -> list[str]:
 def _load(source: str) -> Any | None:
     """Write ``source`` under its hash (once) and import it; None if impossible."""
     digest = hashlib.sha256(source.encode()).hexdigest()[:20]
-    folder = cache_dir() / "fused"
-    path = folder / f"driver_{digest}.py"
     try:
-        folder.mkdir(parents=True, exist_ok=True)
+        folder = cache_dir() / "fused"
+        path = folder / f"driver_{digest}.py"
+        if not _private_folder(folder.parent) or not _private_folder(folder):
+            return None
         if not path.exists():  # never rewritten: numba's cache keys on the file's stamp
             part = folder / f".driver_{digest}.{os.getpid()}.tmp"
             part.write_text(source, encoding="utf-8")
             os.replace(part, path)
+        if path.read_text(encoding="utf-8") != source:
+            return None
         name = f"dvqp_fused_driver_{digest}"
         module = sys.modules.get(name)
         if module is None:
@@ -171,7 +221,7 @@ def _load(source: str) -> Any | None:
             module = importlib.util.module_from_spec(spec)
             spec.loader.exec_module(module)
             sys.modules[name] = module
-    except OSError:
+    except Exception:  # no usable cache (no home, a read-only disk, ...): the plain loop
         return None
     return module
 

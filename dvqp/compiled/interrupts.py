@@ -35,6 +35,8 @@ class _Holder:
         if threading.current_thread() is not threading.main_thread():
             return
         if self.depth == 0:
+            if signal.getsignal(signal.SIGINT) is None:  # not installed from Python: leave it
+                return
             self.caught = False
             self.previous = signal.signal(signal.SIGINT, self._hold)
         self.depth += 1

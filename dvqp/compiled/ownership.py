@@ -1,10 +1,11 @@
 """Whether a part's compiled kernel computes what the part itself computes.
 
-A subclass that overrides a part's math (``evaluate``, ``compute``, ``distances``, ...) but not
-its ``kernel`` would inherit a kernel of its base's math. :func:`own_kernel` gives the kernel
-method only if the class that defines it is at least as derived as every class that defines
-the part's math; otherwise (and when the kernel says it cannot be built by raising
-``NotImplementedError``) the run takes the reference path.
+A subclass inherits its base's kernel, which computes its base's math: any override (of
+``evaluate``, ``compute``, ``distances``, a private helper, ...) would make the compiled step
+differ from the part. :func:`own_kernel` therefore trusts a kernel only where the part's own
+class is one of dvqp's (its kernel is tested against its math) or defines the kernel itself (its
+author wrote both); a subclass of either that does not define its own kernel takes the
+reference path. A kernel factory raising ``NotImplementedError`` means the same.
 """
 
 from __future__ import annotations
@@ -20,25 +21,25 @@ SHAPE = ("point_distance", "segment_distance", "batch_points", "batch_segments",
          "size")  # fmt: skip
 
 
-def _owner(cls: type, name: str) -> type | None:
-    for c in cls.__mro__:
-        if name in c.__dict__:
-            return c
-    return None
+def _trusted(cls: type, name: str) -> bool:
+    """``cls`` is one of dvqp's own classes, or defines ``name`` itself."""
+    return cls.__module__.split(".")[0] == "dvqp" or name in cls.__dict__
 
 
-def own_kernel(part: Any, name: str, math: tuple[str, ...]) -> Callable[..., Any] | None:
-    """``part.<name>`` (a kernel factory) if it covers every method in ``math`` that ``part``'s
-    class defines, else None (also when ``part`` has no such method)."""
+def own_kernel(part: Any, name: str, math: tuple[str, ...] = ()) -> Callable[..., Any] | None:
+    """``part.<name>`` (a kernel factory) if the kernel is the part's own (see the module
+    docstring), else None (also when ``part`` has no such method). ``math`` names the methods
+    that make up the part's math (documentation of what a kernel must match)."""
     cls = part if isinstance(part, type) else type(part)
-    owner = _owner(cls, name)
-    if owner is None:
+    if getattr(cls, name, None) is None or not _trusted(cls, name):
         return None
-    for method in math:
-        defined = _owner(cls, method)
-        if defined is not None and not issubclass(owner, defined):
-            return None
     return getattr(part, name)  # type: ignore[no-any-return]
+
+
+def exact(part: Any, *classes: type) -> bool:
+    """``part`` is an instance of one of ``classes`` exactly (not of a subclass, whose
+    overrides the compiled step would not follow)."""
+    return type(part) in classes
 
 
 def build(part: Any, name: str, math: tuple[str, ...], *args: Any) -> tuple[bool, Any]:

@@ -39,6 +39,7 @@ from dvqp.compiled.buffers import (
     Slot,
     StateBuffers,
 )
+from dvqp.errors import ParameterError
 
 if TYPE_CHECKING:
     from dvqp.geometry.obstacle import ObstacleSet
@@ -102,6 +103,8 @@ class StepPlan:
         return 2.0 * np.pi * self.radius
 
     def _slot(self, array: str, count: int) -> Slot:
+        if self.stacked:
+            raise ParameterError(array, "rows asked for after the plan was finalised")
         start = self._sizes.get(array, 0)
         self._sizes[array] = start + count
         return Slot(array, start, start + count)

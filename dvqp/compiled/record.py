@@ -32,7 +32,7 @@ def record_sample(  # type: ignore[no-untyped-def]
     points[k] = guarded[: points.shape[1]]
     w[k] = value[0]
     limit_excess[k] = max(excess[0], 0.0)
-    limits_kept[k] = not excess[1] > 1.0
+    limits_kept[k] = excess[1] <= 1.0
     tilt[k], self_distance[k] = diagnostics[0], diagnostics[1]
     min_clearance[k], probe_clearance[k] = diagnostics[2], diagnostics[3]
 

@@ -91,13 +91,14 @@ def open_box(lb: Array, ub: Array) -> None:
 
 @njit(cache=True)
 def finish(A: Array, b: Array, x: Array, q: Array, dt: float, out: Array) -> None:
-    """``out = [‖A x − b‖∞, max |dt·x|]`` and ``q += dt·x`` (the step integrated in place)."""
+    """``out = [‖A x − b‖∞, max |(q + dt·x) − q|]`` and ``q += dt·x`` (the step integrated in
+    place)."""
     out[0] = task_error(A, b, x)
     largest = 0.0
     for i in range(q.shape[0]):
-        delta = dt * x[i]
-        q[i] += delta
-        largest = max(largest, abs(delta))
+        moved = q[i] + dt * x[i]
+        largest = max(largest, abs(moved - q[i]))  # as the reference measures the step
+        q[i] = moved
     out[1] = largest
 
 

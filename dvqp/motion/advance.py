@@ -138,12 +138,13 @@ def _attempt(ctx: _Context, state: KinematicState, dt: float, depth: int) -> Adv
             raise
         broken = Excess(np.inf, 1.0, "singular configuration", str(exc))
     else:
-        broken = worst_excess(ctx.resolver.spec.limits, ctx.start, after)
-        if ctx.verify and not broken.broken:
+        end = worst_excess(ctx.resolver.spec.limits, ctx.start, after)
+        broken = end
+        if ctx.verify and not broken.broken:  # decides with the interior points too
             broken = _straight(ctx, state, after.q, dt, broken)
         if not ctx.verify or not broken.broken:
             _observe(ctx, step.qdot, dt)
-            return Advance(after, step, 1, broken)
+            return Advance(after, step, 1, end)  # what the sample holds: the end's excess
     if depth >= ctx.max_halvings:
         _observe(ctx, np.zeros(state.n), dt)
         return _failed(state, step, broken, 2**depth)

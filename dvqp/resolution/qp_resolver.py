@@ -21,7 +21,7 @@ from dvqp import _validate
 from dvqp.errors import BackendError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.limit import Bounds
-from dvqp.resolution.qp import StepTerms, build_qp
+from dvqp.resolution.qp import StepTerms, build_qp, limit_rows, step_terms
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Step, check_command
 
@@ -75,7 +75,15 @@ class QPResolver:
         start = time.perf_counter()
         cmd = check_command(command)
         dt = _validate.positive("dt", dt)
-        strict = build_qp(self.spec, state, cmd, dt)
+        parts = (step_terms(self.spec, state, cmd, dt), *limit_rows(self.spec, state, dt))
+        box = parts[2]
+        crossed = np.flatnonzero(box.lb > box.ub)
+        if crossed.size:  # no velocity keeps every bound: nothing to solve
+            i = int(crossed[0])
+            message = (f"failed: the bounds on joint{i + 1}'s velocity cross "
+                       f"({box.lb[i]:.4g} > {box.ub[i]:.4g} rad/s)")  # fmt: skip
+            return Step(np.zeros(state.n), False, message, np.inf, time.perf_counter() - start)
+        strict = build_qp(self.spec, state, cmd, dt, parts=parts)
         solution = self._strict.solve(strict.problem)
         solver_time, status = solution.solver_time, "optimal"
         if not solution.found:
