@@ -5,10 +5,13 @@ Usage::
     python benchmarks/step_benchmark.py [SCENE] [--backends pinv,daqp,...] [--repeat 5]
 
 Each repeat runs the whole scene once per backend, in a rotated order so that drift of the
-machine's speed falls on every backend alike. A "full step" is what ``simulate`` times:
-kinematics, objective, the resolution and the exact check of the integrated step. "resolve" is
-the resolver alone (QP assembly + solve + residual check, or the pseudoinverse), "solver" the
-time inside the QP backend's calls, "rest" the full step less the solver. The peer line is
+machine's speed falls on every backend alike, each run in a fresh process (a backend's side
+effects on a process — HiGHS leaves later backends measurably slower — reach no other run).
+A "full step" is what ``simulate`` times: kinematics, objective, the resolution, the exact
+check of the integrated step and the recording (the compiled step, ``engine="auto"``).
+"resolve" is the resolver alone (QP assembly + solve + residual check, or the
+pseudoinverse), "solver" the time inside the QP backend's own calls (data update and solve),
+"rest" the full step less the solver. The peer line is
 pink's ``solve_ik`` (FrameTask on the tool frame, ConfigurationLimit, VelocityLimit, DAQP) on
 the same Pinocchio model, integration included (``pip install 'dvqp[bench]'``; skipped without
 it). Ratios compare medians measured in this same run. Timing is noisy on a shared machine:
@@ -18,8 +21,10 @@ compare ratios, not absolute numbers across runs.
 from __future__ import annotations
 
 import argparse
+import multiprocessing
 import sys
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -60,6 +65,28 @@ def pink_steps(scene: dvqp.Scene, steps: int) -> np.ndarray | None:
     return times
 
 
+def measure(scene_file: str, name: str) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """One run of ``name``: per-step times (the first step, which pays set-ups, left out) and
+    the reported iterations."""
+    traj = dvqp.plan(dvqp.load_scene(scene_file), name)
+    return {f: getattr(traj, f)[1:] for f in FIELDS}, traj.iterations[traj.iterations >= 0]
+
+
+def pink_steps_of(scene_file: str) -> np.ndarray | None:
+    """:func:`pink_steps` for as many steps as the scene has."""
+    scene = dvqp.load_scene(scene_file)
+    return pink_steps(scene, dvqp.plan(scene, "pinv").n_steps)
+
+
+def isolated(function, *args):  # type: ignore[no-untyped-def]
+    """``function(*args)`` in a fresh process: a backend's side effects on the process (HiGHS
+    leaves the next backends measurably slower in the same process) never reach another's
+    measurement. Compiled code is loaded from the cache, outside the timed steps."""
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=1, mp_context=context) as pool:
+        return pool.submit(function, *args).result()
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("scene", nargs="?", default=str(ROOT / "scenes" / "paper-two-inlets.toml"))
@@ -80,12 +107,11 @@ def main(argv: list[str] | None = None) -> int:
     for r in range(args.repeat):
         order = backends[r % len(backends) :] + backends[: r % len(backends)]
         for name in order:
-            traj = dvqp.plan(scene, name)
+            fields, its = isolated(measure, args.scene, name)
             for f in FIELDS:
-                got[name][f].append(getattr(traj, f)[1:])  # the first step pays set-ups
-            iterations[name].append(traj.iterations[traj.iterations >= 0])
-        n_steps = traj.n_steps
-        found = pink_steps(scene, n_steps)
+                got[name][f].append(fields[f])
+            iterations[name].append(its)
+        found = isolated(pink_steps_of, args.scene)
         if found is not None:
             peer.append(found[1:])
         print(f"repeat {r + 1}/{args.repeat} done", file=sys.stderr)
