@@ -87,9 +87,9 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         f"limits          {_worst(row, bool(traj.limits_kept.all()))}",
         f"step time       median {_num(row['median_step_us'], '{:.0f}')} us, "
         f"p95 {_num(row['p95_step_us'], '{:.0f}')} us ({_steps_compiled(row)})",
-        f"solver          {_num(row['median_solver_us'], '{:.1f}')} us a step in the solver "
-        f"call ({_num(row['median_iterations'], '{:.0f}')} iterations), "
-        f"{_num(row['median_rest_us'], '{:.1f}')} us the rest (medians)",
+        f"solver          {_num(row['median_solver_us'], '{:.1f}')} us a step in the solver's "
+        f"calls, {_num(row['median_rest_us'], '{:.1f}')} us the rest, "
+        f"{_num(row['median_iterations'], '{:.0f}')} iterations (medians)",
         f"final tool DV   l = {tool[0]:.4f} m, z = {tool[1]:.4f} m, h = {tool[2]:.4f} m, "
         f"alpha = {tool[3]:.4f} rad",
     ]
