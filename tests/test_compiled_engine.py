@@ -84,6 +84,14 @@ def test_relaxed_steps_are_compiled_too() -> None:
     assert got.compiled[relaxed].all()
 
 
+def test_the_step_of_a_bundled_scene_is_fused_into_two_generated_drivers() -> None:
+    s = scene("pipe-rack")
+    step = compile_step(s.robot, s.pipe_radius, make_resolver("daqp", s.spec()), s.obstacles,
+                        True)  # fmt: skip
+    assert step is not None
+    assert step.evaluate.fused and step.prepare.fused  # type: ignore[attr-defined]
+
+
 def test_the_baseline_is_compiled_on_every_step() -> None:
     _, got = runs("paper-two-inlets", "pinv")
     assert got.compiled.all()

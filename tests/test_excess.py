@@ -71,3 +71,17 @@ def test_describe_reads_as_one_line() -> None:
     assert e.describe() == "probe/obstacle3 clearance 0.0062 m < 0.01 m (by 3.8 mm)"
     bad = Excess(math.inf, 1.0, "singular configuration", "tool on the pipe axis")
     assert bad.describe() == "singular configuration (tool on the pipe axis)" and bad.broken
+
+
+def test_a_nan_excess_is_broken_and_the_worst() -> None:
+    class Fixed:
+        def __init__(self, excess: Excess) -> None:
+            self.found = excess
+
+        def excess(self, start: object, state: object) -> Excess:
+            return self.found
+
+    nan = Excess(float("nan"), 1e-4, "a/nan")
+    assert nan.broken
+    worst = worst_excess([Fixed(Excess(0.5, 1e-4, "big")), Fixed(nan)], None, None)  # type: ignore[arg-type]
+    assert worst.label == "a/nan"

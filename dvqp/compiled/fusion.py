@@ -84,14 +84,19 @@ def cache_dir() -> Path:
 
 
 @functools.cache
-def _package_fingerprint() -> str:
-    """A hash of dvqp's own source and the compiler's versions: a driver compiled against
-    other kernels' code is never reused (numba's cache of a driver only checks the driver's
-    file, not the code it calls)."""
+def _package_fingerprint() -> str | None:
+    """A hash of the source files of dvqp's loaded modules and the compiler's versions: a
+    driver compiled against other kernels' code is never reused (numba's cache of a driver
+    only checks the driver's file, not the code it calls). None if a file cannot be read (the
+    kernels then run in a plain loop)."""
     digest = hashlib.sha256(f"{numba.__version__} {sys.version}".encode())
-    root = Path(__file__).resolve().parent.parent
-    for path in sorted(root.rglob("*.py")):
-        digest.update(path.read_bytes())
+    files = sorted({str(m.__file__) for name, m in list(sys.modules.items())
+                    if name.split(".")[0] == "dvqp" and getattr(m, "__file__", None)})  # fmt: skip
+    try:
+        for path in files:
+            digest.update(Path(path).read_bytes())
+    except OSError:
+        return None
     return digest.hexdigest()[:20]
 
 
@@ -152,7 +157,10 @@ def _source(kernels: Sequence[Kernel], lists: dict[str, list[Any]], fs: list[flo
     """The module's source, filling the bag's lists; None if a kernel cannot be fused."""
     head = ["from numba import njit, types", "from numba.experimental import structref", "",
             "from dvqp.compiled.fusion import BagType", ""]  # fmt: skip
-    prints = {"dvqp": _package_fingerprint()}
+    package = _package_fingerprint()
+    if package is None:
+        return None
+    prints = {"dvqp": package}
     body: list[str] = []
     for i, kernel in enumerate(kernels):
         f = kernel.function
@@ -201,7 +209,10 @@ def _bag_source(lists: dict[str, list[Any]]) -> list[str]:
 def _load(source: str) -> Any | None:
     """Write ``source`` under its hash (once) and import it; None if impossible."""
     digest = hashlib.sha256(source.encode()).hexdigest()[:20]
-    try:
+    name = f"dvqp_fused_driver_{digest}"
+    if name in sys.modules:
+        return sys.modules[name]
+    try:  # no usable cache (no home, a read-only disk, another's folder): the plain loop
         folder = cache_dir() / "fused"
         path = folder / f"driver_{digest}.py"
         if not _private_folder(folder.parent) or not _private_folder(folder):
@@ -212,17 +223,14 @@ def _load(source: str) -> Any | None:
             os.replace(part, path)
         if path.read_text(encoding="utf-8") != source:
             return None
-        name = f"dvqp_fused_driver_{digest}"
-        module = sys.modules.get(name)
-        if module is None:
-            spec = importlib.util.spec_from_file_location(name, path)
-            if spec is None or spec.loader is None:
-                return None
-            module = importlib.util.module_from_spec(spec)
-            spec.loader.exec_module(module)
-            sys.modules[name] = module
-    except Exception:  # no usable cache (no home, a read-only disk, ...): the plain loop
+    except (OSError, UnicodeError, RuntimeError):  # RuntimeError: Path.home() without a home
         return None
+    spec = importlib.util.spec_from_file_location(name, path)
+    if spec is None or spec.loader is None:
+        return None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)  # an error in the generated code is dvqp's bug: raised
+    sys.modules[name] = module
     return module
 
 
@@ -236,12 +244,14 @@ def _loop(kernels: Sequence[Kernel]) -> Callable[[], int]:
                 return int(status)
         return -1
 
+    run.fused = False  # type: ignore[attr-defined]
     return run
 
 
 def fuse(kernels: Sequence[Kernel]) -> Callable[[], int]:
     """One call running ``kernels`` in order; it returns −1, or the first status other than
-    −1 of a ``checked`` kernel (which stops the sequence there)."""
+    −1 of a ``checked`` kernel (which stops the sequence there). Its attribute ``fused`` says
+    whether it is a generated driver (else a plain loop over the kernels)."""
     lists: dict[str, list[Any]] = {k: [] for k in KINDS.values()}
     fs: list[float] = []
     ns: list[int] = []
@@ -253,4 +263,9 @@ def fuse(kernels: Sequence[Kernel]) -> Callable[[], int]:
     bag = module.pack(*parts, np.array(fs, dtype=np.float64), np.array(ns, dtype=np.int64))
     driver = module.driver
     driver.compile((numba.typeof(bag),))  # now, not in the first step (or load the cache)
-    return lambda: driver(bag)  # type: ignore[no-any-return]
+
+    def run() -> int:
+        return driver(bag)  # type: ignore[no-any-return]
+
+    run.fused = True  # type: ignore[attr-defined]
+    return run

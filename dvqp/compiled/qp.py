@@ -108,6 +108,8 @@ class CompiledQP:
         bounds)."""
         plan = self.plan
         strict = self.problem
+        if not braking(plan.lb, plan.ub, self.brake):  # crossed bounds: the reference fails it
+            return None
         solution = self.strict_backend.solve(strict)
         spent, status = solution.solver_time, "optimal"
         if not solution.found:

@@ -100,7 +100,7 @@ class KinematicState:
         SingularConfigurationError
             A point or the tool lies on the pipe axis.
         """
-        qv = robot.check_q(q).copy()
+        qv = robot.check_q(q)  # a copy
         model, data = robot.model, robot.data
         pin.computeJointJacobians(model, data, qv)
         pin.updateFramePlacements(model, data)

@@ -69,8 +69,8 @@ class Excess:
 
     @property
     def broken(self) -> bool:
-        """Past the bound by more than the tolerance."""
-        return self.value > self.tolerance
+        """Past the bound by more than the tolerance (a NaN value counts as past it)."""
+        return not self.value <= self.tolerance
 
     @property
     def ratio(self) -> float:
@@ -116,6 +116,8 @@ def worst_excess(limits: Iterable[object], start: KinematicState, state: Kinemat
         if check is None:
             continue
         found = check(start, state)
-        if found.ratio > worst.ratio:
+        if found.ratio > worst.ratio or math.isnan(found.ratio):  # a NaN is the worst
             worst = found
+            if math.isnan(found.ratio):
+                break
     return worst
