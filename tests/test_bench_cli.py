@@ -183,6 +183,10 @@ def test_a_real_sigint_stops_cleanly_and_keeps_what_finished(tmp_path: Path) -> 
     if not wired():
         pytest.skip("bench is not wired into dvqp.cli.main yet")
     out, scenes = tmp_path / "a.json", tmp_path / "s"
+    # the first scene's step compiled (or loaded) beforehand: on an empty cache compiling
+    # takes longer than the wait below, and no scene would have finished when Ctrl-C comes
+    warm = [sys.executable, "-m", "dvqp", "bench", "--count", "1", "--backends", "pinv"]
+    assert subprocess.run(warm, capture_output=True, timeout=300).returncode == 0
     argv = ["bench", "--count", "400", "--backends", "pinv", "--json", str(out),
             "--save-scenes", str(scenes)]  # fmt: skip
     proc = subprocess.Popen([sys.executable, "-m", "dvqp", *argv], stdout=subprocess.PIPE,

@@ -83,18 +83,24 @@ def cache_dir() -> Path:
     return Path(base) / "dvqp"
 
 
+def _visible(path: Path, root: Path) -> bool:
+    """No part of ``path`` below ``root`` is hidden (an editor's lock file, ``.git``)."""
+    return not any(part.startswith(".") for part in path.relative_to(root).parts)
+
+
 @functools.cache
 def _package_fingerprint() -> str | None:
-    """A hash of the source files of dvqp's loaded modules and the compiler's versions: a
-    driver compiled against other kernels' code is never reused (numba's cache of a driver
-    only checks the driver's file, not the code it calls). None if a file cannot be read (the
-    kernels then run in a plain loop)."""
+    """A hash of dvqp's source files and the compiler's versions: a driver compiled against
+    other kernels' code is never reused (numba's cache of a driver only checks the driver's
+    file, not the code it calls). The same for every process of one installation (so they
+    share their drivers); None if a file cannot be read (the kernels then run in a plain
+    loop)."""
     digest = hashlib.sha256(f"{numba.__version__} {sys.version}".encode())
-    files = sorted({str(m.__file__) for name, m in list(sys.modules.items())
-                    if name.split(".")[0] == "dvqp" and getattr(m, "__file__", None)})  # fmt: skip
+    root = Path(__file__).resolve().parent.parent
     try:
+        files = sorted(p for p in root.rglob("*.py") if _visible(p, root))
         for path in files:
-            digest.update(Path(path).read_bytes())
+            digest.update(path.read_bytes())
     except OSError:
         return None
     return digest.hexdigest()[:20]
