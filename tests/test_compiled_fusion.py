@@ -13,7 +13,7 @@ from numba import njit
 
 from dvqp.compiled import Kernel
 from dvqp.compiled.fusion import fuse
-from dvqp.compiled.interrupts import deferred
+from dvqp.compiled.interrupts import _CompilerLockListener
 
 
 @njit(cache=True)
@@ -94,12 +94,14 @@ def test_a_kernel_that_is_not_a_module_level_numba_function_runs_unfused() -> No
     assert run() == -1 and calls == [1] and out[0] == 42.0
 
 
-def test_an_interrupt_during_a_deferred_block_is_raised_after_it() -> None:
-    done = []
-    with pytest.raises(KeyboardInterrupt), deferred():
+def test_an_interrupt_while_numba_holds_its_compiler_lock_is_raised_after_it() -> None:
+    listener, done = _CompilerLockListener(), []
+    with pytest.raises(KeyboardInterrupt):
+        listener.on_start(None)  # type: ignore[arg-type]  # numba takes its compiler lock
         signal.raise_signal(signal.SIGINT)
-        done.append("the block ran to its end")
-    assert done == ["the block ran to its end"]
+        done.append("the compilation ran to its end")
+        listener.on_end(None)  # type: ignore[arg-type]  # and releases it
+    assert done == ["the compilation ran to its end"]
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 

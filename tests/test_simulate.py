@@ -1,12 +1,17 @@
 """Offline integration of JOG commands, with and without position feedback."""
 
+import sys
+import time
+from pathlib import Path
+
 import numpy as np
 import pytest
 
+import dvqp
 from dvqp import JogSegment, KinematicState, Obstacle, Robot, jog_commands, simulate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry import min_clearance
-from dvqp.motion.simulate import dv_error
+from dvqp.motion.simulate import COMPILE_NOTICE, dv_error
 from tests.common import PIPE_RADIUS, baseline, objective_with, obstacles_of
 
 DT = 0.005
@@ -79,3 +84,19 @@ def test_bad_commands_raise_typed_errors(robot: Robot, q0: np.ndarray) -> None:
         simulate(robot, PIPE_RADIUS, resolver, q0, np.zeros((5, 4)), DT, reference=np.zeros(4))
     with pytest.raises(ParameterError, match="duration"):
         JogSegment(0.0, np.zeros(4))
+
+
+def test_a_slow_compilation_is_announced_through_notice(monkeypatch: pytest.MonkeyPatch) -> None:
+    module = sys.modules["dvqp.motion.simulate"]  # (dvqp.motion.simulate is the function)
+    real = module.compile_step
+
+    def slow(*args: object, **kwargs: object) -> object:
+        time.sleep(0.3)
+        return real(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(module, "compile_step", slow)
+    monkeypatch.setattr(module, "COMPILE_NOTICE_SECONDS", 0.05)
+    said: list[str] = []
+    scene = dvqp.load_scene(Path(__file__).resolve().parent.parent / "scenes" / "fold.toml")
+    traj = dvqp.plan(scene, "pinv", notice=said.append)
+    assert said == [COMPILE_NOTICE] and traj.compiled.all()

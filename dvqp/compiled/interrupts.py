@@ -5,15 +5,13 @@ state where the interrupt is swallowed, LLVM objects fail to be destroyed, or th
 crashes at exit. :func:`guard_compilation` (installed on import of :mod:`dvqp.compiled`)
 listens to numba's compiler lock, which numba holds while it compiles a function or loads one
 from its cache: while the main thread holds it, a SIGINT is held, and delivered again as soon
-as the lock is released. :func:`deferred` does the same for a block of code.
+as the lock is released.
 """
 
 from __future__ import annotations
 
-import contextlib
 import signal
 import threading
-from collections.abc import Iterator
 from types import FrameType
 from typing import Any
 
@@ -74,13 +72,3 @@ def guard_compilation() -> None:
         listener = _CompilerLockListener()
         event.register("numba:compiler_lock", listener)
         _INSTALLED.append(listener)
-
-
-@contextlib.contextmanager
-def deferred() -> Iterator[None]:
-    """Run the block with SIGINT held; deliver it after the block if one came."""
-    _HOLDER.enter()
-    try:
-        yield
-    finally:
-        _HOLDER.leave()

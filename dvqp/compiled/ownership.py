@@ -13,23 +13,15 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-TASK = ("compute",)
-TERM = ("evaluate",)
-LIMIT = ("compute", "distances", "all_distances")
-VERIFIED = ("excess", "distances", "all_distances")
-SHAPE = ("point_distance", "segment_distance", "batch_points", "batch_segments", "penalty",
-         "size")  # fmt: skip
-
 
 def _trusted(cls: type, name: str) -> bool:
     """``cls`` is one of dvqp's own classes, or defines ``name`` itself."""
     return cls.__module__.split(".")[0] == "dvqp" or name in cls.__dict__
 
 
-def own_kernel(part: Any, name: str, math: tuple[str, ...] = ()) -> Callable[..., Any] | None:
+def own_kernel(part: Any, name: str) -> Callable[..., Any] | None:
     """``part.<name>`` (a kernel factory) if the kernel is the part's own (see the module
-    docstring), else None (also when ``part`` has no such method). ``math`` names the methods
-    that make up the part's math (documentation of what a kernel must match)."""
+    docstring), else None (also when ``part`` has no such method)."""
     cls = part if isinstance(part, type) else type(part)
     if getattr(cls, name, None) is None or not _trusted(cls, name):
         return None
@@ -42,10 +34,10 @@ def exact(part: Any, *classes: type) -> bool:
     return type(part) in classes
 
 
-def build(part: Any, name: str, math: tuple[str, ...], *args: Any) -> tuple[bool, Any]:
+def build(part: Any, name: str, *args: Any) -> tuple[bool, Any]:
     """``(True, kernel-or-None)`` from ``part.<name>(*args)``, or ``(False, None)`` when the
     part has no kernel of its own math or its factory raises ``NotImplementedError``."""
-    make = own_kernel(part, name, math)
+    make = own_kernel(part, name)
     if make is None:
         return False, None
     try:

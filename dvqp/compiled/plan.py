@@ -135,7 +135,7 @@ class StepPlan:
         buffers = ProximityBuffers.allocate(len(obstacles), self.k)
         kernels = []
         for cls, shapes, indices in obstacles.groups():
-            make = ownership.own_kernel(cls, "kernel", ownership.SHAPE)
+            make = ownership.own_kernel(cls, "kernel")
             index = np.asarray(indices, dtype=np.int64)
             kernel = None if make is None else make(shapes, index, self, buffers)
             if kernel is None:

@@ -40,6 +40,15 @@ def relaxed_data(A, G, cost, lb, ub, A_r, G_r, cost_r, lb_r, ub_r) -> None:  # t
 
 
 @njit(cache=True)
+def crossed(lb: Array, ub: Array) -> int:
+    """The first index with ``lb > ub``, or −1."""
+    for i in range(lb.shape[0]):
+        if lb[i] > ub[i]:
+            return i
+    return -1
+
+
+@njit(cache=True)
 def braking(lb: Array, ub: Array, out: Array) -> bool:
     """``out = clip(0, lb, ub)``: the step closest to rest in the box; False if it is empty."""
     for i in range(lb.shape[0]):
@@ -98,18 +107,19 @@ class CompiledQP:
             Kernel(scale, (plan.objective_gradient, -gain, self.cost)),
             Kernel(open_box, (plan.lb, plan.ub)),
             *(plan.bind(k) for k in rows),
+            Kernel(crossed, (plan.lb, plan.ub), True),
         ]
         """What assembles the QP once the tasks' rows are written: the cost, the bounds and
-        the limits' rows."""
+        the limits' rows; the status is the first joint whose bounds cross (else −1)."""
 
     def solve(self, status: int) -> Answer | None:
         """Solve this step's QP (assembled by :attr:`kernels`, whose ``status`` is −1):
         strict, else relaxed, else braking; None when even braking is impossible (crossed
         bounds)."""
+        if status != -1:  # crossed bounds: the reference resolver fails the step
+            return None
         plan = self.plan
         strict = self.problem
-        if not braking(plan.lb, plan.ub, self.brake):  # crossed bounds: the reference fails it
-            return None
         solution = self.strict_backend.solve(strict)
         spent, status = solution.solver_time, "optimal"
         if not solution.found:

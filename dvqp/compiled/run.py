@@ -7,7 +7,6 @@ import time
 import numpy as np
 
 from dvqp.compiled.engine import CompiledStep
-from dvqp.compiled.interrupts import deferred
 from dvqp.compiled.solve import Answer, finish
 from dvqp.errors import SingularConfigurationError
 from dvqp.kinematics.state import KinematicState
@@ -25,9 +24,8 @@ def run_compiled(step: CompiledStep, run: Run) -> None:
     """
     record, state = run.record, step.plan.state
     step.index[0] = 0
-    with deferred():  # the first calls load (or compile) what the step did not yet
-        step.start(run.q0)
-        _first_calls(step, run)
+    step.start(run.q0)
+    _first_calls(step, run)  # load (or compile) now what the timed steps call directly
     start: KinematicState | None = None
     saved = np.empty_like(run.q0)
     plain = run.reference is None or run.gain <= 0.0

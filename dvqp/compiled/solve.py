@@ -40,7 +40,7 @@ def task_kernels(spec: StepSpec, plan: StepPlan) -> list[Kernel] | None:
     """The hard tasks' kernels, or None if a task is soft or has no kernel of its own."""
     found = []
     for task in spec.tasks:
-        ok, kernel = ownership.build(task, "kernel", ownership.TASK, plan)
+        ok, kernel = ownership.build(task, "kernel", plan)
         if not getattr(task, "hard", False) or not ok or kernel is None:
             return None
         found.append(kernel)
@@ -52,7 +52,7 @@ def limit_kernels(spec: StepSpec, plan: StepPlan) -> list[Kernel] | None:
     limit whose kernel is None adds nothing)."""
     found = []
     for limit in spec.limits:
-        ok, kernel = ownership.build(limit, "kernel", ownership.LIMIT, plan)
+        ok, kernel = ownership.build(limit, "kernel", plan)
         if not ok:
             return None
         if kernel is not None:
@@ -67,7 +67,7 @@ def verifier_kernels(spec: StepSpec, plan: StepPlan) -> list[Kernel] | None:
     for limit in spec.limits:
         if not hasattr(limit, "excess"):
             continue
-        ok, kernel = ownership.build(limit, "verifier", ownership.VERIFIED, plan)
+        ok, kernel = ownership.build(limit, "verifier", plan)
         if not ok:
             return None
         if kernel is not None:

@@ -144,11 +144,10 @@ def simulate(
     record = TrajectoryRecorder(cmd.shape[0], robot.n, robot.n_points, obstacles)
     run = Run(robot, radius, resolver, q_start, cmd, ref, gain, dt, check, max_halvings, record,
               progress)  # fmt: skip
-    compiled = (
-        None
-        if engine == "reference"
-        else compile_step(robot, radius, resolver, obstacles, check, samples=record.arrays)
-    )
+    compiled = None
+    if engine != "reference":
+        with _noticed(notice):
+            compiled = compile_step(robot, radius, resolver, obstacles, check, record.arrays)
     if compiled is None and engine == "compiled":
         raise ParameterError("engine", "a part of this run has no compiled kernel")
     if compiled is None:

@@ -85,7 +85,7 @@ class Objective:
         """
         kernels = []
         for term in self.terms:
-            ok, kernel = ownership.build(term, "kernel", ownership.TERM, plan)
+            ok, kernel = ownership.build(term, "kernel", plan)
             if not ok or kernel is None:
                 return None
             kernels.append(kernel)
