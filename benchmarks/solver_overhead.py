@@ -24,8 +24,9 @@ plus the number of solutions found, of cold retries, the largest distance of a f
 to the first backend's, and for each direct adapter the ratio ``qpsolvers:NAME / NAME`` of
 ``total``.
 The last lines time ``Problem(...)`` (validated copies, what a per-step build costs) against
-``Problem.trusted`` and the compiled residuals against the NumPy reference. Timing is noisy on
-a shared machine: compare ratios within one run.
+``Problem.trusted``, and the public :func:`solvers.residuals` (the compiled kernel behind
+``check``, plus its argument conversions). Timing is noisy on a shared machine: compare
+ratios within one run.
 """
 
 from __future__ import annotations
@@ -145,25 +146,17 @@ def median_us(fn: Callable[[], object], repeat: int = 5000) -> float:
 
 
 def extras(args: argparse.Namespace) -> None:
-    """Problem construction and residual computation, validated/NumPy vs trusted/compiled."""
+    """Problem construction (validated vs trusted) and the public residual computation."""
     ws = Workspace(args.seed, args.p_every)
     ws.step(0)
     print(f"Problem(...) validated copies: {median_us(ws.validated):7.1f} us")
     if hasattr(Problem, "trusted"):
         print(f"Problem.trusted(...):          {median_us(ws.problem):7.1f} us")
-    from solvers.residuals import kkt_residuals
-
     problem = ws.problem()
     sol = solvers.make_backend("daqp").solve(problem)
     x, y, z, zb = sol.x, sol.y, sol.z, sol.z_box
-    numpy_us = median_us(lambda: kkt_residuals(problem, x, y, z, zb))
-    print(f"NumPy kkt_residuals:           {numpy_us:7.1f} us")
-    if not hasattr(Problem, "trusted"):  # the code before the fast path had no solvers.kkt
-        return
-    from solvers.kkt import kkt_residuals as compiled
-
-    compiled_us = median_us(lambda: compiled(problem, x, y, z, zb))
-    print(f"compiled kkt_residuals:        {compiled_us:7.1f} us")
+    residuals_us = median_us(lambda: solvers.residuals(problem, x, y, z, zb))
+    print(f"solvers.residuals(...):        {residuals_us:7.1f} us")
 
 
 def main() -> None:

@@ -1,13 +1,14 @@
-"""Start-up cost of the compiled step: a cold run (nothing compiled yet) and a cached one.
+"""Start-up cost: what compiles when, and the CPU of a first and a cached run.
 
 Usage::
 
     python benchmarks/startup.py [SCENE] [--backend daqp]
 
-Each measurement is a fresh Python process timing ``import dvqp`` and one ``dvqp.plan`` of the
-scene. "cold" points numba's cache (``NUMBA_CACHE_DIR``) and dvqp's generated drivers
-(``DVQP_CACHE_DIR``) at an empty temporary directory, so everything compiles; "cached" runs
-again with the same directories, so everything loads. The reference engine is timed too.
+Every measurement is a fresh Python process. "cold" points numba's cache (``NUMBA_CACHE_DIR``)
+at an empty temporary directory, as after installing dvqp: whatever a command needs compiles;
+the following commands share that directory, so what was compiled before is loaded. For each
+command it prints the wall time, the CPU time of the process (user + sys) and how many numba
+functions were compiled (not loaded from the cache) in it.
 """
 
 from __future__ import annotations
@@ -15,45 +16,80 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 PROBE = """
-import json, sys, time
-started = time.perf_counter()
-import dvqp
-imported = time.perf_counter()
-scene = dvqp.load_scene(sys.argv[1])
-traj = dvqp.plan(scene, sys.argv[2], engine=sys.argv[3])
-done = time.perf_counter()
-print(json.dumps({"import": imported - started, "plan": done - imported,
-                  "steps": traj.n_steps, "compiled": int(traj.compiled.sum())}))
+import json, sys
+from numba.core import event
+
+compiled = []
+
+class Count(event.Listener):
+    def on_start(self, ev):
+        compiled.append(1)
+
+    def on_end(self, ev):
+        pass
+
+event.register("numba:compile", Count())
+args = sys.argv[1:]
+if args[0] == "import":
+    import dvqp  # noqa: F401
+    code = 0
+else:
+    from dvqp.cli import main
+
+    code = main(args)
+print(json.dumps({"compiled": len(compiled), "code": code}), file=sys.stderr)
 """
 
 
-def measure(scene: str, backend: str, engine: str, env: dict[str, str]) -> dict[str, float]:
-    out = subprocess.run([sys.executable, "-c", PROBE, scene, backend, engine], env=env,
-                         capture_output=True, text=True, check=True).stdout  # fmt: skip
-    return json.loads(out.strip().splitlines()[-1])  # type: ignore[no-any-return]
+def measure(args: list[str], env: dict[str, str]) -> dict[str, float]:
+    """Wall time, CPU (user + sys, s) and compiled functions of ``dvqp <args>`` in a fresh
+    process (``import`` for ``import dvqp`` alone)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    started = time.perf_counter()
+    out = subprocess.run([sys.executable, "-c", PROBE, *args], env=env, capture_output=True,
+                         text=True, check=False, cwd=ROOT)  # fmt: skip
+    wall = time.perf_counter() - started
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    found = json.loads(out.stderr.strip().splitlines()[-1])
+    return {"wall": wall, "cpu": cpu, **found}
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("scene", nargs="?", default=str(ROOT / "scenes" / "paper-two-inlets.toml"))
+    parser.add_argument("scene", nargs="?", default="scenes/paper-two-inlets.toml")
     parser.add_argument("--backend", default="daqp")
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
-        env = {**os.environ, "NUMBA_CACHE_DIR": tmp, "DVQP_CACHE_DIR": tmp}
-        runs = [("cold (compiles)", "auto"), ("cached (loads)", "auto"),
-                ("reference engine", "reference")]  # fmt: skip
-        rows = [(label, measure(args.scene, args.backend, engine, env)) for label, engine in runs]
-    print(f"{'start-up':<18} {'import s':>9} {'plan s':>8} {'steps':>6} {'compiled':>9}")
+        trajectory = str(Path(tmp) / "run.npz")
+        runs = [
+            ("cold: import dvqp", ["import"]),
+            ("cold: dvqp --help", ["--help"]),
+            ("cold: dvqp backends", ["backends"]),
+            (f"cold: dvqp plan ({args.backend})", ["plan", args.scene, "--backend",
+                                                   args.backend, "-o", trajectory]),
+            ("then: dvqp plot", ["plot", trajectory, "-o", str(Path(tmp) / "run.png")]),
+            ("cached: dvqp plan", ["plan", args.scene, "--backend", args.backend]),
+            ("then: dvqp compare (every backend)", ["compare", args.scene]),
+        ]  # fmt: skip
+        env = {**os.environ, "NUMBA_CACHE_DIR": str(Path(tmp) / "numba"), "MPLBACKEND": "Agg"}
+        rows = [(label, measure(command, env)) for label, command in runs]
+        env["NUMBA_CACHE_DIR"] = str(Path(tmp) / "numba-readme")
+        rows.append(("cold: dvqp compare (README's first command)",
+                     measure(["compare", args.scene], env)))  # fmt: skip
+    print(f"{'command':<45} {'wall s':>7} {'cpu s':>7} {'compiled':>9} {'exit':>5}")
     for label, m in rows:
-        print(f"{label:<18} {m['import']:9.2f} {m['plan']:8.2f} {m['steps']:6.0f} "
-              f"{m['compiled']:9.0f}")  # fmt: skip
+        print(f"{label:<45} {m['wall']:7.2f} {m['cpu']:7.2f} {m['compiled']:9.0f} "
+              f"{m['code']:5.0f}")  # fmt: skip
     return 0
 
 

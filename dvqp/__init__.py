@@ -1,18 +1,21 @@
 """dvqp: QP-based redundancy resolution of hyper-redundant manipulators in a pipe's developed view.
 
-The pieces, in the order a step uses them (one subpackage each):
+The pieces, from the bottom up (one subpackage each):
 
-- :mod:`dvqp.kinematics` — :class:`Robot` on Pinocchio and the per-step :class:`KinematicState`;
-- :mod:`dvqp.geometry` — :class:`Obstacle` circles and the body's proximity to them;
-- :mod:`dvqp.tasks` — what the joints must do: the tool's DV task :class:`ToolTask`;
-- :mod:`dvqp.objective` — ``w(Q)`` as a sum of terms, :class:`Objective`;
-- :mod:`dvqp.limits` — joint, obstacle and height limits, each ``Constraint(G, h)`` or ``Bounds``;
-- :mod:`dvqp.resolution` — :class:`StepSpec`, the QP built from it, the QP and pseudoinverse
-  resolvers and the registry of their names;
+- :mod:`dvqp.workspace` — the compiled step's buffers and rows (no domain knowledge);
+- :mod:`dvqp.kinematics` — :class:`Robot` on Pinocchio, its compiled kinematics and the
+  :class:`KinematicState` every part reads;
+- :mod:`dvqp.geometry` — obstacle shapes and the body's proximity to them;
+- :mod:`dvqp.tasks`, :mod:`dvqp.objective`, :mod:`dvqp.limits` — what a step is made of:
+  tasks (:class:`ToolTask`), the objective ``w(Q)`` (:class:`Objective`), limits, each one
+  class with its compiled kernel in its module;
+- :mod:`dvqp.resolution` — :class:`StepSpec`, the QP and pseudoinverse resolvers, their names;
+- :mod:`dvqp.step` — the compiled step (:class:`Stepper`) and one verified step (``advance``);
 - :mod:`dvqp.motion` — JOG and path commands, :func:`simulate`, :class:`Trajectory`;
 - :mod:`dvqp.scenes` — scene files; :func:`plan` runs one with a named backend.
 """
 
+from dvqp._versions import __version__
 from dvqp.errors import (
     BackendError,
     DvqpError,
@@ -25,7 +28,7 @@ from dvqp.errors import (
 )
 from dvqp.geometry import Obstacle, ObstacleSet
 from dvqp.kinematics import KinematicState, Robot
-from dvqp.limits import Bounds, Constraint, Limit, VelocityDamper
+from dvqp.limits import Bounds, Constraint, Distances, Limit, VelocityDamper
 from dvqp.motion import JogSegment, ToolPath, Trajectory, jog_commands, simulate
 from dvqp.objective import Objective, ObjectiveTerm, Term
 from dvqp.planning import check_run, plan
@@ -35,20 +38,21 @@ from dvqp.resolution import (
     Resolver,
     Step,
     StepSpec,
-    build_qp,
     make_resolver,
 )
 from dvqp.scenes import Scene, load_scene
+from dvqp.step import Stepper
 from dvqp.tasks import Task, TaskRows, ToolTask
-
-__version__ = "0.2.0"
+from dvqp.workspace import Kernel, StepPlan
 
 __all__ = [
     "BackendError",
     "Bounds",
     "Constraint",
+    "Distances",
     "DvqpError",
     "JogSegment",
+    "Kernel",
     "KinematicState",
     "Limit",
     "LimitViolationError",
@@ -66,7 +70,9 @@ __all__ = [
     "ShapeError",
     "SingularConfigurationError",
     "Step",
+    "StepPlan",
     "StepSpec",
+    "Stepper",
     "Task",
     "TaskRows",
     "Term",
@@ -76,7 +82,6 @@ __all__ = [
     "UnreachableTargetError",
     "VelocityDamper",
     "__version__",
-    "build_qp",
     "check_run",
     "jog_commands",
     "load_scene",

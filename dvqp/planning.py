@@ -17,12 +17,14 @@ from numpy.typing import NDArray
 
 from dvqp.errors import LimitViolationError, UnreachableTargetError
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits import Excess, Limit, worst_excess
+from dvqp.limits import Excess, Limit
 from dvqp.motion.jog import box_average, jog_commands
 from dvqp.motion.simulate import dv_error, simulate
 from dvqp.motion.trajectory import Trajectory
+from dvqp.resolution.pinv import PseudoinverseResolver
 from dvqp.resolution.registry import make_resolver
 from dvqp.scenes.scene import Scene
+from dvqp.step import Stepper
 from dvqp.tasks import Task
 
 
@@ -79,7 +81,6 @@ def plan(
     tasks: Sequence[Task] = (),
     limits: Sequence[Limit] = (),
     progress: Callable[[int, int], None] | None = None,
-    engine: str = "auto",
     notice: Callable[[str], None] | None = None,
 ) -> Trajectory:
     """Run a scene with a resolver and return its trajectory.
@@ -98,12 +99,9 @@ def plan(
         Tasks and limits added to the scene's own (the baseline ignores limits).
     progress
         Called as ``progress(k, N)`` after each step.
-    engine
-        ``"auto"`` (compiled where every part has a kernel), ``"compiled"`` or
-        ``"reference"``: see :func:`dvqp.motion.simulate.simulate`.
     notice
-        Called with one line if compiling the step takes long (the first run of a
-        composition); see :func:`dvqp.motion.simulate.simulate`.
+        Called with one line if compiling the step takes long (the first run after
+        installing); see :func:`dvqp.motion.simulate.simulate`.
 
     Raises
     ------
@@ -117,7 +115,7 @@ def plan(
     traj = simulate(
         scene.robot, scene.pipe_radius, resolver, scene.q0, c.velocity, scene.dt,
         obstacles=scene.obstacles, reference=c.reference[:-1] if c.feedback_gain > 0 else None,
-        feedback_gain=c.feedback_gain, progress=progress, engine=engine, notice=notice,
+        feedback_gain=c.feedback_gain, progress=progress, notice=notice,
     )  # fmt: skip
     error = dv_error(c.reference, traj.tool, scene.pipe_radius)
     return dataclasses.replace(traj, tracking_error=error, scene_text=scene.text)
@@ -183,16 +181,18 @@ def worst_sample_excess(
     """
     if traj.limit_excess.shape[0] == 0:
         return None
-    every = (*scene.spec().limits, *limits)
-    start = KinematicState.compute(scene.robot, traj.q[0], scene.pipe_radius)
     candidates = np.flatnonzero(traj.limit_excess > 0.0)
     if candidates.shape[0] == 0:
         return None
+    spec = scene.spec().with_extra(limits=limits)
+    stepper = Stepper(scene.robot, scene.pipe_radius, PseudoinverseResolver(spec), traj.q[0],
+                      scene.dt)  # fmt: skip
+    stepper.start(traj.q[0])
     found = []
     for k in candidates[np.argsort(traj.limit_excess[candidates])[-20:]]:
-        state = KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius)
-        found.append((int(k), worst_excess(every, start, state)))
-    return max(found, key=lambda item: item[1].ratio)
+        if stepper.load(traj.q[k]):
+            found.append((int(k), stepper.excess()))
+    return max(found, key=lambda item: item[1].ratio) if found else None
 
 
 def final_errors(traj: Trajectory) -> tuple[float, float]:

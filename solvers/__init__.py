@@ -5,7 +5,7 @@
 >>> x = backend.solve(Problem(P, q, A=A, b=b)).require()  # doctest: +SKIP
 """
 
-from .exceptions import ProblemShapeError, SolverError, SolverFailure, UnknownBackendError
+from .exceptions import ProblemShapeError, SolverError, UnknownBackendError
 from .problem import Problem
 from .protocol import Backend
 from .registry import (
@@ -16,7 +16,7 @@ from .registry import (
     make_backend,
 )
 from .residuals import Residuals, residuals
-from .solution import Solution
+from .solution import Solution, SolverFailure
 from .stateful import RawResult, StatefulBackend
 
 __all__ = [

@@ -1,11 +1,16 @@
-"""Small compiled helpers of the adapters' per-step update paths."""
+"""Small compiled helpers of the adapters' per-step update paths.
+
+Each compiles (or loads numba's cache) at its first call, for its one declared signature
+(:func:`solvers._jit.compiled_on_first_call`); the arrays it is given must be float64 and
+C-contiguous, of the declared dimensions, or the call raises ``TypeError``.
+"""
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
-from numba import njit, types
+from numba import types
+
+from ._jit import compiled_on_first_call
 
 _VEC_IN = types.Array(types.float64, 1, "C", readonly=True)
 _MAT_IN = types.Array(types.float64, 2, "C", readonly=True)
@@ -18,39 +23,7 @@ EMPTY_MATRIX = np.zeros((0, 0))
 EMPTY_VECTOR.flags.writeable = EMPTY_MATRIX.flags.writeable = False
 
 
-def direct(dispatcher: Any) -> Any:
-    """The compiled function behind a one-signature numba dispatcher, or the dispatcher.
-
-    Calling it skips numba's typing of the arguments (~0.2 µs a call) and with it every
-    check that they match the signature; only the itemsize of arrays is still checked, and an
-    array of more dimensions than declared overwrites memory. So pass it only arrays known to
-    match: float64, C-contiguous, of the declared dimensions (see :func:`pinned`).
-    """
-    try:
-        (result,) = dispatcher.overloads.values()
-        return result.entry_point
-    except (AttributeError, ValueError):  # another numba: keep the checked call
-        return dispatcher
-
-
-def pinned(array: Any, ndim: int) -> np.ndarray | None:
-    """A view of ``array`` if it is a float64 C-contiguous ndarray of ``ndim`` dimensions.
-
-    The view is a new object sharing the data, so nothing done later to the caller's array
-    object (reshaping it in place, say) changes what :func:`direct` calls see; the data
-    itself cannot move while the view holds it. None if ``array`` does not qualify.
-    """
-    if (
-        type(array) is np.ndarray
-        and array.dtype == np.float64
-        and array.ndim == ndim
-        and array.flags.c_contiguous
-    ):
-        return array.view()
-    return None
-
-
-@njit(types.boolean(_MAT_IN, _MAT_OUT), cache=True)
+@compiled_on_first_call(types.boolean(_MAT_IN, _MAT_OUT))
 def refresh(source: np.ndarray, kept: np.ndarray) -> bool:
     """Copy ``source`` into ``kept`` (same shape) if any entry differs; return whether it did.
 
@@ -58,17 +31,17 @@ def refresh(source: np.ndarray, kept: np.ndarray) -> bool:
     entry always counts as a change.
     """
     rows, cols = source.shape
+    changed = False
     for i in range(rows):
         for j in range(cols):
             if source[i, j] != kept[i, j]:
-                kept[:, :] = source
-                return True
-    return False
+                kept[i, j] = source[i, j]  # element by element: no broadcasting to compile
+                changed = True
+    return changed
 
 
-@njit(
-    types.int64(*(_MAT_IN, _VEC_IN) * 3, _VEC_IN, _VEC_IN, _VEC_OUT, *(types.int64,) * 4),
-    cache=True,
+@compiled_on_first_call(
+    types.int64(*(_MAT_IN, _VEC_IN) * 3, _VEC_IN, _VEC_IN, _VEC_OUT, *(types.int64,) * 4)
 )
 def stack(
     P: np.ndarray,

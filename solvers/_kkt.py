@@ -1,4 +1,9 @@
-"""The compiled KKT kernel behind :mod:`solvers.kkt` (see there for what it computes)."""
+"""The compiled KKT kernel behind :mod:`solvers.kkt` (see there for what it computes).
+
+:func:`kernel` and :func:`stacked` compile (or load numba's cache) at their first call, for
+their one declared signature (:func:`solvers._jit.compiled_on_first_call`); the ``@njit``
+helpers are inlined into both and never compiled on their own.
+"""
 
 from __future__ import annotations
 
@@ -6,6 +11,8 @@ import math
 
 import numpy as np
 from numba import njit, types
+
+from ._jit import compiled_on_first_call
 
 _VEC = types.Array(types.float64, 1, "C", readonly=True)
 _MAT = types.Array(types.float64, 2, "C", readonly=True)
@@ -132,7 +139,7 @@ def _residuals(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags):  # type: ignore
     return float(code), equality, inequality, bounds, stationarity, complementarity, scale
 
 
-@njit(_SIGNATURE, cache=True, fastmath=_FASTMATH)
+@compiled_on_first_call(_SIGNATURE, fastmath=_FASTMATH)
 def kernel(
     P: np.ndarray,
     q: np.ndarray,
@@ -157,10 +164,9 @@ def kernel(
     return _residuals(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags)
 
 
-@njit(
+@compiled_on_first_call(
     # Writable arrays (DAQP's buffer and answers): an exact match, the quickest dispatch.
     types.UniTuple(types.float64, 7)(*(types.float64[::1],) * 3, *(types.int64,) * 5),
-    cache=True,
     fastmath=_FASTMATH,
 )
 def stacked(

@@ -28,10 +28,10 @@ problem's data the solve used (DAQP only reads it), with the same compiled code 
 :meth:`Solution.checked <solvers.Solution.checked>` on the problem's own arrays: three
 arrays to pass instead of twelve. ``Model.solve`` returns fresh copies of ``x`` and
 ``lam``, which the solution keeps without copying them again (``y``, ``z``, ``z_box`` are
-views of ``lam``). Both compiled calls skip numba's argument typing
-(:func:`solvers._fast.direct`): ``stack`` gets views of the problem's arrays, checked once
-per problem object (:func:`solvers._fast.pinned`; a problem whose arrays do not qualify is
-copied with NumPy), ``stacked`` gets DAQP's answers once the typed call accepted them.
+views of ``lam``). Both compiled calls are ordinary typed numba calls: ``stack`` gets the
+problem's arrays, the argument tuple kept per problem object; a problem whose arrays the
+compiled copy refuses (not float64 C-contiguous of the right dimensions: ``TypeError``) is
+copied with NumPy from then on.
 
 API notes (daqp 0.11): ``Model.update`` silently ignores arrays whose shape
 differs from the set-up (no error), hence the structure key; every array must
@@ -47,7 +47,7 @@ from typing import Any, ClassVar
 import daqp
 import numpy as np
 
-from ._fast import EMPTY_MATRIX, EMPTY_VECTOR, direct, pinned, refresh, stack
+from ._fast import EMPTY_MATRIX, EMPTY_VECTOR, refresh, stack
 from ._kkt import HAS_LB, HAS_UB, MISFITTING, stacked
 from .problem import Problem
 from .solution import Solution, judged
@@ -67,9 +67,6 @@ EXIT_FLAGS = {
 }
 
 _SENSE_EQUALITY = 5
-#: The compiled calls without numba's argument typing (see _fast.direct): stack gets views
-#: checked by _fast.pinned, stacked this model's answers once the dispatch typed them.
-_STACK, _STACKED = direct(stack), direct(stacked)
 
 
 class DaqpBackend(StatefulBackend):
@@ -97,8 +94,7 @@ class DaqpBackend(StatefulBackend):
         self._layout: tuple[int, ...] = ()  # n, p, m, ms and HAS_LB | HAS_UB as given
         self._cuts: tuple[slice | None, ...] = ()  # y, z, z_box in DAQP's lam
         self._bound: Problem | None = None  # the problem whose arguments of stack are kept
-        self._stack: tuple[Any, ...] | None = None
-        self._check: Any = stacked  # _STACKED once this model's answers are known to fit
+        self._stack: tuple[Any, ...] | None = None  # None: copy _bound with NumPy
 
     @classmethod
     def known_settings(cls) -> set[str]:
@@ -116,22 +112,18 @@ class DaqpBackend(StatefulBackend):
         return super()._structure_of(problem)
 
     def _bind(self, problem: Problem) -> None:
-        """Keep the arguments of :func:`~solvers._fast.stack` for ``problem``: views of its
-        arrays (fixed objects, rewritten in place from one solve to the next), or None (copy
-        with NumPy) if one is not a float64 C-contiguous array of the right dimension."""
+        """Keep the arguments of :func:`~solvers._fast.stack` for ``problem``: its arrays
+        (fixed objects, rewritten in place from one solve to the next), empty placeholders
+        for its absent blocks, and the set-up's buffer and sizes."""
         A, G, lb, ub, empty = problem.A, problem.G, problem.lb, problem.ub, EMPTY_VECTOR
-        views = [
-            pinned(array, ndim)
-            for array, ndim in (
-                (problem.P, 2), (problem.q, 1),
-                (EMPTY_MATRIX if A is None else A, 2), (empty if A is None else problem.b, 1),
-                (EMPTY_MATRIX if G is None else G, 2), (empty if G is None else problem.h, 1),
-                (empty if lb is None else lb, 1), (empty if ub is None else ub, 1),
-            )
-        ]  # fmt: skip
         self._bound = problem
-        fit = all(view is not None for view in views)
-        self._stack = (*views, self._data, *self._layout[:4]) if fit else None
+        self._stack = (
+            problem.P, problem.q,
+            EMPTY_MATRIX if A is None else A, empty if A is None else problem.b,
+            EMPTY_MATRIX if G is None else G, empty if G is None else problem.h,
+            empty if lb is None else lb, empty if ub is None else ub,
+            self._data, *self._layout[:4],
+        )  # fmt: skip
 
     def _fill(self, problem: Problem) -> None:
         """Copy ``q``, ``G``, ``h``, ``A``, ``b``, ``lb``, ``ub`` into the set-up's buffers."""
@@ -162,7 +154,7 @@ class DaqpBackend(StatefulBackend):
         H, self._f, M, self._upper, self._lower = np.split(data, ends)
         self._H, self._M = H.reshape(n, n), M.reshape(p + m, n)
         self._upper[:], self._lower[:] = np.inf, -np.inf
-        self._bound, self._check = None, stacked
+        self._bound = None
         self._load(problem)  # H: DAQP's, and the reference that tells P changed
         sense = np.zeros(rows, dtype=np.intc)
         sense[rows - m :] = _SENSE_EQUALITY
@@ -187,22 +179,21 @@ class DaqpBackend(StatefulBackend):
         """Copy ``problem`` into the set-up's buffers; return whether ``P`` changed."""
         if problem is not self._bound:
             self._bind(problem)
-        arguments = self._stack
-        changed = -2 if arguments is None else _STACK(*arguments)
+        changed = -2  # -2: copy with NumPy, -1: a misfit the compiled copy found
+        if self._stack is not None:
+            try:
+                changed = stack(*self._stack)
+            except TypeError:  # arrays the compiled copy refuses: NumPy copies this problem
+                self._stack = None
         if changed < 0:
             self._fill(problem)  # NumPy names a misfit it sees
             if changed == -1 or problem.P.shape != self._H.shape:
                 raise ValueError("the problem's arrays do not fit the set-up's sizes")
-            changed = refresh(problem.P, self._H)
+            changed = refresh(np.ascontiguousarray(problem.P, dtype=np.float64), self._H)
         return changed
 
     def _update(self, problem: Problem, guess: np.ndarray | None) -> RawResult | Solution:
-        if problem is not self._bound:
-            self._bind(problem)
-        arguments = self._stack
-        changed = -2 if arguments is None else _STACK(*arguments)
-        if changed < 0:  # the NumPy copy, or the error that names a misfit
-            changed = self._load(problem)
+        changed = self._load(problem)
         start = perf_counter()
         # f and A suffice: DAQP then recomputes v, M and d, reading both bounds through its
         # pointers to the set-up's buffers, which were rewritten in place.
@@ -220,14 +211,10 @@ class DaqpBackend(StatefulBackend):
         lam = info["lam"]
         # The check runs on the copy of the problem's data that the solve used (DAQP only
         # reads these buffers): the very values it would give on the problem's own arrays.
-        check = self._check
         try:
-            values = check(self._data, x, lam, *self._layout)
-        except TypeError:  # not float64 vectors: Solution.adopt sorts it out
+            values = stacked(self._data, x, lam, *self._layout)
+        except TypeError:  # not float64 vectors: judged (Solution.checked) sorts it out
             values = MISFITTING
-        else:
-            if check is stacked:  # numba's dispatch typed this model's answers: skip it now
-                self._check = _STACKED
         y, z, box = self._cuts
         # Model.solve returns fresh copies of x and lam: the solution keeps them uncopied.
         return judged(

@@ -1,11 +1,10 @@
-"""Exceptions raised by the ``solvers`` package."""
+"""Exceptions raised by the ``solvers`` package.
+
+Every one is a :class:`SolverError`; :class:`~solvers.SolverFailure`, which carries a
+:class:`~solvers.Solution`, is defined next to it in :mod:`solvers.solution`.
+"""
 
 from __future__ import annotations
-
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from .solution import Solution
 
 
 class SolverError(Exception):
@@ -39,17 +38,3 @@ class UnknownBackendError(SolverError, ValueError):
             f"unknown QP backend {name!r}; installed: {listed}; "
             "more with: pip install 'dvqp[solvers]'"
         )
-
-
-class SolverFailure(SolverError):
-    """Raised by :meth:`Solution.require` when no acceptable solution was found.
-
-    Attributes
-    ----------
-    solution : Solution
-        The failed solution, with its status, residuals and message.
-    """
-
-    def __init__(self, solution: Solution) -> None:
-        self.solution = solution
-        super().__init__(solution.message or f"{solution.backend}: no solution found")

@@ -1,17 +1,19 @@
-r"""Compiled KKT residuals: :func:`solvers.residuals.kkt_residuals` in one numba kernel.
+r"""The compiled KKT residuals, as raw values: one numba kernel over a problem's arrays.
 
-Same formulas and scale as the NumPy reference in :mod:`solvers.residuals` (the tests hold
-them to 1e-12 relative), including ``+inf`` in ``h``/``lb``/``ub`` (an infinite slack
-counts as 1 in complementarity), missing blocks and missing multipliers. One difference,
-on data the regular :class:`~solvers.Problem` rejects: a NaN anywhere (e.g. in a trusted
-problem's ``h``) makes the affected residual NaN, hence a failed check, where the
-reference's ``max(0.0, nan)`` can yield 0.
+The only implementation of the residuals in the package: :func:`solvers.residuals` and
+:meth:`Solution.checked <solvers.Solution.checked>` both go through it (the tests hold it to
+an independent NumPy oracle to 1e-12 relative). ``+inf`` in ``h``/``lb``/``ub`` is handled
+(an infinite slack counts as 1 in complementarity), and so are missing blocks and missing
+multipliers. A NaN in the data, ``x`` or a multiplier (e.g. in a trusted problem's ``h``)
+makes the residuals computed from it NaN, hence a failed check, never a 0 the way
+``max(0.0, nan)`` would give; only in complementarity does a NaN slack weigh 1, as an
+infinite one does (the primal residual of its row is NaN already).
 
-The kernel has a single eager signature (read-only float64 C-contiguous arrays, which
-writable arrays also match), compiled once and cached on disk (``cache=True``); missing
-blocks are passed as empty arrays. It checks every size itself (a misfit returns
-:data:`MISFIT` and reads nothing out of range), so :func:`quick` can call it on arrays as
-they come: about 1 µs on a dvqp-sized QP.
+The kernel (:func:`solvers._kkt.kernel`) has a single signature (read-only float64
+C-contiguous arrays, which writable arrays also match), compiled at its first call and cached
+on disk; missing blocks are passed as empty arrays. It checks every size itself (a misfit
+returns :data:`~solvers._kkt.MISFIT` and reads nothing out of range), so :func:`quick` can
+call it on arrays as they come: about 1 µs on a dvqp-sized QP.
 """
 
 from __future__ import annotations
@@ -20,10 +22,9 @@ import numpy as np
 import numpy.typing as npt
 
 from ._fast import EMPTY_MATRIX, EMPTY_VECTOR
-from ._kkt import DUALS, HAS_BOX, HAS_LB, HAS_UB, HAS_Y, HAS_Z, MISFIT, kernel
+from ._kkt import HAS_BOX, HAS_LB, HAS_UB, HAS_Y, HAS_Z, MISFIT, kernel
 from .exceptions import ProblemShapeError
 from .problem import Problem
-from .residuals import Residuals
 
 
 def _multiplier(name: str, value: np.ndarray | None, size: int) -> np.ndarray | None:
@@ -63,7 +64,7 @@ def quick(
     -------
     tuple of float or None
         ``(code, equality, inequality, bounds, stationarity, complementarity, scale)``,
-        ``code`` holding the bits :data:`FINITE` and :data:`DUALS`.
+        ``code`` holding the bits :data:`~solvers._kkt.FINITE` and :data:`~solvers._kkt.DUALS`.
     """
     p = problem
     A, G, lb, ub = p.A, p.G, p.lb, p.ub
@@ -108,9 +109,9 @@ def evaluate(
     -------
     tuple of float
         ``(code, equality, inequality, bounds, stationarity, complementarity, scale)``:
-        ``code`` holds the bits :data:`FINITE` (``x`` is finite) and :data:`DUALS` (every
-        multiplier the problem needs is given; else the dual residuals are NaN
-        placeholders); see :func:`kkt_residuals` for the others.
+        ``code`` holds the bits :data:`~solvers._kkt.FINITE` (``x`` is finite) and
+        :data:`~solvers._kkt.DUALS` (every multiplier the problem needs is given; else the
+        dual residuals are NaN placeholders); see :class:`~solvers.Residuals` for the others.
 
     Raises
     ------
@@ -129,41 +130,3 @@ def evaluate(
             f"problem: arrays do not fit x of shape ({n},) or are not float64 C-contiguous"
         )
     return values
-
-
-def kkt_residuals(
-    problem: Problem,
-    x: np.ndarray,
-    y: np.ndarray | None = None,
-    z: np.ndarray | None = None,
-    z_box: np.ndarray | None = None,
-) -> tuple[Residuals, float]:
-    """Compiled :func:`solvers.residuals.kkt_residuals`: residuals and gradient scale.
-
-    Parameters
-    ----------
-    problem : Problem
-        The QP (regular or :meth:`~solvers.Problem.trusted`).
-    x : ndarray, shape (n,)
-        Primal candidate (not checked for finiteness here).
-    y, z, z_box : ndarray, optional
-        Multipliers in the package sign convention; converted to float64 if needed.
-
-    Returns
-    -------
-    Residuals
-        Stationarity and complementarity are None unless every needed multiplier is given.
-    float
-        The gradient scale ``max(||P x||_inf, ||q||_inf)``.
-
-    Raises
-    ------
-    ProblemShapeError
-        If ``x`` or a needed multiplier has the wrong shape.
-    """
-    point = _multiplier("x", x, problem.n)
-    assert point is not None
-    code, equality, inequality, bounds, stat, comp, scale = evaluate(problem, point, y, z, z_box)
-    if not int(code) & DUALS:
-        return Residuals(equality, inequality, bounds), scale
-    return Residuals(equality, inequality, bounds, stat, comp), scale

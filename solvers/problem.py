@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -83,7 +83,6 @@ class Problem:
     h: np.ndarray | None = None
     lb: np.ndarray | None = None
     ub: np.ndarray | None = None
-    _finite: tuple[bool, bool, bool] = field(default=(True, True, True), init=False, repr=False)
 
     if TYPE_CHECKING:  # the generated __init__ accepts anything array-like
 
@@ -161,20 +160,15 @@ class Problem:
             if asym > SYMMETRY_TOLERANCE * (1.0 + float(np.abs(P).max(initial=0.0))):
                 raise ProblemShapeError(f"P: must be symmetric, max |P - P^T| = {asym:.1e}")
         h, lb, ub = arrays["h"], arrays["lb"], arrays["ub"]
-        finite = []  # whether h, lb, ub are free of infinite entries (used by residuals)
         for name, v, bad, what in (
             ("h", h, -np.inf, "must not be NaN or -inf"),
             ("lb", lb, np.inf, "must not be NaN or +inf"),
             ("ub", ub, -np.inf, "must not be NaN or -inf"),
         ):
-            if v is None or math.isfinite(float(v.sum())):
-                finite.append(True)
-                continue
-            _require(name, ~np.isnan(v) & (v != bad), what)
-            finite.append(bool(np.isfinite(v).all()))
+            if v is not None and not math.isfinite(float(v.sum())):
+                _require(name, ~np.isnan(v) & (v != bad), what)
         if lb is not None and ub is not None and (ub < lb).any():
             _require("lb", lb <= ub, "must be <= ub")
-        object.__setattr__(self, "_finite", tuple(finite))
 
     @classmethod
     def trusted(
@@ -222,11 +216,7 @@ class Problem:
             A = b = None
         if G is not None and G.shape[0] == 0:
             G = h = None
-        # Whether h, lb, ub are finite is not known (and may change with the data):
-        # (False, False, False) selects the code paths that handle infinite entries.
-        problem.__dict__.update(
-            P=P, q=q, A=A, b=b, G=G, h=h, lb=lb, ub=ub, _finite=(False, False, False)
-        )
+        problem.__dict__.update(P=P, q=q, A=A, b=b, G=G, h=h, lb=lb, ub=ub)
         return problem
 
     @property

@@ -8,6 +8,9 @@ Multiplier sign convention (the one of ``qpsolvers``), used by every backend:
 
 with ``z_box[i] <= 0`` when the lower bound of ``x[i]`` is active and
 ``z_box[i] >= 0`` when its upper bound is active.
+
+The values come from the compiled kernel of :mod:`solvers.kkt`, the package's one
+implementation of the residuals; this module gives them their public form.
 """
 
 from __future__ import annotations
@@ -17,13 +20,18 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from ._kkt import DUALS, FINITE
 from .exceptions import ProblemShapeError
+from .kkt import evaluate
 from .problem import Problem
 
 
 @dataclass(frozen=True)
 class Residuals:
     """Violation of each optimality condition, all in the infinity norm.
+
+    A residual computed from a NaN (in ``x``, a multiplier, or a trusted problem's data) is
+    NaN, which no tolerance accepts.
 
     Attributes
     ----------
@@ -50,6 +58,7 @@ class Residuals:
 
 
 def _multiplier(name: str, value: npt.ArrayLike | None, size: int) -> np.ndarray | None:
+    """``value`` as a float64 array of shape ``(size,)``, None if absent."""
     if value is None:
         return None
     array = np.asarray(value, dtype=np.float64)
@@ -58,82 +67,40 @@ def _multiplier(name: str, value: npt.ArrayLike | None, size: int) -> np.ndarray
     return array
 
 
-def _slack_product(multiplier: np.ndarray, slack: np.ndarray, finite: bool) -> float:
-    """Largest ``max(m, 0) * |slack|``; an infinite slack counts as 1."""
-    if not multiplier.size:
-        return 0.0
-    if not finite:
-        slack = np.where(np.isfinite(slack), slack, 1.0)
-    return float((np.maximum(multiplier, 0.0) * np.abs(slack)).max())
-
-
 def kkt_residuals(
     problem: Problem,
-    x: np.ndarray,
+    x: npt.ArrayLike,
     y: npt.ArrayLike | None = None,
     z: npt.ArrayLike | None = None,
     z_box: npt.ArrayLike | None = None,
 ) -> tuple[Residuals, float]:
-    """:func:`residuals` plus the gradient scale ``max(||P x||_inf, ||q||_inf)``."""
+    """:func:`residuals` plus the gradient scale ``max(||P x||_inf, ||q||_inf)``.
+
+    Returns
+    -------
+    Residuals
+        Stationarity and complementarity are None unless every needed multiplier is given.
+    float
+        The gradient scale, which :func:`failed_checks` needs.
+
+    Raises
+    ------
+    ProblemShapeError
+        If ``x`` or a needed multiplier has the wrong shape, or a trusted problem's arrays
+        do not fit ``x``.
+    """
     p = problem
-    h_finite, lb_finite, ub_finite = p._finite
-    equality = inequality = bounds = 0.0
-    if p.A is not None and p.b is not None:
-        equality = float(np.abs(p.A @ x - p.b).max())
-    slack_in = p.h - p.G @ x if p.G is not None and p.h is not None else None
-    if slack_in is not None:
-        inequality = max(0.0, -float(slack_in.min()))
-    slack_ub = None if p.ub is None else p.ub - x
-    slack_lb = None if p.lb is None else x - p.lb
-    if slack_ub is not None:
-        bounds = max(bounds, -float(slack_ub.min()))
-    if slack_lb is not None:
-        bounds = max(bounds, -float(slack_lb.min()))
-    Px = p.P @ x
-    scale = max(float(np.abs(Px).max()), float(np.abs(p.q).max())) if p.n else 0.0
-
-    y = _multiplier("y", y, p.n_eq) if p.n_eq else None
-    z = _multiplier("z", z, p.n_in) if p.n_in else None
-    z_box = _multiplier("z_box", z_box, p.n) if p.has_bounds else None
-    if (p.n_eq and y is None) or (p.n_in and z is None) or (p.has_bounds and z_box is None):
+    point = np.asarray(x, dtype=np.float64)
+    if point.shape != (p.n,):
+        raise ProblemShapeError(f"x: expected shape ({p.n},), got {point.shape}")
+    y = None if p.A is None else _multiplier("y", y, p.A.shape[0])
+    z = None if p.G is None else _multiplier("z", z, p.G.shape[0])
+    z_box = None if p.lb is None and p.ub is None else _multiplier("z_box", z_box, p.n)
+    point = np.ascontiguousarray(point)  # for the kernel; evaluate sees to the multipliers
+    code, equality, inequality, bounds, stat, comp, scale = evaluate(p, point, y, z, z_box)
+    if not int(code) & DUALS:
         return Residuals(equality, inequality, bounds), scale
-
-    gradient = Px + p.q
-    complementarity = 0.0
-    if p.A is not None and y is not None:
-        gradient += y @ p.A
-    if p.G is not None and z is not None and slack_in is not None:
-        gradient += z @ p.G
-        complementarity = max(-float(z.min()), _slack_product(z, slack_in, h_finite))
-    if z_box is not None:
-        gradient += z_box
-        bound = _bound_complementarity(z_box, slack_lb, slack_ub, lb_finite, ub_finite)
-        complementarity = max(complementarity, bound)
-    stationarity = float(np.abs(gradient).max()) if p.n else 0.0
-    return Residuals(equality, inequality, bounds, stationarity, max(complementarity, 0.0)), scale
-
-
-def _bound_complementarity(
-    z_box: np.ndarray,
-    slack_lb: np.ndarray | None,
-    slack_ub: np.ndarray | None,
-    lb_finite: bool,
-    ub_finite: bool,
-) -> float:
-    """Largest ``|z_box| * slack`` of the bounds, each sign paired with its side of the box."""
-    if slack_ub is not None and slack_lb is not None and ub_finite and lb_finite:
-        # z_box > 0 pairs with the upper slack, z_box < 0 with the lower one.
-        paired = np.where(z_box > 0.0, slack_ub, slack_lb)
-        return float(np.abs(z_box * paired).max())
-    upper = _box_product(z_box, slack_ub, ub_finite)
-    return max(upper, _box_product(-z_box, slack_lb, lb_finite))
-
-
-def _box_product(multiplier: np.ndarray, slack: np.ndarray | None, finite: bool) -> float:
-    """Complementarity of one side of the box; a multiplier on a missing bound is all error."""
-    if slack is None:
-        return float(multiplier.max())
-    return _slack_product(multiplier, slack, finite)
+    return Residuals(equality, inequality, bounds, stat, comp), scale
 
 
 def residuals(
@@ -148,7 +115,7 @@ def residuals(
     Parameters
     ----------
     problem : Problem
-        The QP the candidate solves.
+        The QP the candidate solves (regular or :meth:`~solvers.Problem.trusted`).
     x : ndarray, shape (n,)
         Primal candidate.
     y : ndarray, shape (m,), optional
@@ -162,17 +129,15 @@ def residuals(
     -------
     Residuals
         Primal residuals always; ``stationarity`` and ``complementarity`` only
-        when every multiplier the problem needs is given.
+        when every multiplier the problem needs is given. A multiplier of a block the
+        problem lacks is ignored.
 
     Raises
     ------
     ProblemShapeError
         If ``x`` or a needed multiplier has the wrong shape.
     """
-    point = np.asarray(x, dtype=np.float64)
-    if point.shape != (problem.n,):
-        raise ProblemShapeError(f"x: expected shape ({problem.n},), got {point.shape}")
-    return kkt_residuals(problem, point, y, z, z_box)[0]
+    return kkt_residuals(problem, x, y, z, z_box)[0]
 
 
 def failed_checks(res: Residuals, tolerance: float, scale: float) -> list[str]:
@@ -191,7 +156,7 @@ def failed_checks(res: Residuals, tolerance: float, scale: float) -> list[str]:
     Returns
     -------
     list of str
-        Empty when the solution is accepted.
+        Empty when the solution is accepted; a NaN residual always fails.
     """
     dual_tol = tolerance * (1.0 + scale)
     checks = [
@@ -209,3 +174,34 @@ def failed_checks(res: Residuals, tolerance: float, scale: float) -> list[str]:
     if res.stationarity is None:  # a feasible x is not yet an optimal one
         failed.append("no multipliers were returned, so optimality cannot be checked")
     return failed
+
+
+#: The kernel's code of a finite ``x`` with every multiplier the problem needs.
+ACCEPTABLE = FINITE | DUALS
+_new = object.__new__
+
+
+def passing(values: tuple[float, ...], tolerance: float) -> Residuals | None:
+    """The residuals in kernel ``values`` if they pass every check, else None.
+
+    ``values`` are :func:`solvers.kkt.evaluate`'s (or :func:`solvers._kkt.stacked`'s):
+    they pass when ``x`` is finite, every needed multiplier was given, and every residual
+    is within its tolerance (as :func:`failed_checks` has it); a NaN never passes.
+    """
+    code, equality, inequality, bounds, stationarity, complementarity, scale = values
+    dual_tol = tolerance * (1.0 + scale)
+    if not (
+        code == ACCEPTABLE
+        and equality <= tolerance
+        and inequality <= tolerance
+        and bounds <= tolerance
+        and stationarity <= dual_tol
+        and complementarity <= dual_tol
+    ):
+        return None
+    residuals = _new(Residuals)  # a frozen dataclass, filled without its slower __init__
+    residuals.__dict__.update(
+        equality=equality, inequality=inequality, bounds=bounds,
+        stationarity=stationarity, complementarity=complementarity,
+    )  # fmt: skip
+    return residuals

@@ -8,11 +8,11 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from ._kkt import DUALS, FINITE, MISFIT, MISFITTING
-from .exceptions import ProblemShapeError, SolverFailure
+from ._kkt import FINITE, MISFIT, MISFITTING
+from .exceptions import ProblemShapeError, SolverError
 from .kkt import evaluate, floats, quick
 from .problem import Problem
-from .residuals import Residuals, failed_checks
+from .residuals import ACCEPTABLE, Residuals, failed_checks, passing
 
 
 @dataclass(eq=False)
@@ -211,40 +211,31 @@ class Solution:
 
 #: Kernel values standing for a non-finite ``x`` whose multipliers could not be checked.
 _NOT_FINITE = (0.0,) + (math.nan,) * 6
-_ACCEPTABLE = FINITE | DUALS  # the kernel's code of a finite x with every multiplier
-_new = object.__new__
 
 
-def _passed(values: tuple[float, ...], tolerance: float) -> Residuals | None:
-    """The residuals of kernel ``values`` that pass every check, else None."""
-    code, equality, inequality, bounds, stationarity, complementarity, scale = values
-    dual_tol = tolerance * (1.0 + scale)
-    if not (
-        code == _ACCEPTABLE
-        and equality <= tolerance
-        and inequality <= tolerance
-        and bounds <= tolerance
-        and stationarity <= dual_tol
-        and complementarity <= dual_tol
-    ):
-        return None
-    residuals = _new(Residuals)  # a frozen dataclass, filled without its slower __init__
-    residuals.__dict__.update(
-        equality=equality, inequality=inequality, bounds=bounds,
-        stationarity=stationarity, complementarity=complementarity,
-    )  # fmt: skip
-    return residuals
+class SolverFailure(SolverError):
+    """Raised by :meth:`Solution.require` when no acceptable solution was found.
+
+    Attributes
+    ----------
+    solution : Solution
+        The failed solution, with its status, residuals and message.
+    """
+
+    def __init__(self, solution: Solution) -> None:
+        self.solution = solution
+        super().__init__(solution.message or f"{solution.backend}: no solution found")
 
 
 def _verdict(solution: Solution, values: tuple[float, ...]) -> Solution:
     """Set ``residuals``, ``found`` and (on rejection) ``message`` from kernel values."""
     tolerance = solution.tolerance
-    residuals = _passed(values, tolerance)
+    residuals = passing(values, tolerance)
     if residuals is not None:
         solution.residuals, solution.found = residuals, True
         return solution
     code, equality, inequality, bounds, stationarity, complementarity, scale = values
-    if code == _ACCEPTABLE:
+    if code == ACCEPTABLE:
         solution.residuals = Residuals(equality, inequality, bounds, stationarity, complementarity)
     elif code == FINITE:
         solution.residuals = Residuals(equality, inequality, bounds)
@@ -277,7 +268,7 @@ def judged(
     (arrays handed over, kept uncopied). On :data:`~solvers._kkt.MISFIT` (e.g. a wrong
     shape) this is :meth:`Solution.checked`, which copies ``x`` and names the problem.
     """
-    residuals = _passed(values, tolerance)
+    residuals = passing(values, tolerance)
     if residuals is not None:
         return Solution(problem, x, status, True, backend, tolerance, iterations, 0.0,
                         y, z, z_box, residuals, "", False, solver_time)  # fmt: skip

@@ -8,6 +8,7 @@ from numpy.typing import ArrayLike
 from dvqp import (
     KinematicState,
     Objective,
+    ObjectiveTerm,
     Obstacle,
     ObstacleSet,
     PseudoinverseResolver,
@@ -63,8 +64,9 @@ def central_difference(f, x: np.ndarray, eps: float = 1e-6, wrap=None) -> np.nda
     return np.stack(cols, axis=-1)
 
 
-class ConstantGradient:
-    """An objective term with value 0 and a fixed gradient (to feed a resolver a given g)."""
+class ConstantGradient(ObjectiveTerm):
+    """An objective term with value 0 and a fixed gradient (to feed a resolver a given g); a
+    term of your own, so a run adds it through its NumPy ``evaluate``."""
 
     name = "constant"
 

@@ -4,23 +4,24 @@ Each case is a robot, a pipe radius, an obstacle set and configurations near a s
 configuration. The mixed sets are built around the guarded points of their start state, the
 shape classes interleaved (circle, band, circle, polygon, inlet, ...), so that small offsets
 put points and links inside every class and the rows of a class are not contiguous.
+:class:`Dot` is a circle of one's own (a subclass of dvqp's, measured by its NumPy methods).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 import dvqp
 from dvqp import KinematicState, ObstacleSet, Robot
-from dvqp.compiled import Kernel, StepPlan
-from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon, Shape
+from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon
 from tests.common import LINK_LENGTHS, PIPE_RADIUS, Q0
+from tests.oracle_geometry import circle_points, circle_segments
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 BUNDLED_WITH_OBSTACLES = ("paper-two-inlets", "paper-inlets", "pipe-rack", "many-obstacles")
@@ -45,14 +46,23 @@ class Case:
         return self.q0 + offsets
 
     def state(self, q: NDArray[np.float64]) -> KinematicState:
-        """The reference kinematics at ``q``."""
+        """The kinematics at ``q``."""
         return KinematicState.compute(self.robot, q, self.radius)
 
 
 class Dot(Circle):
-    """A circle class without a compiled kernel (:meth:`Shape.kernel` returns None)."""
+    """A circle of one's own: a subclass of dvqp's :class:`Circle` is not dvqp's own class, so
+    dvqp measures it by its NumPy methods (the oracle's closed form). ``calls`` counts them."""
 
-    kernel = classmethod(Shape.kernel.__func__)  # type: ignore[assignment, attr-defined]
+    calls: ClassVar[list[str]] = []
+
+    def point_distance(self, lz, period):  # type: ignore[no-untyped-def]
+        Dot.calls.append("point_distance")
+        return circle_points(self.center, self.radius, lz, period)
+
+    def segment_distance(self, a, b, period):  # type: ignore[no-untyped-def]
+        Dot.calls.append("segment_distance")
+        return circle_segments(self.center, self.radius, a, b, period)
 
 
 def scene_case(name: str) -> Case:
@@ -91,23 +101,10 @@ def paper_robot() -> Robot:
     return Robot.ndt13(LINK_LENGTHS)
 
 
-def run(plan: StepPlan, kernels: list[Kernel]) -> None:
-    """Bind and call ``kernels`` in order."""
-    for kernel in kernels:
-        bound = plan.bind(kernel)
-        bound.function(*bound.args)
-
-
 def spoil(*arrays: NDArray[np.float64]) -> None:
     """Fill ``arrays`` with NaN, so that an entry a kernel forgets shows."""
     for a in arrays:
         a.fill(np.nan)
-
-
-def bound_kernels(plan: StepPlan, build: Callable[[StepPlan], list[Kernel]]) -> list[Kernel]:
-    """``build(plan)``, then the plan's geometry kernels followed by those, bound."""
-    kernels = build(plan)
-    return [plan.bind(k) for k in (*plan.geometry, *kernels)]
 
 
 def _wrap(dl: float, period: float) -> float:

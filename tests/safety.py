@@ -1,8 +1,10 @@
-"""Limits of a configuration recomputed independently of dvqp's limit code, for the tests.
+"""Limits of a configuration recomputed independently of dvqp, for the tests.
 
-Clearances come from sampling every guarded segment densely in the developed view and taking
-the shapes' point distances there (not the closest-point computations of segments, which the
-planner uses); heights and tilt from the frames' Cartesian positions.
+The frames come from Pinocchio, not dvqp's compiled kinematics; clearances from every shape's
+signed distance written in NumPy, each guarded link sampled densely in the developed view (not
+the closest-point computations the planner uses); heights and tilt from the frames' Cartesian
+positions; self distances from an exact closest-point formulation of its own
+(``tests/oracle_resolution.py``).
 """
 
 from __future__ import annotations
@@ -11,48 +13,41 @@ import math
 
 import numpy as np
 
-from dvqp import KinematicState, Scene
+from dvqp import Scene
 from dvqp.limits import ObstacleDamper, SurfaceHeight, TiltLimit
-
-SAMPLES_PER_LINK = 400
+from tests.oracle_resolution import Frames, frames, link_distances, point_distances
+from tests.oracle_resolution import tilt as frame_tilt
 
 
 def _limit(scene: Scene, kind: type) -> object:
     return next(limit for limit in scene.limits if isinstance(limit, kind))
 
 
+def _frames(scene: Scene, q: np.ndarray) -> Frames:
+    return frames(scene.robot, np.asarray(q, dtype=float), scene.pipe_radius)
+
+
 def clearances(scene: Scene, q: np.ndarray) -> tuple[float, float]:
     """Smallest clearance (m) of the whole guarded arm, and of the probe and its holder."""
-    state = KinematicState.compute(scene.robot, q, scene.pipe_radius)
+    if not len(scene.obstacles):
+        return math.inf, math.inf
+    g = _frames(scene, q).guarded  # points 1..k, then the tool
     period = 2.0 * math.pi * scene.pipe_radius
-    lz = np.array([[p[0], p[1]] for p in state.guarded])  # points 1..k, then the tool
-    t = np.linspace(0.0, 1.0, SAMPLES_PER_LINK)
-    best, probe = math.inf, math.inf
-    for i in range(lz.shape[0] - 1):
-        a, b = lz[i], lz[i + 1].copy()
-        b[0] = a[0] + ((b[0] - a[0] + period / 2) % period - period / 2)
-        pts = a + t[:, None] * (b - a)
-        for o in scene.obstacles:
-            c = float(o.point_distance(pts, period)[0].min())
-            best = min(best, c)
-            if i == lz.shape[0] - 2:
-                probe = min(probe, c)
-    return best, probe
+    links = link_distances(scene.obstacles, g, period)  # the links' ends included
+    points = point_distances(scene.obstacles, g[:, :2], period)
+    return float(min(links.min(), points.min())), float(links[:, -1].min())
 
 
 def heights(scene: Scene, q: np.ndarray) -> tuple[float, float]:
     """Lowest body point height and the probe's height over the surface, m (from x, y)."""
-    state = KinematicState.compute(scene.robot, q, scene.pipe_radius)
-    rho = np.hypot(state.origins[:, 0], state.origins[:, 1]) - scene.pipe_radius
+    o = _frames(scene, q).origins
+    rho = np.hypot(o[:, 0], o[:, 1]) - scene.pipe_radius
     return float(rho[:-1].min()), float(rho[-1])
 
 
 def tilt(scene: Scene, q: np.ndarray) -> float:
     """Angle (rad) of the probe axis from the radial direction, folded into [0, π/2]."""
-    state = KinematicState.compute(scene.robot, q, scene.pipe_radius)
-    o, a = state.origins[-1], state.axes[-1]
-    radial = np.array([o[0], o[1], 0.0]) / math.hypot(o[0], o[1])
-    angle = math.acos(max(-1.0, min(1.0, float(a @ radial))))
+    angle = frame_tilt(_frames(scene, q))
     return min(angle, math.pi - angle)
 
 
@@ -64,7 +59,7 @@ def worst_breach(scene: Scene, qs: np.ndarray) -> dict[str, float]:
     margin = _limit(scene, ObstacleDamper).margin  # type: ignore[attr-defined]
     h_min = _limit(scene, SurfaceHeight).min_height  # type: ignore[attr-defined]
     min_tilt = _limit(scene, TiltLimit).min_tilt  # type: ignore[attr-defined]
-    c0, _ = clearances(scene, qs[0]) if len(scene.obstacles) else (math.inf, math.inf)
+    c0, _ = clearances(scene, qs[0])
     h0, p0 = heights(scene, qs[0])
     t0 = tilt(scene, qs[0])
     out = {"clearance": -math.inf, "height": -math.inf, "probe height": -math.inf,

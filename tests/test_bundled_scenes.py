@@ -5,47 +5,39 @@ The QP claims run on DAQP (the fastest backend here); the baseline claims on ``p
 
 from __future__ import annotations
 
-import functools
 from collections import Counter
-from pathlib import Path
 
 import numpy as np
-import pytest
 
-from dvqp import KinematicState, Scene, Trajectory, load_scene, plan
+from dvqp import Constraint, QPResolver, Scene, Stepper, Trajectory, plan
 from dvqp.limits import ObstacleDamper, SurfaceHeight
 from dvqp.planning import check_run, scene_commands
-from dvqp.resolution import limit_rows
 from dvqp.scenes.scene import loads
-
-SCENES = Path(__file__).resolve().parent.parent / "scenes"
-
-
-@functools.cache
-def scene(name: str) -> Scene:
-    return load_scene(SCENES / f"{name}.toml")
-
-
-@functools.cache
-def run(name: str, backend: str) -> Trajectory:
-    if backend != "pinv":
-        pytest.importorskip(backend)
-    return plan(scene(name), backend)
+from tests.runs import run, scene
 
 
 def tight_rows(s: Scene, traj: Trajectory, tol: float = 1e-6) -> Counter[str]:
     """How many steps each QP inequality row (obstacle damper, height) held with equality.
 
-    Also checks that no row was broken by more than ``tol`` (m/s).
+    The rows are written again at every sample by a step of the scene's own (``Stepper.rows``);
+    also checks that no row was broken by more than ``tol`` (m/s).
     """
     spec = s.spec()
+    step = Stepper(s.robot, s.pipe_radius, QPResolver(spec, "daqp"), s.q0, s.dt)
+    step.start(s.q0)
+    limits = [lim for lim in spec.limits if isinstance(lim, (ObstacleDamper, SurfaceHeight))]
+    commands = scene_commands(s).velocity
     tight: Counter[str] = Counter()
     for k in range(traj.n_steps):
-        state = KinematicState.compute(s.robot, traj.q[k], s.pipe_radius)
-        rows, _ = limit_rows(spec, state, s.dt)
-        slack = rows.h - rows.G @ traj.qdot[k]
-        assert slack.min(initial=0.0) > -tol, f"step {k} breaks a row"
-        tight.update(label for label, value in zip(rows.labels, slack, strict=True) if value < tol)
+        assert step.load(traj.q[k])
+        step.prepare(commands[k], s.dt)
+        for limit in limits:
+            rows = step.rows(limit)
+            assert isinstance(rows, Constraint)
+            slack = rows.h - rows.G @ traj.qdot[k]
+            assert slack.min(initial=0.0) > -tol, f"step {k} breaks a row"
+            tight.update(label for label, value in zip(rows.labels, slack, strict=True)
+                         if value < tol)  # fmt: skip
     return tight
 
 

@@ -433,7 +433,7 @@ def test_the_progress_bar_tells_the_time_left(monkeypatch: pytest.MonkeyPatch) -
 def test_a_quiet_worker_ends_on_ctrl_c_without_a_word() -> None:
     code = (
         "import os, signal, time\n"
-        "from dvqp.cli.progress import quiet_worker\n"
+        "from dvqp.comparison import quiet_worker\n"
         "quiet_worker()\n"
         "os.kill(os.getpid(), signal.SIGINT)\n"
         "time.sleep(5)\n"

@@ -1,182 +1,220 @@
-"""The compiled step reproduces the reference path, hands back what it does not do, and says so."""
+"""The compiled step (the only one dvqp has) checked against independent computations.
+
+Every bundled scene's run is re-verified sample by sample from its joint trajectory alone:
+the integration, the frames and figures recorded (Pinocchio, brute-force distances, closest
+points of our own), the task error (finite differences of Pinocchio's tool), the exact
+verification, and every QP answer (eq. 18 where no inequality is active, otherwise a KKT
+certificate of the problem the step wrote). Parts of your own run between the compiled stages,
+on the same state; a subclass of one of dvqp's parts is one of your own.
+"""
 
 from __future__ import annotations
 
-import dataclasses
 import functools
+import math
 
 import numpy as np
 import pytest
 
 import dvqp
-from dvqp.compiled.engine import compile_step
-from dvqp.errors import ParameterError
-from dvqp.kinematics.state import KinematicState
-from dvqp.limits.excess import worst_excess
-from dvqp.resolution.registry import make_resolver
-from tests.common import random_configurations
-from tests.runs import scene
+from dvqp import Bounds, Limit, ObjectiveTerm, QPResolver, Stepper, Term
+from dvqp.motion.simulate import dv_error
+from dvqp.objective import OrbitalLevel
+from dvqp.planning import scene_commands
+from dvqp.resolution.pinv import PseudoinverseResolver
+from tests import safety
+from tests.oracle_resolution import (
+    eq18,
+    frames,
+    kkt_residual,
+    self_distances,
+    tilt,
+    verified_values,
+    worst_excess,
+    wrapped,
+)
+from tests.runs import BUNDLED, run, scene
 
-SAMPLED = ("q", "tool", "w", "min_clearance", "probe_clearance", "tilt", "self_distance",
-           "limit_excess")  # fmt: skip
-STEPPED = ("qdot", "task_error")
-SCENES = ("paper-two-inlets", "pipe-rack", "fold", "probe-into-clamp", "joint-limit", "long-weld",
-          "urdf-arm")  # fmt: skip
+
+def commands(s: dvqp.Scene, traj: dvqp.Trajectory) -> np.ndarray:
+    """The tool command of every step, with the position feedback of a path, (N, 4)."""
+    c = scene_commands(s)
+    if c.feedback_gain == 0.0:
+        return c.velocity  # type: ignore[no-any-return]
+    error = dv_error(c.reference[:-1], traj.tool[:-1], s.pipe_radius)
+    return c.velocity + c.feedback_gain * error  # type: ignore[no-any-return]
+
+
+def checked_samples(traj: dvqp.Trajectory) -> list[int]:
+    """Every 40th sample, the last and the extremes of the recorded figures."""
+    extremes = (np.argmin(traj.min_clearance), np.argmin(traj.self_distance),
+                np.argmax(traj.limit_excess), np.argmin(traj.probe_clearance))  # fmt: skip
+    return sorted({*range(0, traj.n_steps + 1, 40), traj.n_steps, *map(int, extremes)})
 
 
 @functools.cache
-def runs(name: str, backend: str) -> tuple[dvqp.Trajectory, dvqp.Trajectory]:
+def start_values(name: str) -> list:  # type: ignore[type-arg]
     s = scene(name)
-    return dvqp.plan(s, backend, engine="reference"), dvqp.plan(s, backend, engine="compiled")
-
-
-def assert_same(name: str, ref: np.ndarray, got: np.ndarray, tol: float = 1e-12) -> None:
-    """Equal to ``tol`` relative to the field's largest finite value (infinities equal)."""
-    assert ref.shape == got.shape, name
-    finite = np.isfinite(ref)
-    np.testing.assert_array_equal(np.isfinite(got), finite, err_msg=name)
-    np.testing.assert_array_equal(got[~finite], ref[~finite], err_msg=name)
-    scale = max(1.0, float(np.abs(ref[finite]).max(initial=0.0)))
-    np.testing.assert_allclose(got[finite], ref[finite], rtol=0, atol=tol * scale, err_msg=name)
+    return verified_values(s.spec().limits, s.robot, np.asarray(s.q0, float), s.pipe_radius)
 
 
 @pytest.mark.parametrize("backend", ["pinv", "daqp"])
-@pytest.mark.parametrize("name", SCENES)
-def test_a_compiled_run_reproduces_the_reference_run(name: str, backend: str) -> None:
-    ref, got = runs(name, backend)
-    for field in SAMPLED:
-        assert_same(field, getattr(ref, field), getattr(got, field))
-    # The QP's answers differ by DAQP's round-off (up to 1.5e-12 rad/s measured): the compiled
-    # problem keeps inactive rows (h = +inf) that the reference problem drops, so the solver
-    # factors differently shaped systems; positions and every sampled value agree to 1e-12.
-    for field in STEPPED:
-        assert_same(field, getattr(ref, field), getattr(got, field), tol=5e-12)
-    for field in ("status", "success", "substeps", "limits_kept", "iterations"):
-        if field == "iterations" and backend == "daqp":
-            continue  # the compiled backend keeps its own warm start
-        np.testing.assert_array_equal(getattr(got, field), getattr(ref, field), err_msg=field)
+@pytest.mark.parametrize("name", BUNDLED)
+def test_every_sample_of_a_run_is_the_state_its_joints_reach(name: str, backend: str) -> None:
+    s, traj = scene(name), run(name, backend)
+    R, period = s.pipe_radius, 2.0 * math.pi * s.pipe_radius
+    scale = max(1.0, float(np.abs(traj.q).max()))
+    np.testing.assert_allclose(traj.q[1:], traj.q[:-1] + s.dt * traj.qdot, rtol=0,
+                               atol=1e-13 * scale)  # fmt: skip
+    for k in checked_samples(traj):
+        f = frames(s.robot, traj.q[k], R)
+        np.testing.assert_allclose(wrapped(traj.tool[k, 0] - f.tool[0], period), 0.0, atol=1e-12)
+        np.testing.assert_allclose(traj.tool[k, 1:3], f.tool[1:3], rtol=0, atol=1e-12)
+        assert wrapped(traj.tool[k, 3] - f.tool[3], 2 * math.pi) == pytest.approx(0.0, abs=1e-12)
+        points = traj.points[k]
+        np.testing.assert_allclose(wrapped(points[:, 0] - f.guarded[:-1, 0], period), 0.0,
+                                   atol=1e-12)  # fmt: skip
+        np.testing.assert_allclose(points[:, 1:], f.guarded[:-1, 1:], rtol=0, atol=1e-12)
+        assert traj.tilt[k] == pytest.approx(tilt(f), abs=1e-9)
+        assert traj.self_distance[k] == pytest.approx(self_distances(f.origins).min(), abs=1e-12)
+        if len(s.obstacles):
+            whole, probe = safety.clearances(s, traj.q[k])
+            assert traj.min_clearance[k] == pytest.approx(whole, abs=1e-7)
+            assert traj.probe_clearance[k] == pytest.approx(probe, abs=1e-7)
+        else:
+            assert traj.min_clearance[k] == math.inf == traj.probe_clearance[k]
+        now = verified_values(s.spec().limits, s.robot, traj.q[k], R)
+        value, ratio, _ = worst_excess(start_values(name), now)
+        assert traj.limit_excess[k] == pytest.approx(max(value, 0.0), abs=1e-7)
+        if abs(ratio - 1.0) > 1e-2:
+            assert traj.limits_kept[k] == (ratio <= 1.0)
 
 
-@pytest.mark.parametrize("dt", [0.05, 0.5])
-def test_large_and_split_steps_are_handed_to_the_reference_path(dt: float) -> None:
-    """At dt 0.05 s some steps move a joint more than 0.02 rad (their straight motion is
-    checked at interior points on the reference path); at 0.5 s every step does, and one is
-    split into substeps."""
-    text = scene("paper-two-inlets").text
-    s = dvqp.scenes.loads(text.replace("dt = 0.005", f"dt = {dt}"), f"paper-dt{dt}.toml")
-    ref = dvqp.plan(s, "daqp", engine="reference")
-    got = dvqp.plan(s, "daqp")
-    assert not ref.compiled.any()
-    large = np.abs(got.qdot * dt).max(axis=1) > 0.02
-    assert large.any()
-    np.testing.assert_array_equal(got.compiled, ~large & (got.substeps == 1))
-    np.testing.assert_array_equal(got.status, ref.status)
-    np.testing.assert_array_equal(got.substeps, ref.substeps)
-    np.testing.assert_array_equal(got.limits_kept, ref.limits_kept)
-    for field in SAMPLED:  # the end states' figures, whichever path took the step
-        assert_same(field, getattr(ref, field), getattr(got, field))
+@pytest.mark.parametrize("backend", ["pinv", "daqp"])
+@pytest.mark.parametrize("name", BUNDLED)
+def test_the_task_error_of_every_step_is_measured_on_the_motion(name: str, backend: str) -> None:
+    """``‖J̄ Q̇ − ẋ‖∞`` with ``J̄ Q̇`` the derivative of Pinocchio's tool along ``Q̇``."""
+    s, traj = scene(name), run(name, backend)
+    xdot, eps = commands(s, traj), 1e-6
+    taken = np.flatnonzero(traj.success & (traj.substeps == 1))
+    assert taken.size > 0.9 * traj.n_steps
+    for k in taken:
+        ahead = frames(s.robot, traj.q[k] + eps * traj.qdot[k], s.pipe_radius).tool
+        behind = frames(s.robot, traj.q[k] - eps * traj.qdot[k], s.pipe_radius).tool
+        moved = (ahead - behind) / (2 * eps)
+        assert traj.task_error[k] == pytest.approx(np.abs(moved - xdot[k]).max(), abs=1e-7)
+    assert np.all(np.isinf(traj.task_error[~traj.success]))
 
 
-def test_relaxed_steps_are_compiled_too() -> None:
-    _, got = runs("probe-into-clamp", "daqp")
-    relaxed = got.status == "relaxed"
-    assert relaxed.sum() > 100
-    assert got.compiled[relaxed].all()
-
-
-def test_the_step_of_a_bundled_scene_is_fused_into_two_generated_drivers() -> None:
-    s = scene("pipe-rack")
-    step = compile_step(s.robot, s.pipe_radius, make_resolver("daqp", s.spec()), s.obstacles,
-                        True)  # fmt: skip
-    assert step is not None
-    assert step.evaluate.fused and step.prepare.fused  # type: ignore[attr-defined]
-
-
-def test_the_baseline_is_compiled_on_every_step() -> None:
-    _, got = runs("paper-two-inlets", "pinv")
-    assert got.compiled.all()
-
-
-def test_the_worst_excess_of_a_state_matches_the_reference_check() -> None:
-    s = scene("pipe-rack")
-    resolver = make_resolver("daqp", s.spec())
-    step = compile_step(s.robot, s.pipe_radius, resolver, s.obstacles, True)
-    assert step is not None
+@pytest.mark.parametrize("name", BUNDLED)
+def test_every_answer_of_the_qp_is_optimal_for_the_problem_of_its_step(name: str) -> None:
+    """At each step's state: the problem the step writes, and its answer certified: eq. 18
+    where no inequality is active, else the KKT conditions (strict, or relaxed with the task
+    weight ρ); braking is the velocity closest to rest in the box."""
+    s, traj = scene(name), run(name, "daqp")
+    spec = s.spec()
+    step = Stepper(s.robot, s.pipe_radius, QPResolver(spec, "daqp"), s.q0, s.dt)
     step.start(s.q0)
-    start = KinematicState.compute(s.robot, s.q0, s.pipe_radius)
-    for q in random_configurations(30, seed=5, spread=0.3):
+    xdot, weights = commands(s, traj), spec.diagonal(s.robot.n)
+    free = 0
+    for k in np.flatnonzero(traj.success & (traj.substeps == 1)):
+        step.observe(traj.qdot[k - 1] if k else np.zeros(s.robot.n), s.dt)  # the velocity so far
+        assert step.load(traj.q[k]) and step.prepare(xdot[k], s.dt) == -1
+        p, x, status = step.problem(), traj.qdot[k], traj.status[k]
+        g = spec.objective.gain * step.objective.gradient
+        np.testing.assert_array_equal(p.b, xdot[k])
+        np.testing.assert_array_equal(p.q, -g)
+        np.testing.assert_array_equal(p.P, np.diag(weights))
+        assert np.all(p.lb - 1e-9 <= x) and np.all(x <= p.ub + 1e-9), k
+        if status == "braking":  # the rows conflict: the box only (the verification decides)
+            np.testing.assert_array_equal(x, np.clip(0.0, p.lb, p.ub))
+            continue
+        assert p.G is None or np.all(p.G @ x <= p.h + 1e-9), k
+        relaxed = spec.task_weight if status == "relaxed" else None
+        if relaxed is None:
+            np.testing.assert_allclose(p.A @ x, p.b, rtol=0, atol=1e-9)
+        residual = kkt_residual(p.P, p.q, p.A, p.b, p.G, p.h, p.lb, p.ub, x, relaxed)
+        assert residual < 1e-9, (k, status, residual)
+        slack = np.concatenate([x - p.lb, p.ub - x, [] if p.G is None else p.h - p.G @ x])
+        if relaxed is None and slack.min() > 1e-7:
+            free += 1
+            expected = eq18(p.A, p.b, g, weights)
+            np.testing.assert_allclose(x, expected, rtol=0, atol=1e-9 * max(1.0, np.abs(x).max()))
+    assert free > 0  # eq. 18 was met as well as the active rows
+
+
+@pytest.mark.parametrize(("name", "spread"), [("pipe-rack", 0.3), ("fold", 0.8),
+                                              ("paper-two-inlets", 0.3)])  # fmt: skip
+def test_the_worst_excess_of_a_state_is_recomputed_independently(name: str, spread: float) -> None:
+    s = scene(name)
+    spec = s.spec()
+    step = Stepper(s.robot, s.pipe_radius, PseudoinverseResolver(spec), s.q0, s.dt)
+    step.start(s.q0)
+    rng = np.random.default_rng(5)
+    broken = 0
+    for q in np.asarray(s.q0) + rng.uniform(-spread, spread, size=(30, s.robot.n)):
         assert step.load(q)
-        ref = worst_excess(
-            resolver.spec.limits, start, KinematicState.compute(s.robot, q, s.pipe_radius)
+        value, ratio, quantity = worst_excess(
+            start_values(name), verified_values(spec.limits, s.robot, q, s.pipe_radius)
         )
-        np.testing.assert_allclose(step.excess[0], ref.value, rtol=0, atol=1e-12)
-        assert step.broken == ref.broken
+        assert step.excess_now[0] == pytest.approx(value, abs=1e-7)
+        assert step.broken == (ratio > 1.0)
+        found = step.excess()
+        assert found.value == step.excess_now[0] and found.quantity == quantity
+        broken += step.broken
+    assert broken >= 5
 
 
-class _PlainLimit:
-    """A user's limit with no kernel: the run must take the reference path."""
+class _PlainLimit(Limit):
+    """A user's limit with no kernel: a box wider than the scene's velocity limits."""
 
     name = "plain"
 
-    def compute(self, state: KinematicState, dt: float) -> dvqp.Bounds:
-        return dvqp.Bounds(np.full(state.n, -10.0), np.full(state.n, 10.0))
+    def compute(self, state, dt):  # type: ignore[no-untyped-def]
+        return Bounds(np.full(state.n, -10.0), np.full(state.n, 10.0))
 
 
-def test_a_part_without_a_kernel_sends_the_run_to_the_reference_path() -> None:
+class _Nothing(ObjectiveTerm):
+    """A user's objective term that adds nothing."""
+
+    def evaluate(self, state):  # type: ignore[no-untyped-def]
+        return Term(0.0, np.zeros(state.n))
+
+
+def test_parts_of_your_own_run_on_the_same_state_between_the_compiled_stages() -> None:
     s = scene("paper-two-inlets")
-    traj = dvqp.plan(s, "daqp", limits=[_PlainLimit()])
-    assert traj.n_steps > 0 and not traj.compiled.any()
-    with pytest.raises(ParameterError, match="engine"):
-        dvqp.plan(s, "daqp", limits=[_PlainLimit()], engine="compiled")
-
-
-def test_an_unknown_engine_is_refused() -> None:
-    with pytest.raises(ParameterError, match="engine"):
-        dvqp.plan(scene("paper-two-inlets"), "pinv", engine="fast")
-
-
-class _ScaledOrbitalLevel(dvqp.objective.OrbitalLevel):
-    """Overrides the math but not the kernel: its inherited kernel would be wrong."""
-
-    def evaluate(self, state: KinematicState) -> dvqp.Term:
-        term = super().evaluate(state)
-        return dvqp.Term(2.0 * term.value, 2.0 * term.gradient)
-
-
-def test_a_subclass_that_changes_the_math_but_not_the_kernel_is_not_compiled() -> None:
-    s = scene("paper-two-inlets")
+    assert np.all(s.robot.qd_max <= 10.0)
     spec = s.spec()
-    terms = (_ScaledOrbitalLevel(0.08), *spec.objective.terms[1:])
-    objective = dvqp.Objective(terms, gain=spec.objective.gain)
-    custom = dvqp.StepSpec(spec.tasks, objective, spec.limits, spec.weights, spec.task_weight)
-    resolver = make_resolver("daqp", custom)
-    assert compile_step(s.robot, s.pipe_radius, resolver, s.obstacles, True) is None
-    assert compile_step(s.robot, s.pipe_radius, make_resolver("daqp", spec), s.obstacles,
-                        True) is not None  # fmt: skip
+    objective = dvqp.Objective((*spec.objective.terms, _Nothing()), gain=spec.objective.gain)
+    ours = dvqp.StepSpec(spec.tasks, objective, (*spec.limits, _PlainLimit()), spec.weights,
+                         spec.task_weight)  # fmt: skip
+    c = scene_commands(s)
+    traj = dvqp.simulate(s.robot, s.pipe_radius, QPResolver(ours, "daqp"), s.q0, c.velocity,
+                         s.dt, obstacles=s.obstacles)  # fmt: skip
+    plain = run("paper-two-inlets", "daqp")
+    for field in ("q", "qdot", "w", "limit_excess", "min_clearance", "task_error"):
+        np.testing.assert_array_equal(getattr(traj, field), getattr(plain, field), err_msg=field)
+    np.testing.assert_array_equal(traj.status, plain.status)
 
 
-class _ThickSelfCollision(dvqp.limits.SelfCollision):
-    """Changes the math through a private helper only: the kernel it inherits would be wrong."""
+class _Level(OrbitalLevel):
+    """Changes the math of a built-in term: the inherited compiled kernel must not run."""
 
-    @staticmethod
-    def _geometry(state: KinematicState):  # type: ignore[no-untyped-def]
-        dist, normal, s, t, pairs = dvqp.limits.SelfCollision._geometry(state)
-        return dist - 0.03, normal, s, t, pairs
+    def evaluate(self, state):  # type: ignore[no-untyped-def]
+        return Term(1.0, np.arange(state.n, dtype=float))
 
 
-class _HalvingResolver(dvqp.QPResolver):
-    def resolve(self, state: KinematicState, command: np.ndarray, dt: float) -> dvqp.Step:
-        step = super().resolve(state, command, dt)
-        return dataclasses.replace(step, qdot=0.5 * step.qdot)
+class _Unchanged(dvqp.limits.SelfCollision):
+    """Derives from a built-in limit and implements nothing of its own."""
 
 
-def test_subclasses_of_built_in_parts_without_their_own_kernel_are_not_compiled() -> None:
-    s = scene("fold")
-    spec = s.spec()
-    limits = tuple(_ThickSelfCollision() if isinstance(lim, dvqp.limits.SelfCollision) else lim
-                   for lim in spec.limits)  # fmt: skip
-    thick = dvqp.StepSpec(spec.tasks, spec.objective, limits, spec.weights, spec.task_weight)
-    assert compile_step(s.robot, s.pipe_radius, make_resolver("daqp", thick), s.obstacles,
-                        True) is None  # fmt: skip
-    halving = _HalvingResolver(spec, "daqp")
-    assert compile_step(s.robot, s.pipe_radius, halving, s.obstacles, True) is None
+def test_a_subclass_of_a_built_in_part_is_a_part_of_your_own(robot: dvqp.Robot,
+                                                            q0: np.ndarray) -> None:  # fmt: skip
+    spec = dvqp.StepSpec((dvqp.ToolTask(),), dvqp.Objective((_Level(0.08),)))
+    step = Stepper(robot, 0.254, PseudoinverseResolver(spec), q0, 0.005)
+    step.start(q0)
+    assert step.objective.value == 1.0
+    np.testing.assert_array_equal(step.objective.gradient, np.arange(13.0))
+    spec = dvqp.StepSpec((dvqp.ToolTask(),), limits=(_Unchanged(),))
+    with pytest.raises(NotImplementedError, match="_Unchanged has no distances"):
+        Stepper(robot, 0.254, QPResolver(spec, "daqp"), q0, 0.005)

@@ -1,249 +1,148 @@
-"""The compiled limits write the reference path's rows and boxes, in place, to 1e-12."""
+"""The step's limits write their rows and box into one problem: dvqp's compiled limits and a
+user's NumPy (or compiled) limits side by side, each against what it keeps, measured
+independently (:mod:`tests.oracle_limits`)."""
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Sequence
-from pathlib import Path
 
 import numpy as np
 import pytest
+from numba import njit
 
-from dvqp import KinematicState, Obstacle, ObstacleSet, Robot, load_scene
-from dvqp.compiled import Kernel, ProximityBuffers, StepPlan
-from dvqp.errors import SingularConfigurationError
-from dvqp.geometry.proximity import proximity
+from dvqp import (
+    Bounds,
+    Constraint,
+    Distances,
+    Kernel,
+    KinematicState,
+    Limit,
+    Objective,
+    ObjectiveTerm,
+    ObstacleSet,
+    QPResolver,
+    Robot,
+    Stepper,
+    StepPlan,
+    Term,
+    VelocityDamper,
+)
 from dvqp.limits import (
     AccelerationLimit,
     JointPositionLimit,
     JointVelocityLimit,
-    Limit,
     ObstacleDamper,
-    ProbeHeight,
-    SelfCollision,
     SurfaceHeight,
     TiltLimit,
-    damper_rhs,
+    damper_value,
 )
-from dvqp.limits.damper_kernels import damper_value
-from dvqp.limits.self_collision import link_pairs, pair_distances
-from dvqp.resolution.qp import limit_rows
-from tests.common import LINK_LENGTHS, PIPE_RADIUS, spec_with
-
-ROOT = Path(__file__).resolve().parent.parent
-SCENES = {"paper-two-inlets": 0.5, "pipe-rack": 0.5, "fold": 1.0}
-"""Bundled scenes and the spread (rad) of random configurations that reach their margins."""
-DTS = (0.001, 0.005, 0.02)
-
-
-@functools.cache
-def scene(name: str):  # type: ignore[no-untyped-def]
-    return load_scene(ROOT / "scenes" / f"{name}.toml")
-
-
-def run(kernel: Kernel) -> None:
-    kernel.function(*kernel.args)
-
-
-def states(
-    robot: Robot, q0: np.ndarray, count: int, seed: int, spread: float, radius: float = PIPE_RADIUS
-) -> list[KinematicState]:
-    """Reference states at random configurations around ``q0`` (singular ones left out)."""
-    rng = np.random.default_rng(seed)
-    found = []
-    for q in q0 + rng.uniform(-spread, spread, size=(count, robot.n)):
-        try:
-            found.append(KinematicState.compute(robot, q, radius))
-        except SingularConfigurationError:
-            continue
-    return found
+from dvqp.limits.self_collision import pair_distances
+from dvqp.objective import ObstaclePoints, OrbitalLevel
+from dvqp.workspace import PairBuffers, as_struct
+from tests import stepping
+from tests.common import LINK_LENGTHS, PIPE_RADIUS
+from tests.limit_fixtures import (
+    DT,
+    DTS,
+    SCENES,
+    configurations,
+    damper_rows,
+    near_obstacles,
+    problem_rows,
+    scene,
+    tight_limits,
+)
+from tests.oracle_limits import damper_rhs, joint_box, segment_distance
+from tests.oracle_objective import total
 
 
-class Compiled:
-    """A plan with the kernels and verifiers of ``limits`` bound; loads reference states.
-
-    The proximity buffers are the shapes' kernels' where those exist, else allocated and
-    registered here; unless ``reference`` is False, at every state they are overwritten with
-    the reference proximity, so the limits are checked on their own (the shapes' kernels have
-    their own tests).
-    """
-
-    def __init__(
-        self, limits: Sequence[Limit], robot: Robot, radius: float, reference: bool = True
-    ) -> None:
-        self.plan = plan = StepPlan(robot.n, robot.n_points, radius)
-        self.limits, self.reference = tuple(limits), reference
-        self.sets = [o for o in (getattr(lim, "obstacles", None) for lim in limits) if o]
-        for obstacles in self.sets if reference else ():
-            if plan.proximity(obstacles) is None:
-                buffers = ProximityBuffers.allocate(len(obstacles), plan.k)
-                plan._proximity[id(obstacles)] = (obstacles, buffers)
-        self.kernels = {lim: lim.kernel(plan) for lim in limits}  # type: ignore[attr-defined]
-        self.verifiers = {
-            lim: lim.verifier(plan)  # type: ignore[attr-defined]
-            for lim in limits
-            if hasattr(lim, "excess")
-        }
-        every = [*self.kernels.values(), *self.verifiers.values()]
-        self.bound = [plan.bind(k) for k in self.kernels.values() if k is not None]
-        self.checks = [plan.bind(k) for k in self.verifiers.values() if k is not None]
-        if not every or all(k is None for k in every):
-            plan.bind(Kernel(run, ()))  # allocate the stacked arrays anyway
-
-    def load(self, state: KinematicState) -> None:
-        plan = self.plan
-        plan.state.load(state)
-        for kernel in plan.geometry:
-            run(kernel)
-        for obstacles in self.sets if self.reference else ():
-            plan._proximity[id(obstacles)][1].load(proximity(state, obstacles))
-
-    def step(self, state: KinematicState, dt: float) -> tuple[np.ndarray, ...]:
-        """``G, h, lb, ub`` of the compiled limits at ``state``."""
-        plan = self.plan
-        self.load(state)
-        plan.dt[0] = dt
-        plan.lb[:] = -np.inf
-        plan.ub[:] = np.inf
-        for kernel in self.bound:
-            run(kernel)
-        return plan.stacked["G"], plan.stacked["h"], plan.lb, plan.ub
-
-    def values(self, state: KinematicState) -> np.ndarray:
-        """The verification values at ``state``."""
-        self.load(state)
-        for kernel in self.checks:
-            run(kernel)
-        return self.plan.stacked["values"].copy()
-
-
-def assert_rows(compiled: Compiled, state: KinematicState, dt: float) -> int:
-    """The compiled rows and box equal ``limit_rows``; returns the active row count."""
-    G, h, lb, ub = compiled.step(state, dt)
-    rows, box = limit_rows(spec_with(np.zeros(state.n), limits=compiled.limits), state, dt)
-    active = np.isfinite(h)
-    assert np.all(G[~active] == 0.0) and np.all(h[~active] == np.inf)
-    np.testing.assert_allclose(G[active], rows.G, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(h[active], rows.h, rtol=0, atol=1e-12)
-    np.testing.assert_array_equal(lb, box.lb)
-    np.testing.assert_array_equal(ub, box.ub)
-    return int(active.sum())
+def assert_problem(s: Stepper, limits: Sequence[Limit], dt: float, *, fd: bool = False,
+                   gradient: bool = True) -> int:  # fmt: skip
+    """At the loaded state, every damper's rows are what it keeps (:func:`damper_rows`), the
+    box is the joint limits' (and a user's boxes'), and the problem holds exactly these rows
+    (damper rows first, in the spec's order, then the other limits' rows; a row that does not
+    apply is ``0 · Q̇ ≤ +inf``). Returns the rows that apply."""
+    q = s.state.q.copy()
+    rows = [damper_rows(s, limit, q, dt, fd=fd, atol=1e-9, gradient=gradient)
+            for limit in limits if isinstance(limit, VelocityDamper)]  # fmt: skip
+    s.load(q)
+    s.prepare(np.zeros(4), dt)
+    rows += [s.rows(limit) for limit in limits if isinstance(limit, Cap)]
+    lb, ub = joint_box(limits, q, dt)
+    for limit in limits:
+        if isinstance(limit, Box):
+            low, high = limit.compute(s.state, dt).lb, limit.compute(s.state, dt).ub
+            lb, ub = np.maximum(lb, low), np.minimum(ub, high)
+    problem = s.problem()
+    np.testing.assert_array_equal(problem.lb, lb)
+    np.testing.assert_array_equal(problem.ub, ub)
+    if problem.G is None:
+        assert not rows or not sum(r.rows for r in rows)  # type: ignore[union-attr]
+        return 0
+    applies = np.isfinite(problem.h)
+    assert np.all(problem.G[~applies] == 0.0)
+    np.testing.assert_array_equal(problem.G[applies], np.vstack([r.G for r in rows]))  # type: ignore[union-attr]
+    np.testing.assert_array_equal(problem.h[applies], np.concatenate([r.h for r in rows]))  # type: ignore[union-attr]
+    return int(applies.sum())
 
 
 @pytest.mark.parametrize("name", SCENES)
-def test_a_scene_s_limits_compile_to_its_rows_and_box(name: str) -> None:
+def test_a_scene_s_limits_write_the_rows_of_what_they_keep(name: str) -> None:
     sc = scene(name)
-    compiled = Compiled(sc.spec().limits, sc.robot, sc.pipe_radius)
-    found = states(sc.robot, sc.q0, 12, seed=1, spread=SCENES[name], radius=sc.pipe_radius)
+    limits = sc.spec().limits
+    found = configurations(sc.robot, sc.q0, 12, seed=1, spread=SCENES[name],
+                           radius=sc.pipe_radius)  # fmt: skip
     assert len(found) >= 6
-    active = [assert_rows(compiled, state, dt) for state in found for dt in DTS]
+    s = Stepper(sc.robot, sc.pipe_radius, QPResolver(sc.spec(), "daqp"), sc.q0, DT)
+    s.start(sc.q0)
+    active = []
+    for i, q in enumerate(found):
+        assert s.load(q)
+        for dt in DTS:
+            active.append(assert_problem(s, limits, dt, fd=i == 0, gradient=dt == DTS[0]))
     assert min(active) < max(active) or not len(sc.obstacles)  # rows come and go in place
-
-
-@pytest.mark.parametrize("name", SCENES)
-def test_the_rows_from_the_shapes_own_kernels(name: str) -> None:
-    """End to end: the obstacle dampers read what the shapes' kernels wrote."""
-    sc = scene(name)
-    plan = StepPlan(sc.robot.n, sc.robot.n_points, sc.pipe_radius)
-    if plan.proximity(sc.obstacles) is None:
-        pytest.skip("an obstacle shape has no compiled kernel yet")
-    compiled = Compiled(sc.spec().limits, sc.robot, sc.pipe_radius, reference=False)
-    for state in states(sc.robot, sc.q0, 6, seed=12, spread=SCENES[name], radius=sc.pipe_radius):
-        assert_rows(compiled, state, 0.005)
-
-
-def near_set(state: KinematicState) -> ObstacleSet:
-    """Circles around and on the arm: one on point 2's centre (no normal), one 0.05 mm
-    inside point 3's 2 cm margin, one holding point 4 inside, one over link 4's middle, one
-    grazing the probe, one far."""
-    p = state.guarded[:, :2]
-    return ObstacleSet([
-        Obstacle(p[1], 0.02),
-        Obstacle(p[2] + np.array([0.0, 0.05 - 5e-5]), 0.03),
-        Obstacle(p[3] + np.array([0.01, 0.0]), 0.03),
-        Obstacle(0.5 * (p[3] + p[4]) + np.array([0.0, 0.035]), 0.03),
-        Obstacle(p[-1] + np.array([0.0, 0.045]), 0.04),
-        Obstacle(np.array([-0.5, -1.0]), 0.05),
-    ])  # fmt: skip
-
-
-def tight_limits(state: KinematicState, deceleration: float) -> tuple[Limit, ...]:
-    """Every damper, tuned so that parts sit above, within and deep below their margins."""
-    return (
-        ObstacleDamper(near_set(state), 0.02, 0.15, 0.7, deceleration),
-        SurfaceHeight(0.08, 0.3, deceleration),
-        ProbeHeight(0.06, 0.5, deceleration),
-        TiltLimit(1.2, 0.5, deceleration),
-        SelfCollision(0.12, 0.2, 0.5, deceleration),
-    )
 
 
 @pytest.mark.parametrize("deceleration", [1.0, 0.05, math.inf])
 def test_the_dampers_rows_inside_and_outside_their_margins(
-    robot: Robot, state0: KinematicState, deceleration: float
+    robot: Robot, q0: np.ndarray, state0: KinematicState, deceleration: float
 ) -> None:
-    compiled = Compiled(tight_limits(state0, deceleration), robot, PIPE_RADIUS)
-    found = [state0, *states(robot, state0.q, 10, seed=2, spread=0.15)]
-    for state in found:
+    limits = tight_limits(state0, deceleration)
+    s = stepping.stepper(robot, q0, limits=limits, backend="daqp")
+    for q in [q0, *configurations(robot, q0, 10, seed=2, spread=0.15)]:
+        assert s.load(q)
         for dt in DTS:
-            assert_rows(compiled, state, dt)
-    h = compiled.step(found[0], 0.005)[1]
-    assert np.any(h == 0.0) and np.any(h < 0.0) and np.any(h > 0.0)  # deep, drift, room
+            assert assert_problem(s, limits, dt, fd=q is q0 and dt == DT, gradient=dt == DT) > 0
+    s.load(q0)
+    s.prepare(np.zeros(4), DT)
+    h = s.problem().h
+    assert np.any(h == 0.0) and np.any(h < 0.0) and np.any((h > 0.0) & (h < np.inf))
 
 
-def test_joint_boxes_with_finite_infinite_and_crossed_limits(robot: Robot, q0: np.ndarray) -> None:
-    q_min, q_max = q0 - 0.1, q0 + 0.1
-    q_min[0], q_max[3] = -np.inf, np.inf
-    limited = Robot.ndt13(LINK_LENGTHS, q_min=q_min, q_max=q_max)
-    acceleration = AccelerationLimit(limited, np.linspace(2.0, 12.0, 13))
-    limits = (JointPositionLimit(limited), JointVelocityLimit(limited), acceleration)
-    compiled = Compiled(limits, limited, PIPE_RADIUS)
-    rng = np.random.default_rng(3)
-    for state in states(limited, q0, 8, seed=4, spread=0.2):  # some joints past their limits
-        for dt in DTS:
-            assert_rows(compiled, state, dt)
-            acceleration.observe(rng.uniform(-2.0, 2.0, 13), dt)
-            assert_rows(compiled, state, dt)
-    acceleration.reset()
-    assert_rows(compiled, state, 0.005)
+def test_limits_that_add_nothing_add_no_rows_and_no_values(robot: Robot, q0: np.ndarray) -> None:
+    limits = [TiltLimit(0.0), ObstacleDamper(ObstacleSet([]))]
+    s = stepping.stepper(robot, q0, limits=limits, backend="daqp")
+    assert s.prepare(np.zeros(4), DT) == -1
+    assert s.problem().G is None and problem_rows(s) == 0
+    assert s.excess().value == -math.inf and s.excess_now[0] == -math.inf
 
 
-def test_the_acceleration_limit_keeps_one_live_previous_velocity(robot: Robot) -> None:
-    limit = AccelerationLimit(robot)
-    previous = limit.previous
-    limit.observe(np.arange(13.0), 0.01)
-    assert limit.previous is previous
-    np.testing.assert_array_equal(previous, np.arange(13.0))
-    limit.reset()
-    assert limit.previous is previous and not previous.any()
+def test_the_arm_s_link_pairs_are_the_brute_force_pairs(robot: Robot, q0: np.ndarray) -> None:
+    pairs = PairBuffers.allocate(5)
+    for q in [q0, *configurations(robot, q0, 5, seed=5, spread=0.6)]:
+        o = np.array(KinematicState.compute(robot, q, PIPE_RADIUS).origins)
+        pair_distances(o, as_struct(pairs))
+        i, j = pairs.i, pairs.j
+        brute, _ = segment_distance(o[i], o[i + 1], o[j], o[j + 1])
+        np.testing.assert_allclose(pairs.distance, brute, rtol=0, atol=1e-12)
+        s, t = pairs.s[:, None], pairs.t[:, None]
+        gap = (o[i] + s * (o[i + 1] - o[i])) - (o[j] + t * (o[j + 1] - o[j]))
+        np.testing.assert_allclose(np.linalg.norm(gap, axis=1), pairs.distance, atol=1e-15)
+        np.testing.assert_allclose(pairs.normal * pairs.distance[:, None], gap, atol=1e-15)
 
 
-def test_limits_that_add_nothing_have_no_kernel(robot: Robot) -> None:
-    plan = StepPlan(robot.n, robot.n_points, PIPE_RADIUS)
-    for limit in (TiltLimit(0.0), ObstacleDamper(ObstacleSet([]))):
-        assert limit.kernel(plan) is None and limit.verifier(plan) is None
-    assert not plan._sizes
-
-
-def test_the_pair_buffers_are_the_reference_pairs(robot: Robot, state0: KinematicState) -> None:
-    plan = StepPlan(robot.n, robot.n_points, PIPE_RADIUS)
-    pairs = plan.self_pairs()
-    assert plan.self_pairs() is pairs and len(plan.geometry) == 1
-    i, j = link_pairs(state0.k)
-    np.testing.assert_array_equal(pairs.i, i)
-    np.testing.assert_array_equal(pairs.j, j)
-    for state in [state0, *states(robot, state0.q, 5, seed=5, spread=0.6)]:
-        plan.state.load(state)
-        run(plan.geometry[0])
-        expected = pair_distances(np.ascontiguousarray(state.origins), i, j)
-        for got, want in zip(
-            (pairs.distance, pairs.normal, pairs.s, pairs.t), expected, strict=True
-        ):  # the same kernel, compiled in another caller: LLVM may round differently
-            np.testing.assert_allclose(got, want, rtol=0, atol=1e-15)
-
-
-def test_the_scalar_damper_value_is_damper_rhs_bit_for_bit() -> None:
+def test_the_scalar_damper_value_is_the_old_damper_rhs_bit_for_bit() -> None:
     rng = np.random.default_rng(6)
     safe, depth = 0.01, 1e-4
     d = np.concatenate([
@@ -256,3 +155,136 @@ def test_the_scalar_damper_value_is_damper_rhs_bit_for_bit() -> None:
                 want = damper_rhs(d, safe, gain, dt, depth, decel)
                 got = np.array([damper_value(x, safe, gain, dt, depth, decel) for x in d])
                 np.testing.assert_array_equal(got, want)
+
+
+# -- a user's limits in the same problem --------------------------------------------------
+
+
+class Mine(VelocityDamper):
+    """A user's damper in NumPy: body points 2 and 4 above their own floors."""
+
+    name = "mine"
+
+    def __init__(self, floors: Sequence[float]) -> None:
+        super().__init__(gain=0.4, deceleration=2.0)
+        self.floors = np.array(floors)
+
+    def distances(self, state: KinematicState) -> Distances:
+        at = [1, 3]
+        return Distances(np.array(state.guarded[at, 2]), np.array(state.guarded_jacobians[at, 2]),
+                         self.floors, lambda: ("mine/point2", "mine/point4"))  # fmt: skip
+
+
+@njit(cache=True)
+def _tool_z(tool, tool_jacobian, distance, gradient, usable):  # type: ignore[no-untyped-def]
+    distance[0], usable[0] = tool[1], True
+    for c in range(gradient.shape[1]):
+        gradient[0, c] = tool_jacobian[1, c]
+
+
+class Compiled(VelocityDamper):
+    """A user's damper with a kernel: the tool's z above a bound (its NumPy ``distances``
+    is the oracle)."""
+
+    name = "z"
+    reach = 0.5
+
+    def __init__(self, z_min: float) -> None:
+        super().__init__(gain=0.6)
+        self.z_min = z_min
+
+    @property
+    def safe(self) -> float:
+        return self.z_min
+
+    def labels(self, k: int) -> tuple[str, ...]:
+        return ("tool/z",)
+
+    def kernel(self, plan: StepPlan) -> Kernel:
+        distance, gradient, usable = plan.damper_rows(1)
+        s = plan.state
+        return Kernel(_tool_z, (s.tool, s.tool_jacobian, distance, gradient, usable))
+
+    def distances(self, state: KinematicState) -> Distances:
+        return Distances(state.tool[1:2], state.tool_jacobian[1:2], self.z_min,
+                         lambda: ("tool/z",))  # fmt: skip
+
+
+class Cap(Limit):
+    """A user's constraint: joints 2 + 3 turn together at most 0.3 rad/s, and joint 2 no
+    faster than 0.2 rad/s while it is negative (a row that comes and goes: the run reserves
+    the rows it has at its start)."""
+
+    name = "cap"
+
+    def compute(self, state: KinematicState, dt: float) -> Constraint:
+        G = np.zeros((2, state.n))
+        G[0, 1:3] = 1.0
+        G[1, 1] = 1.0
+        if state.q[1] < 0.0:
+            return Constraint(G, np.array([0.3, 0.2]))
+        return Constraint(G[:1], np.array([0.3]))
+
+
+class Box(Limit):
+    """A user's box: every joint within 0.4 rad/s, the wrist joints within 0.1 + |q| rad/s."""
+
+    name = "box"
+
+    def compute(self, state: KinematicState, dt: float) -> Bounds:
+        ub = np.full(state.n, 0.4)
+        ub[10:] = 0.1 + np.abs(state.q[10:])
+        return Bounds(-ub, ub)
+
+
+class Lean(ObjectiveTerm):
+    """A user's objective term: ``w = −½ (q₂ − 0.02)²``."""
+
+    name = "lean"
+
+    def evaluate(self, state: KinematicState) -> Term:
+        gradient = np.zeros(state.n)
+        gradient[1] = -(state.q[1] - 0.02)
+        return Term(-0.5 * float(state.q[1] - 0.02) ** 2, gradient)
+
+
+def test_a_user_s_limits_land_in_the_same_problem_as_dvqp_s(q0: np.ndarray) -> None:
+    """A user's dampers (NumPy and compiled), constraint, box and objective term, between
+    dvqp's: every row, the box and the cost of one problem, which the step solves."""
+    robot = Robot.ndt13(LINK_LENGTHS, q_min=q0 - 0.3, q_max=q0 + 0.3)
+    state = KinematicState.compute(robot, q0, PIPE_RADIUS)
+    heights = np.array(state.guarded[[1, 3], 2])
+    obstacles = near_obstacles(state)
+    objective = Objective((OrbitalLevel(0.08, 50.0), Lean(), ObstaclePoints(obstacles)), 0.5)
+    cap = Cap()
+    limits = (
+        Mine(heights - [0.02, 1e-5]),
+        ObstacleDamper(obstacles, margin=0.01, influence=0.1),
+        cap,
+        JointPositionLimit(robot),
+        Compiled(float(state.tool[1]) - 0.05),
+        Box(),
+        SurfaceHeight(0.02),
+        JointVelocityLimit(robot),
+        AccelerationLimit(robot, 20.0),
+    )
+    s = stepping.stepper(robot, q0, limits=limits, objective=objective, backend="daqp")
+    signs = set()
+    for q in [q0, *configurations(robot, q0, 6, seed=7, spread=0.1)]:
+        assert s.load(q)
+        signs.add(bool(q[1] > 0.0))
+        for dt in (DT, 0.02):
+            assert assert_problem(s, limits, dt, fd=q is q0) > 0
+            found = cap.compute(s.state, dt)
+            rows = s.rows(cap)
+            np.testing.assert_array_equal(rows.G, found.G)  # type: ignore[union-attr]
+            np.testing.assert_array_equal(rows.h, found.h)  # type: ignore[union-attr]
+        want = total(objective.terms, KinematicState.compute(robot, q, PIPE_RADIUS))
+        assert s.objective.value == pytest.approx(want.value, rel=0, abs=1e-12)
+        found = s.resolve(np.array([0.01, 0.0, 0.0, 0.0]), DT)
+        problem = s.problem()
+        np.testing.assert_allclose(problem.q, -0.5 * want.gradient, rtol=0, atol=1e-12)
+        assert found.success and np.all(problem.G @ s.x <= problem.h + 1e-9)
+        assert np.all(problem.lb - 1e-9 <= s.x) and np.all(s.x <= problem.ub + 1e-9)
+        s.observe(s.x, DT)
+    assert signs == {True, False}  # the user's second row came and went

@@ -1,24 +1,38 @@
-"""The objective terms' compiled kernels against their ``evaluate``: each adds its value and
-gradient to the plan's, over the same configurations as the geometry tests."""
+"""The step's objective against the old NumPy terms (:mod:`tests.oracle_objective`): each
+compiled term and their sum over every shape class and bundled scene, with a user's terms
+(NumPy or compiled) and shapes of one's own mixed in."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from numba import njit
 
-from dvqp import KinematicState, Objective, ObstacleSet
-from dvqp.compiled import StepPlan
-from dvqp.objective import ObstacleLinks, ObstaclePoints, OrbitalLevel
-from tests.common import ORBITAL_LEVEL, ConstantGradient
+from dvqp import (
+    Kernel,
+    KinematicState,
+    Objective,
+    ObjectiveTerm,
+    ObstacleSet,
+    StepPlan,
+    Term,
+)
+from dvqp.errors import ShapeError
+from dvqp.geometry.shapes import Band, Circle
+from dvqp.limits import ObstacleDamper
+from dvqp.objective import ObstacleLinks
+from tests import stepping
+from tests.common import ORBITAL_LEVEL, central_difference
 from tests.compiled_cases import (
     BUNDLED_WITH_OBSTACLES,
     Case,
     Dot,
-    bound_kernels,
     mixed_case,
     paper_robot,
     scene_case,
 )
+from tests.limit_fixtures import damper_rows
+from tests.oracle_objective import evaluate, total
 
 K_HEIGHT = np.array([100.0, 50.0, 80.0, 120.0, 90.0])
 K_OBSTACLE = np.array([1.0, 2.0, 0.5, 1.5, 1.0])
@@ -38,88 +52,174 @@ def cases() -> list[tuple[str, Case]]:
     return found
 
 
-def run_term(plan: StepPlan, kernels: list, state: KinematicState, start: float, g0) -> None:  # type: ignore[no-untyped-def, type-arg]
-    """Load ``state``, set the accumulators to ``start`` and ``g0``, call the kernels."""
-    plan.state.load(state)
-    plan.objective_value[0] = start
-    plan.objective_gradient[:] = g0
-    for kernel in kernels:
-        kernel.function(*kernel.args)
+CASES = cases()
 
 
-@pytest.mark.parametrize(("name", "case"), cases(), ids=[c[0] for c in cases()])
+def assert_objective(case: Case, objective: Objective, configurations: np.ndarray) -> list[float]:
+    """At each configuration the step's ``w`` and ``∂w/∂Q`` are the oracle's (1e-12);
+    returns the values."""
+    s = stepping.stepper(case.robot, case.q0, objective=objective, radius=case.radius)
+    values = []
+    for q in configurations:
+        assert s.load(q)
+        found, want = s.objective, total(objective.terms, case.state(q))
+        assert found.value == pytest.approx(want.value, rel=0, abs=1e-12)
+        np.testing.assert_allclose(found.gradient, want.gradient, rtol=0, atol=1e-12)
+        values.append(found.value)
+    return values
+
+
+@pytest.mark.parametrize(("name", "case"), CASES, ids=[c[0] for c in CASES])
 @pytest.mark.parametrize("vector_gains", [False, True], ids=["scalar", "per-point"])
-def test_each_compiled_term_adds_its_reference_value_and_gradient(
-    name: str, case: Case, vector_gains: bool
-) -> None:
+def test_each_compiled_term_is_its_oracle(name: str, case: Case, vector_gains: bool) -> None:
     objective = paper_objective(case.obstacles, vector_gains)
     spread = 0.1 if name.startswith("mixed") else 0.3
-    rng = np.random.default_rng(1)
-    active = dict.fromkeys((t.name for t in objective.terms), 0)
+    active = {}
     for term in objective.terms:
-        state0 = case.state(case.q0)
-        plan = StepPlan(state0.n, state0.k, case.radius)
-        kernels = bound_kernels(plan, lambda p, term=term: [term.kernel(p)])
-        for q in case.configurations(30, spread):
-            state = case.state(q)
-            start, g0 = rng.normal(), rng.normal(size=state.n)
-            run_term(plan, kernels, state, start, g0)
-            want = term.evaluate(state)
-            active[term.name] += want.value != 0.0
-            assert plan.objective_value[0] - start == pytest.approx(want.value, rel=0, abs=1e-12)
-            np.testing.assert_allclose(
-                plan.objective_gradient - g0, want.gradient, rtol=0, atol=1e-12
-            )
+        values = assert_objective(case, Objective((term,)), case.configurations(30, spread))
+        active[term.name] = sum(v != 0.0 for v in values)
     if name.startswith("mixed"):  # the obstacle terms were really exercised
         assert min(active.values()) >= 10, active
 
 
-@pytest.mark.parametrize(("name", "case"), cases(), ids=[c[0] for c in cases()])
-def test_the_compiled_objective_sums_to_the_reference_objective(name: str, case: Case) -> None:
+@pytest.mark.parametrize(("name", "case"), CASES, ids=[c[0] for c in CASES])
+def test_the_objective_is_the_sum_of_the_oracle_terms(name: str, case: Case) -> None:
     objective = paper_objective(case.obstacles, vector_gains=True)
-    state0 = case.state(case.q0)
-    plan = StepPlan(state0.n, state0.k, case.radius)
-    kernels = bound_kernels(plan, objective.kernels)  # type: ignore[arg-type]
-    assert len(kernels) == len(plan.geometry) + 3
-    for q in case.configurations(20, 0.1):
-        state = case.state(q)
-        run_term(plan, kernels, state, 0.0, 0.0)
-        want = objective.evaluate(state)
-        assert plan.objective_value[0] == pytest.approx(want.value, rel=0, abs=1e-12)
-        np.testing.assert_allclose(plan.objective_gradient, want.gradient, rtol=0, atol=1e-12)
+    assert_objective(case, objective, case.configurations(20, 0.1))
+
+
+@pytest.mark.parametrize("seam", [False, True], ids=["mixed", "mixed-seam"])
+def test_the_gradient_is_the_derivative_of_w(seam: bool) -> None:
+    """Central differences of the step's own ``w``, every shape class in the points' term;
+    the links' term over the circles and bands (the deepest point of a link inside a polygon
+    can sit on a kink, where the penalty has no derivative)."""
+    case = mixed_case(paper_robot(), seam=seam)
+    smooth = ObstacleSet([o for o in case.obstacles if type(o) in (Circle, Band)])
+    paper = paper_objective(case.obstacles, vector_gains=True)
+    terms = (paper.terms[0], paper.terms[1], ObstacleLinks(smooth, K_OBSTACLE))
+    s = stepping.stepper(case.robot, case.q0, objective=Objective(terms), radius=case.radius)
+
+    def w(v: np.ndarray) -> float:
+        assert s.load(v)
+        return s.objective.value
+
+    links = 0
+    for q in case.configurations(4, 0.1, seed=1):
+        fd = central_difference(w, q, 1e-7)
+        s.load(q)
+        scale = max(np.abs(fd).max(), 1e-12)
+        np.testing.assert_allclose(s.objective.gradient, fd, rtol=1e-6, atol=1e-6 * scale)
+        links += evaluate(terms[2], case.state(q)).value != 0.0
+    assert links > 0
 
 
 def test_an_empty_obstacle_set_adds_only_the_orbital_level() -> None:
     case = mixed_case(paper_robot())
     objective = paper_objective(ObstacleSet(), vector_gains=True)
-    state = case.state(case.configurations(2, 0.1)[1])
-    plan = StepPlan(state.n, state.k, case.radius)
-    kernels = bound_kernels(plan, objective.kernels)  # type: ignore[arg-type]
-    assert plan.geometry == [] and len(kernels) == 3
-    run_term(plan, kernels, state, 0.0, 0.0)
-    want = objective.evaluate(state)
-    assert plan.objective_value[0] == pytest.approx(want.value, rel=0, abs=1e-12)
-    np.testing.assert_allclose(plan.objective_gradient, want.gradient, rtol=0, atol=1e-12)
-    assert want.value == objective.terms[0].evaluate(state).value
+    q = case.configurations(2, 0.1)[1]
+    (value,) = assert_objective(case, objective, q[None, :])
+    assert value == evaluate(objective.terms[0], case.state(q)).value != 0.0
 
 
-def test_an_objective_without_terms_has_no_kernels() -> None:
-    assert Objective(()).kernels(StepPlan(13, 5, 0.254)) == []
+def test_an_objective_without_terms_is_zero() -> None:
+    case = mixed_case(paper_robot())
+    s = stepping.stepper(case.robot, case.q0, objective=Objective(()), backend="daqp")
+    for q in case.configurations(3, 0.1):
+        assert s.load(q)
+        assert s.objective.value == 0.0 and not s.objective.gradient.any()
+    s.prepare(np.zeros(4), 0.005)
+    assert not s.problem().q.any()
 
 
-def test_a_term_without_kernel_makes_the_objective_uncompiled() -> None:
-    objective = Objective((OrbitalLevel(ORBITAL_LEVEL), ConstantGradient(np.zeros(13))))
-    assert objective.kernels(StepPlan(13, 5, 0.254)) is None
+class Centering(ObjectiveTerm):
+    """A user's term in NumPy: ``−½ Σ c_i (q_i − m_i)²``."""
+
+    name = "centering"
+
+    def __init__(self, middle: np.ndarray, gains: np.ndarray) -> None:
+        self.middle, self.gains = middle, gains
+
+    def evaluate(self, state: KinematicState) -> Term:
+        e = state.q - self.middle
+        return Term(-0.5 * float(self.gains @ (e * e)), -self.gains * e)
 
 
-def test_a_shape_without_kernel_makes_the_obstacle_terms_uncompiled() -> None:
-    obstacles = ObstacleSet([Dot([0.3, 0.3], 0.05)])
-    plan = StepPlan(13, 5, 0.254)
-    assert ObstaclePoints(obstacles).kernel(plan) is None
-    assert ObstacleLinks(obstacles).kernel(plan) is None
-    assert paper_objective(obstacles, vector_gains=False).kernels(plan) is None
+@njit(cache=True)
+def _reach(tool, tool_jacobian, value, gradient):  # type: ignore[no-untyped-def]
+    """Add ``l_tool`` to ``w`` and ``∂l/∂Q`` to its gradient."""
+    value[0] += tool[0]
+    for c in range(gradient.shape[0]):
+        gradient[c] += tool_jacobian[0, c]
 
 
-def test_per_point_gains_of_the_wrong_length_are_refused_when_the_plan_is_built() -> None:
-    with pytest.raises(ValueError, match="k_height"):
-        OrbitalLevel(ORBITAL_LEVEL, [1.0, 2.0]).kernel(StepPlan(13, 5, 0.254))
+class Reach(ObjectiveTerm):
+    """A user's compiled term: ``w = l`` of the tool (its ``evaluate`` is the oracle's)."""
+
+    name = "reach"
+
+    def kernel(self, plan: StepPlan) -> Kernel:
+        s = plan.state
+        return Kernel(_reach, (s.tool, s.tool_jacobian, plan.objective_value,
+                               plan.objective_gradient))  # fmt: skip
+
+    def evaluate(self, state: KinematicState) -> Term:
+        return Term(float(state.tool[0]), np.array(state.tool_jacobian[0]))
+
+
+def test_a_user_s_terms_add_to_the_compiled_terms() -> None:
+    """A NumPy term and a compiled term of one's own, between dvqp's: the sum of all."""
+    case = mixed_case(paper_robot())
+    paper = paper_objective(case.obstacles, vector_gains=True)
+    rng = np.random.default_rng(3)
+    centering = Centering(case.q0, rng.uniform(0.5, 2.0, 13))
+    terms = (paper.terms[0], centering, paper.terms[1], Reach(), paper.terms[2])
+    values = assert_objective(case, Objective(terms), case.configurations(10, 0.1))
+    alone = assert_objective(case, paper, case.configurations(10, 0.1))
+    assert all(a != b for a, b in zip(values, alone, strict=True))
+
+
+def test_a_shape_of_one_s_own_counts_in_the_obstacle_terms() -> None:
+    """A :class:`Dot` (measured by its NumPy methods) where a circle was: the same objective
+    as dvqp's compiled circle, next to the compiled shapes."""
+    case = mixed_case(paper_robot())
+    shapes = list(case.obstacles)
+    at = [i for i, shape in enumerate(shapes) if type(shape) is Circle]
+    own = list(shapes)
+    for i in at:
+        circle = shapes[i]
+        own[i] = Dot(circle.center, circle.radius, circle.weight)  # type: ignore[attr-defined]
+    dvqp_s = paper_objective(ObstacleSet(shapes), vector_gains=True)
+    ours = paper_objective(ObstacleSet(own), vector_gains=True)
+    Dot.calls.clear()
+    configurations = case.configurations(10, 0.1)
+    values = assert_objective(case, ours, configurations)
+    assert "point_distance" in Dot.calls and "segment_distance" in Dot.calls
+    np.testing.assert_allclose(values, assert_objective(case, dvqp_s, configurations),
+                               rtol=0, atol=1e-12)  # fmt: skip
+
+
+def test_terms_and_dampers_over_overlapping_sets_each_read_their_own_shapes() -> None:
+    """The objective over some shapes, an obstacle damper over others (some shared), the
+    recorded obstacles over a third set: each part sees its own."""
+    case = mixed_case(paper_robot())
+    shapes = list(case.obstacles)
+    objective = paper_objective(ObstacleSet(shapes[:5]), vector_gains=True)
+    damper = ObstacleDamper(ObstacleSet([shapes[4], shapes[2], shapes[7]]), 0.005, 0.1)
+    s = stepping.stepper(case.robot, case.q0, objective=objective, limits=[damper],
+                         backend="daqp", obstacles=ObstacleSet(shapes[5:]))  # fmt: skip
+    for q in case.configurations(8, 0.1):
+        assert s.load(q)
+        want = total(objective.terms, case.state(q))
+        assert s.objective.value == pytest.approx(want.value, rel=0, abs=1e-12)
+        np.testing.assert_allclose(s.objective.gradient, want.gradient, rtol=0, atol=1e-12)
+        damper_rows(s, damper, q)
+
+
+def test_per_point_gains_of_the_wrong_length_are_refused_when_the_step_is_laid_out() -> None:
+    case = mixed_case(paper_robot())
+    for objective in (
+        Objective.paper(ORBITAL_LEVEL, case.obstacles, k_height=[1.0, 2.0]),
+        Objective.paper(ORBITAL_LEVEL, case.obstacles, k_obstacle=np.ones(6)),
+    ):
+        with pytest.raises(ShapeError, match=r"k_height|k_obstacle"):
+            stepping.stepper(case.robot, case.q0, objective=objective)

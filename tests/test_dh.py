@@ -9,8 +9,9 @@ from tests.common import LINK_LENGTHS, random_configurations
 
 
 def pinocchio_frames(robot: Robot, q: np.ndarray) -> list[np.ndarray]:
-    pin.framesForwardKinematics(robot.model, robot.data, q)
-    return [robot.data.oMf[i].homogeneous for i in robot.frame_ids]
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, q)
+    return [data.oMf[i].homogeneous for i in robot.frame_ids]
 
 
 def test_pinocchio_forward_kinematics_equals_plain_dh_product(robot: Robot) -> None:

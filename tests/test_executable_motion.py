@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 import dvqp
-from dvqp.cli.compare import summarize
+from dvqp.comparison import summarize
 from dvqp.limits import AccelerationLimit, SelfCollision, self_distance
+from tests.oracle_resolution import frames, self_distances
 from tests.runs import BUNDLED, QP, run, scene
 
 
@@ -25,10 +26,12 @@ def test_accelerations_and_self_distance_stay_within_their_limits(name: str, bac
     ok = traj.success
     assert np.all(np.abs(traj.qddot[ok]) <= qdd * (1 + 1e-9) + 1e-9)
     assert traj.self_distance.min() >= margin - 1e-3
-    # the recorded figure is the true one
-    k = int(np.argmin(traj.self_distance))
-    state = dvqp.KinematicState.compute(s.robot, traj.q[k], s.pipe_radius)
-    assert traj.self_distance[k] == pytest.approx(self_distance(state)[0], abs=1e-12)
+    # the recorded figure is the true one (Pinocchio's frames, closest points of our own)
+    for k in {int(np.argmin(traj.self_distance)), 0, traj.n_steps}:
+        true = self_distances(frames(s.robot, traj.q[k], s.pipe_radius).origins).min()
+        assert traj.self_distance[k] == pytest.approx(true, abs=1e-12)
+        state = dvqp.KinematicState.compute(s.robot, traj.q[k], s.pipe_radius)
+        assert self_distance(state)[0] == pytest.approx(true, abs=1e-12)
 
 
 def test_the_baseline_folds_the_arm_and_its_accelerations_are_reported() -> None:

@@ -1,17 +1,23 @@
-"""The QP resolver: agreement with the baseline, limits held, relaxed and failed steps."""
+"""The QP resolver: equal to eq. 18 without an active inequality, limits held, relaxed, braking
+and failed steps."""
 
 import numpy as np
 import pytest
 
 import solvers
 from dvqp import (
+    Bounds,
     JogSegment,
-    KinematicState,
+    Limit,
     Obstacle,
     ObstacleSet,
     PseudoinverseResolver,
+    QPResolver,
     Robot,
+    Stepper,
     StepSpec,
+    Task,
+    TaskRows,
     ToolTask,
     jog_commands,
 )
@@ -19,16 +25,22 @@ from dvqp import simulate as run
 from dvqp.errors import BackendError
 from dvqp.limits import (
     AccelerationLimit,
-    Bounds,
     JointPositionLimit,
     JointVelocityLimit,
     ObstacleDamper,
     SurfaceHeight,
 )
 from dvqp.objective import Objective
-from dvqp.resolution.pinv import weighted_pinv_step
-from dvqp.resolution.qp_resolver import QPResolver
-from tests.common import LINK_LENGTHS, PIPE_RADIUS, objective_with, random_configurations, spec_with
+from dvqp.step import advance
+from tests.common import (
+    LINK_LENGTHS,
+    PIPE_RADIUS,
+    Q0,
+    objective_with,
+    random_configurations,
+    spec_with,
+)
+from tests.oracle_resolution import eq18, kkt
 
 DT = 0.005
 
@@ -49,6 +61,17 @@ BACKENDS = [
 ]
 
 
+def stepper(robot: Robot, spec: StepSpec, backend: object = "daqp",
+            q0: np.ndarray | None = None) -> Stepper:  # fmt: skip
+    """The compiled step of ``spec`` on ``backend`` (``"pinv"``: the baseline), started."""
+    resolver = (PseudoinverseResolver(spec) if backend == "pinv"
+                else QPResolver(spec, backend))  # type: ignore[arg-type]  # fmt: skip
+    start = np.array(Q0) if q0 is None else q0
+    s = Stepper(robot, PIPE_RADIUS, resolver, start, DT)
+    s.start(start)
+    return s
+
+
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("weighted", [False, True])
 def test_qp_equals_the_pseudoinverse_step_when_no_inequality_is_active(
@@ -59,13 +82,54 @@ def test_qp_equals_the_pseudoinverse_step_when_no_inequality_is_active(
     # Loose limits, no obstacle, a floor far below: nothing is active.
     limits = (JointPositionLimit(robot), JointVelocityLimit(robot), SurfaceHeight(-1.0))
     tol = AGREEMENT_TOLERANCE[backend.removeprefix("qpsolvers:")]
+    spec = spec_with(np.zeros(13), weights, limits)
+    g = spec.objective.terms[0].gradient  # type: ignore[attr-defined]  # read at every state
+    qp, pinv = stepper(robot, spec, backend), stepper(robot, spec, "pinv")
     for q in random_configurations(5, seed=23, spread=0.3):
-        state = KinematicState.compute(robot, q, PIPE_RADIUS)
-        g, xdot = 0.1 * rng.normal(size=13), 0.02 * rng.normal(size=4)
-        step = QPResolver(spec_with(g, weights, limits), backend).resolve(state, xdot, DT)
-        assert step.success and step.status == "optimal", step.status
-        expected = weighted_pinv_step(state.tool_jacobian, xdot, g, 1.0 / weights)
-        np.testing.assert_allclose(step.qdot, expected, atol=tol, rtol=0)
+        g[:], xdot = 0.1 * rng.normal(size=13), 0.02 * rng.normal(size=4)
+        assert qp.load(q) and pinv.load(q)
+        found = qp.resolve(xdot, DT)
+        assert found.success and found.status == "optimal", found.status
+        p = qp.problem()
+        assert np.all(p.lb < qp.x - 1e-3) and np.all(qp.x < p.ub - 1e-3)  # the box is inactive
+        assert np.all(p.G @ qp.x < p.h - 1e-3)
+        expected = eq18(np.array(qp.state.tool_jacobian), xdot, g, weights)
+        np.testing.assert_allclose(qp.x, expected, atol=tol, rtol=0)
+        pinv.resolve(xdot, DT)  # the compiled baseline
+        np.testing.assert_allclose(qp.x, pinv.x, atol=tol, rtol=0)
+
+
+class Lean(Task):
+    """Soft task: joint ``i`` at ``speed`` rad/s, weight ``w``."""
+
+    name = "lean"
+    hard = False
+
+    def __init__(self, i: int, w: float, speed: float) -> None:
+        self.i, self.w, self.speed = i, w, speed
+
+    def compute(self, state, command, dt):  # type: ignore[no-untyped-def]
+        return TaskRows(np.eye(1, state.n, self.i), np.array([self.speed]), self.w)
+
+
+def test_with_soft_tasks_the_qp_equals_the_dense_metric_step(robot: Robot) -> None:
+    rng = np.random.default_rng(29)
+    tasks = [Lean(3, 4.0, 0.2), Lean(9, 0.5, -0.3)]
+    limits = (JointPositionLimit(robot), JointVelocityLimit(robot), SurfaceHeight(-1.0))
+    spec = spec_with(0.1 * rng.normal(size=13), limits=limits).with_extra(tasks=tasks)
+    qp, pinv = stepper(robot, spec), stepper(robot, spec, "pinv")
+    metric, pull = np.eye(13), spec.objective.terms[0].gradient.copy()  # type: ignore[attr-defined]
+    for t in tasks:
+        metric[t.i, t.i] += t.w
+        pull[t.i] += t.w * t.speed
+    for q in random_configurations(4, seed=31, spread=0.3):
+        xdot = 0.02 * rng.normal(size=4)
+        assert qp.load(q) and pinv.load(q)
+        assert qp.resolve(xdot, DT).status == "optimal"
+        pinv.resolve(xdot, DT)
+        expected = kkt(np.array(qp.state.tool_jacobian), xdot, pull, metric)
+        np.testing.assert_allclose(qp.x, expected, atol=1e-9, rtol=0)
+        np.testing.assert_allclose(pinv.x, expected, atol=1e-9, rtol=0)
 
 
 def limited_robot() -> Robot:
@@ -101,7 +165,7 @@ def test_limits_hold_along_a_jog_that_breaks_them_with_the_pseudoinverse(q0: np.
         Obstacle(np.array([0.08, 0.30]), 0.03, 10.0),
     ]
     objective = objective_with(obstacles)
-    obstacle_set = objective.terms[1].obstacles
+    obstacle_set = objective.terms[1].obstacles  # type: ignore[attr-defined]
     spec = paper_spec(robot, objective, obstacle_set, 0.06, margin=0.005, influence=0.05)
     cmd = jog_commands(
         [
@@ -165,25 +229,26 @@ class CorruptingBackend:
         self._inner.reset()
 
 
-def test_a_wrong_answer_reported_as_solved_is_not_used_and_the_arm_brakes(
-    state0: KinematicState, robot: Robot
-) -> None:
-    resolver = QPResolver(spec_with(np.zeros(13)), CorruptingBackend)
-    step = resolver.resolve(state0, np.array([0.01, 0, 0, 0]), DT)
-    assert step.status == "braking" and np.all(step.qdot == 0.0)  # no bound: brakes to rest
+def test_a_wrong_answer_reported_as_solved_is_not_used_and_the_arm_brakes(robot: Robot) -> None:
+    s = stepper(robot, spec_with(np.zeros(13)), CorruptingBackend)
+    moved = advance(s, np.array([0.01, 0, 0, 0]), DT)
+    step = moved.step
+    assert step.success and step.status == "braking" and np.all(step.qdot == 0.0)  # to rest
     assert step.task_error == pytest.approx(0.01)
+    np.testing.assert_array_equal(s.state.q, Q0)
 
 
-def test_braking_stays_inside_the_joint_bounds(state0: KinematicState, robot: Robot) -> None:
+def test_braking_stays_inside_the_joint_bounds(robot: Robot) -> None:
     limit = AccelerationLimit(robot, 2.0)
-    limit.observe(np.full(13, 0.5), DT)  # moving at 0.5 rad/s: may slow by 2·DT per step
-    resolver = QPResolver(spec_with(np.zeros(13), limits=(limit,)), CorruptingBackend)
-    step = resolver.resolve(state0, np.array([0.01, 0, 0, 0]), DT)
-    assert step.status == "braking"
-    np.testing.assert_allclose(step.qdot, 0.5 - 2.0 * DT)
+    s = stepper(robot, spec_with(np.zeros(13), limits=(limit,)), CorruptingBackend)
+    s.observe(np.full(13, 0.5), DT)  # moving at 0.5 rad/s: may slow by 2·DT per step
+    np.testing.assert_array_equal(limit.previous, 0.5)
+    found = s.resolve(np.array([0.01, 0, 0, 0]), DT)
+    assert found.success and found.status == "braking"
+    np.testing.assert_allclose(s.x, 0.5 - 2.0 * DT)
 
 
-class _Box:
+class _Box(Limit):
     """A user's bounds limit (rad/s)."""
 
     name = "box"
@@ -191,16 +256,20 @@ class _Box:
     def __init__(self, lb: float, ub: float) -> None:
         self.lb, self.ub = lb, ub
 
-    def compute(self, state: KinematicState, dt: float) -> Bounds:
+    def compute(self, state, dt):  # type: ignore[no-untyped-def]
         return Bounds(np.full(state.n, self.lb), np.full(state.n, self.ub))
 
 
-def test_bounds_that_cross_fail_the_step_and_name_the_joint(state0: KinematicState) -> None:
-    resolver = QPResolver(spec_with(np.zeros(13), limits=(_Box(0.2, 1.0), _Box(-1.0, 0.1))),
-                          "daqp")  # fmt: skip
-    step = resolver.resolve(state0, np.zeros(4), DT)
-    assert not step.success and np.all(step.qdot == 0.0)
-    assert step.status == "failed: the bounds on joint1's velocity cross (0.2 > 0.1 rad/s)"
+def test_bounds_that_cross_fail_the_step_and_name_the_joint(robot: Robot) -> None:
+    s = stepper(robot, spec_with(np.zeros(13), limits=(_Box(0.2, 1.0), _Box(-1.0, 0.1))))
+    why = "failed: the bounds on joint1's velocity cross (0.2 > 0.1 rad/s)"
+    assert s.prepare(np.zeros(4), DT) == 0  # the first joint whose bounds cross
+    found = s.resolve(np.zeros(4), DT)
+    assert not found.success and found.status == why
+    moved = advance(s, np.zeros(4), DT)
+    assert not moved.step.success and moved.step.status == why
+    assert np.all(moved.step.qdot == 0.0) and moved.substeps == 1
+    np.testing.assert_array_equal(s.state.q, Q0)  # the arm holds still
 
 
 def test_unknown_backend_lists_the_installed_ones(robot: Robot) -> None:

@@ -13,10 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dvqp import load_scene, plan
+from tests.runs import run
 
 DATA = Path(__file__).resolve().parent / "data" / "reference_runs.npz"
-SCENES = Path(__file__).resolve().parent.parent / "scenes"
 NAMES = ("joint-limit", "many-obstacles", "narrow-passage", "paper-two-inlets",
          "weld-circumference")  # fmt: skip
 FIELDS = ("q", "qdot", "w", "min_clearance", "task_error")
@@ -33,7 +32,7 @@ def stored() -> dict[str, np.ndarray]:
 def test_bundled_scene_reproduces_the_stored_run(name: str, backend: str) -> None:
     if backend != "pinv":
         pytest.importorskip(backend)
-    traj = plan(load_scene(SCENES / f"{name}.toml"), backend)
+    traj = run(name, backend)  # the session's run of the scene, shared with other tests
     ref = stored()
     for field in FIELDS:
         expected = ref[f"{name}/{backend}/{field}"]

@@ -67,8 +67,9 @@ SCENES = Path(__file__).resolve().parent.parent / "scenes"
 
 
 def frames_at(robot: Robot, q: np.ndarray) -> list[np.ndarray]:
-    pin.framesForwardKinematics(robot.model, robot.data, q)
-    return [robot.data.oMf[i].homogeneous.copy() for i in robot.frame_ids]
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, q)
+    return [data.oMf[i].homogeneous.copy() for i in robot.frame_ids]
 
 
 def test_the_bundled_urdf_is_the_ndt13_arm(robot: Robot) -> None:
@@ -101,9 +102,22 @@ def test_continuous_joints_on_any_axis_become_unlimited_revolute_joints(tmp_path
     np.testing.assert_array_equal(cont.q_max, [np.inf, 1.0, np.inf])
     np.testing.assert_allclose(cont.qd_max, [2.0, 1.0, 0.5])
     assert [f.name for f in cont.model.frames] == [f.name for f in rev.model.frames]
+    raw = pin.buildModelFromUrdf(str(tmp_path / "c.urdf"))  # continuous: q = (cos, sin)
+    raw_data = raw.createData()
     for q in ([0.0, 0.0, 0.0], [5.0, 0.5, -4.0], [-7.0, -0.9, 2.5]):
         for a, b in zip(frames_at(cont, np.array(q)), frames_at(rev, np.array(q)), strict=True):
             np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
+        pin.framesForwardKinematics(
+            raw, raw_data, np.array([np.cos(q[0]), np.sin(q[0]), q[1], np.cos(q[2]), np.sin(q[2])])
+        )
+        mine = KinematicState.compute(cont, q, 0.3)
+        theirs = KinematicState.compute(rev, q, 0.3)
+        for i, name in enumerate(cont.frame_names):
+            frame = raw_data.oMf[raw.getFrameId(name)]
+            np.testing.assert_allclose(mine.origins[i], frame.translation, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(mine.axes[i], frame.rotation[:, 2], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(mine.frame_jacobians, theirs.frame_jacobians, rtol=0,
+                                   atol=1e-12)  # fmt: skip
 
 
 def test_other_joints_are_refused_and_the_parser_stays_quiet(

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from dvqp import SceneError
+from dvqp.geometry import distances
 from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon
 from dvqp.scenes import loads
 
@@ -45,7 +46,8 @@ def test_a_polygon_may_straddle_the_seam() -> None:
     (pad,) = loads(with_obstacles(table), SRC).obstacles
     period = 2 * np.pi * 0.254
     inside_either_side = np.array([[edge - 0.01, 0.62], [-edge + 0.01, 0.62]])
-    assert (pad.point_distance(inside_either_side, period)[0] < 0).all()
+    d, _ = distances([pad], inside_either_side, period)
+    np.testing.assert_allclose(d[0], -0.02, rtol=0, atol=1e-12)  # 2 cm from the nearest edge
 
 
 BAD = [

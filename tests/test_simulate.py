@@ -1,5 +1,6 @@
 """Offline integration of JOG commands, with and without position feedback."""
 
+import re
 import sys
 import time
 from pathlib import Path
@@ -88,15 +89,25 @@ def test_bad_commands_raise_typed_errors(robot: Robot, q0: np.ndarray) -> None:
 
 def test_a_slow_compilation_is_announced_through_notice(monkeypatch: pytest.MonkeyPatch) -> None:
     module = sys.modules["dvqp.motion.simulate"]  # (dvqp.motion.simulate is the function)
-    real = module.compile_step
+    real = module.Stepper
 
     def slow(*args: object, **kwargs: object) -> object:
         time.sleep(0.3)
         return real(*args, **kwargs)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(module, "compile_step", slow)
+    monkeypatch.setattr(module, "Stepper", slow)
     monkeypatch.setattr(module, "COMPILE_NOTICE_SECONDS", 0.05)
     said: list[str] = []
     scene = dvqp.load_scene(Path(__file__).resolve().parent.parent / "scenes" / "fold.toml")
     traj = dvqp.plan(scene, "pinv", notice=said.append)
-    assert said == [COMPILE_NOTICE] and traj.compiled.all()
+    assert said[0] == COMPILE_NOTICE and len(said) == 2
+    assert re.fullmatch(r"compiled the step in \d+ s", said[1])
+    assert traj.ok and traj.n_steps > 0
+
+
+def test_a_quick_start_says_nothing() -> None:
+    said: list[str] = []
+    scene = dvqp.load_scene(Path(__file__).resolve().parent.parent / "scenes" / "fold.toml")
+    dvqp.plan(scene, "pinv")  # compiles the step if no run has yet
+    dvqp.plan(scene, "pinv", notice=said.append)  # the compiled step is loaded, not compiled
+    assert said == []

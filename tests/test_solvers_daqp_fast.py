@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from solvers import Problem, Solution, make_backend
-from solvers._fast import EMPTY_MATRIX, EMPTY_VECTOR, pinned, stack
+from solvers._fast import EMPTY_MATRIX, EMPTY_VECTOR, stack
 from solvers._kkt import HAS_LB, HAS_UB, stacked
 from solvers.solution import judged
 from tests.solvers_qp_cases import kkt_case, spd
@@ -234,15 +234,17 @@ def test_daqp_sees_a_change_of_bounds_alone_warm(part: str) -> None:
         np.testing.assert_allclose(warm.require(), cold, atol=2 * TOL)
 
 
-def test_daqp_copies_problems_that_do_not_fit_the_compiled_copy_with_numpy() -> None:
+@pytest.mark.parametrize("field", ["G", "P"])
+def test_daqp_copies_problems_that_do_not_fit_the_compiled_copy_with_numpy(field: str) -> None:
     pytest.importorskip("daqp")
     ws = Drift(seed=6)
-    fortran = np.asfortranarray(ws.G)
-    problem = Problem.trusted(ws.P, ws.q, ws.A, ws.b, fortran, ws.h, ws.lb, ws.ub)
+    fortran = np.asfortranarray(getattr(ws, field))
+    arrays = {name: fortran if name == field else getattr(ws, name) for name in FIELDS}
+    problem = Problem.trusted(**arrays)
     backend = make_backend("daqp")
     for _ in range(3):
         ws.move(0.01)
-        fortran[:] = ws.G
+        fortran[:] = getattr(ws, field)
         solution = backend.solve(problem)
         assert backend._stack is None and solution.found and not solution.retried
         np.testing.assert_allclose(solution.x, make_backend("daqp").solve(ws.fresh()).require(),
@@ -258,22 +260,16 @@ def test_daqp_survives_a_trusted_array_reshaped_in_place_or_misfit() -> None:
     ws = Drift(seed=7)
     backend = make_backend("daqp")
     backend.solve(ws.problem).require()
-    ws.q.shape = (ws.q.size, 1)  # the compiled copy keeps its own view of q
-    assert backend.solve(ws.problem).found
+    ws.q.shape = (ws.q.size, 1)  # the compiled copy refuses it, NumPy names the misfit
+    reshaped = backend.solve(ws.problem)
+    assert not reshaped.found and "ValueError" in reshaped.message
     ws.q.shape = (ws.q.size,)
+    assert backend.solve(ws.problem).found and backend._stack is not None
     short = Problem.trusted(ws.P, ws.q, ws.A, ws.b, ws.G, ws.h[:-1], ws.lb, ws.ub)
     failed = backend.solve(short)
     assert not failed.found and "ValueError" in failed.message
 
 
-def test_pinned_views_only_float64_c_contiguous_arrays_of_the_given_dimension() -> None:
-    a = np.arange(6.0).reshape(2, 3)
-    view = pinned(a, 2)
-    assert view is not None and view is not a and np.shares_memory(view, a)
-    a.shape = (3, 2)
-    assert view.shape == (2, 3)
-    assert pinned(a, 1) is None
-    assert pinned(a.T, 2) is None
-    assert pinned(a.astype(np.float32), 2) is None
-    assert pinned([1.0, 2.0], 1) is None
-    assert math.isnan(stacked(np.zeros(3), np.zeros(1), np.zeros(1), 1, 0, 0, 0, 0)[1])
+def test_stacked_refuses_a_misfit_with_nan_values() -> None:
+    values = stacked(np.zeros(3), np.zeros(1), np.zeros(1), 1, 0, 0, 0, 0)
+    assert values[0] == -1 and all(math.isnan(v) for v in values[1:])

@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import math
+from dataclasses import astuple
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from solvers import Problem, ProblemShapeError, residuals
+from solvers import Problem, ProblemShapeError, Solution, residuals
+from solvers.residuals import failed_checks, kkt_residuals
+from tests.solvers_oracle import kkt_residuals as oracle
 from tests.solvers_qp_cases import equality_case, kkt_case
 
 seeds = st.integers(min_value=0, max_value=2**32 - 1)
@@ -110,3 +115,40 @@ def test_multiplier_of_wrong_shape_is_rejected() -> None:
     case = kkt_case(np.random.default_rng(1))
     with pytest.raises(ProblemShapeError, match=r"^z: expected shape \(6,\), got \(5,\)"):
         residuals(case.problem, case.x, case.y, case.z[:5], case.z_box)
+
+
+def test_residuals_of_a_shifted_optimum_equal_the_oracle() -> None:
+    case = kkt_case(np.random.default_rng(6), infinite=True)
+    x = case.x + 1e-3
+    got = residuals(case.problem, list(x), case.y, case.z, case.z_box)  # any array-like
+    want = oracle(case.problem, x, case.y, case.z, case.z_box)[0]
+    assert astuple(got) == pytest.approx(astuple(want), rel=1e-12, abs=1e-15)
+    assert residuals(case.problem, x).stationarity is None
+
+
+DATA = ("P", "q", "A", "b", "G", "h", "lb", "ub")
+#: Where a NaN goes (field, index) and the residual it must make NaN.
+NAN_CASES = [
+    ("h", 0, "inequality"), ("G", (0, 0), "inequality"), ("b", 0, "equality"),
+    ("A", (0, 0), "equality"), ("lb", 0, "bounds"), ("ub", 1, "bounds"),
+    ("P", (0, 0), "stationarity"), ("q", 0, "stationarity"), ("x", 0, "equality"),
+    ("y", 0, "stationarity"), ("z", 0, "complementarity"), ("z_box", 0, "stationarity"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("field", "index", "residual"), NAN_CASES)
+def test_a_nan_makes_its_residual_nan_and_never_passes(
+    field: str, index: int | tuple[int, int], residual: str
+) -> None:
+    case = kkt_case(np.random.default_rng(7))
+    data = {name: np.array(getattr(case.problem, name)) for name in DATA}
+    point = {name: np.array(getattr(case, name)) for name in ("x", "y", "z", "z_box")}
+    (point if field in point else data)[field][index] = np.nan
+    problem = Problem.trusted(**data)  # the regular constructor refuses NaN data
+    res, scale = kkt_residuals(problem, **point)  # type: ignore[arg-type]
+    assert math.isnan(getattr(res, residual)), res
+    assert any(phrase.startswith(residual) for phrase in failed_checks(res, 1e-6, scale))
+    checked = Solution.checked(problem, backend="t", tolerance=1e-6, status="ok", **point)
+    assert not checked.found
+    if field == "h":  # what a NumPy max(0.0, nan) gives, and the package must not
+        assert oracle(problem, **point)[0].inequality == 0.0  # type: ignore[arg-type]

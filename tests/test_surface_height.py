@@ -1,45 +1,76 @@
-"""Surface height: one damper row per body point, minus the height gradient."""
+"""Surface height: one damper row per body point, minus the height gradient; the damper rule."""
+
+import math
 
 import numpy as np
 import pytest
 
 from dvqp import KinematicState, Robot
 from dvqp.errors import ParameterError
-from dvqp.limits import SurfaceHeight, damper_rhs
+from dvqp.limits import SurfaceHeight, damper_value
+from tests import stepping
 from tests.common import PIPE_RADIUS, central_difference
-from tests.limit_fixtures import DT
+from tests.limit_fixtures import DT, configurations, damper_rows
 
 
 def test_height_rows_are_minus_the_height_gradient(robot: Robot, q0: np.ndarray) -> None:
     state = KinematicState.compute(robot, q0, PIPE_RADIUS)
-    rows = SurfaceHeight(min_height=0.02, gain=0.5).compute(state, DT)
+    rows = stepping.rows(SurfaceHeight(min_height=0.02, gain=0.5), robot, q0)
     fd = central_difference(
         lambda v: KinematicState.compute(robot, v, PIPE_RADIUS).points[:, 2], q0, 1e-7
     )
-    np.testing.assert_allclose(-rows.G, fd, rtol=1e-6, atol=1e-8)
+    np.testing.assert_allclose(-rows.G, fd, rtol=1e-6, atol=1e-8)  # type: ignore[union-attr]
     room = state.points[:, 2] - 0.02
-    np.testing.assert_allclose(rows.h, np.minimum(0.5 / DT * room, np.sqrt(2.0 * room)))
-    assert rows.labels == tuple(f"point{i}/height" for i in range(1, 6))
+    np.testing.assert_allclose(rows.h, np.minimum(0.5 / DT * room, np.sqrt(2.0 * room)))  # type: ignore[union-attr]
+    assert rows.labels == tuple(f"point{i}/height" for i in range(1, 6))  # type: ignore[union-attr]
 
 
-def test_a_point_well_below_the_minimum_may_only_not_descend(state0: KinematicState) -> None:
+def test_a_point_well_below_the_minimum_may_only_not_descend(
+    robot: Robot, q0: np.ndarray, state0: KinematicState
+) -> None:
     above = float(state0.points[:, 2].max()) + 0.01
-    rows = SurfaceHeight(min_height=above, gain=0.5).compute(state0, DT)
-    np.testing.assert_array_equal(rows.h, 0.0)
+    rows = stepping.rows(SurfaceHeight(min_height=above, gain=0.5), robot, q0)
+    assert rows.rows == 5  # type: ignore[union-attr]
+    np.testing.assert_array_equal(rows.h, 0.0)  # type: ignore[union-attr]
 
 
-def test_damper_rhs_decays_brakes_pulls_small_drifts_back_and_holds_deep_starts() -> None:
-    d = np.array([0.05, 0.01, 0.00995, -0.02])
+def test_the_damper_rule_decays_brakes_pulls_small_drifts_back_and_holds_deep_starts() -> None:
+    d = [0.05, 0.01, 0.00995, -0.02]
+
+    def rule(deceleration: float) -> list[float]:
+        return [damper_value(x, 0.01, 0.5, 0.1, 1e-4, deceleration) for x in d]
+
     # 4 cm above: decay; at the margin: 0; 0.05 mm below: pulled back; 3 cm below: held
-    np.testing.assert_allclose(
-        damper_rhs(d, 0.01, 0.5, 0.1, 1e-4), [0.2, 0.0, -0.00025, 0.0], atol=1e-15
-    )
+    np.testing.assert_allclose(rule(math.inf), [0.2, 0.0, -0.00025, 0.0], atol=1e-15)
     # with a deceleration of 0.2 m/s², 4 cm away: at most sqrt(2·0.2·0.04) = 0.126 m/s;
     # the pull back no faster than 0.2 m/s² · 0.1 s
-    capped = damper_rhs(d, 0.01, 0.5, 0.1, 1e-4, deceleration=0.2)
-    np.testing.assert_allclose(capped, [np.sqrt(0.016), 0.0, -0.00025, 0.0], atol=1e-15)
-    slow = damper_rhs(d, 0.01, 0.5, 0.1, 1e-4, deceleration=0.001)
-    assert slow[2] == pytest.approx(-0.0001)
+    np.testing.assert_allclose(rule(0.2), [np.sqrt(0.016), 0.0, -0.00025, 0.0], atol=1e-15)
+    assert rule(0.001)[2] == pytest.approx(-0.0001)
+
+
+def test_several_height_limits_each_write_their_rows_into_one_problem(
+    robot: Robot, q0: np.ndarray, state0: KinematicState
+) -> None:
+    """Two surface heights with different minima, gains and decelerations: each its k rows
+    (by the damper rule of its own parameters), both in the problem."""
+    low = float(state0.points[:, 2].min())
+    limits = [
+        SurfaceHeight(min_height=0.02, gain=0.3, deceleration=0.5),
+        SurfaceHeight(min_height=low + 5e-5, gain=0.9, deceleration=math.inf),
+    ]
+    s = stepping.stepper(robot, q0, limits=limits, backend="daqp")
+    for q in [q0, *configurations(robot, q0, 3, seed=21, spread=0.02)]:
+        for dt in (0.001, 0.02):
+            rows = [damper_rows(s, limit, q, dt, fd=q is q0) for limit in limits]
+            assert [r.rows for r in rows] == [5, 5]
+            problem = s.problem()
+            np.testing.assert_array_equal(problem.G, np.vstack([r.G for r in rows]))
+            np.testing.assert_array_equal(problem.h, np.concatenate([r.h for r in rows]))
+    s.load(q0)
+    s.prepare(np.zeros(4), DT)
+    h = s.rows(limits[1]).h  # type: ignore[union-attr]
+    assert h.min() == pytest.approx(-0.9 / DT * 5e-5)  # the lowest point: 0.05 mm below
+    assert np.sum(h > 0.0) == 4
 
 
 def test_constructor_validates_its_parameters() -> None:
@@ -47,3 +78,5 @@ def test_constructor_validates_its_parameters() -> None:
         SurfaceHeight(min_height=float("inf"))
     with pytest.raises(ParameterError, match="gain"):
         SurfaceHeight(gain=0.0)
+    with pytest.raises(ParameterError, match="deceleration"):
+        SurfaceHeight(deceleration=-1.0)

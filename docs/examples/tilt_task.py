@@ -15,10 +15,10 @@ import math
 
 import numpy as np
 
-from dvqp import KinematicState, TaskRows
+from dvqp import KinematicState, Task, TaskRows
 
 
-class TiltTask:
+class TiltTask(Task):
     """Soft task: the probe's tilt from the radial direction toward ``tilt`` (rad).
 
     Parameters

@@ -12,7 +12,7 @@ from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 
 from dvqp.bench.runner import Job, Row, run_job
-from dvqp.cli.progress import quiet_worker
+from dvqp.comparison import quiet_worker
 
 Progress = Callable[[int, int, str], None]
 """``progress(done, total, label)``, counting runs (scene × backend)."""

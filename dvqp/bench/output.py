@@ -16,7 +16,7 @@ from typing import Any
 from dvqp._versions import versions
 from dvqp.bench.execution import Where
 from dvqp.bench.runner import EXTRA_FIELDS, Row
-from dvqp.cli.compare import FIELDS, machine
+from dvqp.comparison import FIELDS, machine
 
 COLUMNS = (  # (summary key, header, format of a defined value)
     ("runs", "runs", "{}"), ("succeeded", "ok", "{}"), ("success_rate", "success", "{:.1%}"),

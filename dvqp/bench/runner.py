@@ -2,7 +2,7 @@
 
 :func:`run_job` takes the scene's text (not a file), so a local process, a thread of a Dask
 worker or a remote machine run exactly the same scene; it returns one row per backend, the
-figures of :func:`dvqp.cli.compare.summarize` plus the bench's own.
+figures of :func:`dvqp.comparison.summarize` plus the bench's own.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from dvqp.cli.compare import FIELDS, summarize
+from dvqp.comparison import FIELDS, summarize
 from dvqp.errors import DvqpError
 from dvqp.motion import Trajectory
 from dvqp.planning import plan
@@ -26,7 +26,7 @@ EXTRA_FIELDS = (
     "index", "mode", "dt", "obstacles", "mean_step_us", "mean_solve_us", "median_solve_us",
     "total_step_s",
 )  # fmt: skip
-"""Keys a bench row adds to :data:`dvqp.cli.compare.FIELDS` (and ``final_tool``)."""
+"""Keys a bench row adds to :data:`dvqp.comparison.FIELDS` (and ``final_tool``)."""
 
 
 @dataclass(frozen=True)
@@ -74,7 +74,7 @@ def run_job(job: Job, on_run: Callable[[str], None] | None = None) -> list[Row]:
 
 
 def _row(job: Job, scene: Scene, traj: Trajectory) -> Row:
-    """The figures of one run: :func:`dvqp.cli.compare.summarize`'s and the bench's."""
+    """The figures of one run: :func:`dvqp.comparison.summarize`'s and the bench's."""
     row = summarize(scene, traj)
     steps_us, solve_us = traj.step_time * 1e6, traj.solve_time * 1e6
     row.update(

@@ -21,9 +21,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from dvqp import Trajectory, __version__, load_scene, plan
+from dvqp import comparison as cmp
 from dvqp._files import output_path
 from dvqp._versions import versions
-from dvqp.cli import compare as cmp
+from dvqp.cli import bench as bench_cmd
 from dvqp.cli import console as console_cli
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
@@ -97,8 +98,6 @@ def _parser() -> argparse.ArgumentParser:
     _add_compare(sub)
     _add_plot(sub)
     console_cli.register(sub)
-    from dvqp.cli import bench as bench_cmd  # here: dvqp.bench imports the CLI's reports
-
     bench_cmd.register(sub)
     b = sub.add_parser("backends", help="list the installed backends and their versions")
     b.set_defaults(run=_backends)

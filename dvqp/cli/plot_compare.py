@@ -1,4 +1,4 @@
-"""A figure of a backend comparison (the rows of :func:`dvqp.cli.compare.compare`)."""
+"""A figure of a backend comparison (the rows of :func:`dvqp.comparison.compare`)."""
 
 from __future__ import annotations
 

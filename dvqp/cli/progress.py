@@ -102,16 +102,6 @@ def interruptible() -> Iterator[None]:
         signal.signal(signal.SIGINT, previous)
 
 
-def quiet_worker() -> None:
-    """Make Ctrl-C end this worker process at once, silently (exit code 130).
-
-    For ``ProcessPoolExecutor(initializer=quiet_worker)``: workers that are not forked from
-    inside :func:`interruptible` (the ``spawn`` and ``forkserver`` start methods) then stop as
-    forked ones do, instead of each printing a traceback.
-    """
-    signal.signal(signal.SIGINT, lambda signum, frame: os._exit(130))
-
-
 @contextlib.contextmanager
 def warnings_summed_up() -> Iterator[list[int]]:
     """Keep warnings (NumPy's ``overflow encountered``, a solver's notes) off the terminal.

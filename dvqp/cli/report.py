@@ -1,6 +1,6 @@
 """What the command line prints and writes: the comparison table, a run's summary, CSV.
 
-The rows are those of :func:`dvqp.cli.compare.summarize` (keys :data:`dvqp.cli.compare.FIELDS`);
+The rows are those of :func:`dvqp.comparison.summarize` (keys :data:`dvqp.comparison.FIELDS`);
 an undefined figure (None) is shown as ``-`` in the table and as an empty CSV cell.
 """
 
@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from dvqp._files import atomic_file
-from dvqp.cli.compare import FIELDS, Row
+from dvqp.comparison import FIELDS, Row
 
 if TYPE_CHECKING:
     from dvqp import Scene, Trajectory
@@ -66,7 +66,7 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
     traj
         Its trajectory.
     row
-        Its figures, from :func:`dvqp.cli.compare.summarize`.
+        Its figures, from :func:`dvqp.comparison.summarize`.
     output
         The file the trajectory was saved to, or None.
     """
@@ -86,7 +86,7 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         f"acceleration    max |qdd| {_num(row['max_joint_acceleration'], '{:.3g} rad/s^2')}",
         f"limits          {_worst(row, bool(traj.limits_kept.all()))}",
         f"step time       median {_num(row['median_step_us'], '{:.0f}')} us, "
-        f"p95 {_num(row['p95_step_us'], '{:.0f}')} us ({_steps_compiled(row)})",
+        f"p95 {_num(row['p95_step_us'], '{:.0f}')} us",
         f"solver          {_num(row['median_solver_us'], '{:.1f}')} us a step in the solver's "
         f"calls, {_num(row['median_rest_us'], '{:.1f}')} us the rest, "
         f"{_num(row['median_iterations'], '{:.0f}')} iterations (medians)",
@@ -100,13 +100,6 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
     if output is not None:
         lines.append(f"saved           {output}")
     return "\n".join(lines)
-
-
-def _steps_compiled(row: Row) -> str:
-    """``"compiled 759 of 759 steps"``."""
-    if row["compiled_steps"] is None:
-        return "compiled -"
-    return f"compiled {row['compiled_steps']} of {row['steps']} steps"
 
 
 def _result(row: Row) -> str:
@@ -140,7 +133,7 @@ def _num(value: float | None, fmt: str) -> str:
 
 
 def rows_to_csv(rows: Sequence[Row]) -> str:
-    """The rows as CSV text: a header of :data:`~dvqp.cli.compare.FIELDS`, then one line each.
+    """The rows as CSV text: a header of :data:`~dvqp.comparison.FIELDS`, then one line each.
 
     Flags are written ``true``/``false``, undefined figures as empty cells.
     """

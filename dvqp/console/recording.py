@@ -10,7 +10,6 @@ consecutive samples.
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections import deque
 from dataclasses import dataclass
 from typing import Any
@@ -18,16 +17,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp.geometry.obstacle import ObstacleSet
-from dvqp.geometry.proximity import proximity
-from dvqp.kinematics.state import KinematicState
-from dvqp.limits.excess import Excess
-from dvqp.limits.self_collision import self_distance
-from dvqp.limits.tilt import tilt
-from dvqp.motion.advance import Advance
+from dvqp.geometry.proximity import link_label, point_label
 from dvqp.motion.simulate import dv_error
 from dvqp.motion.trajectory import Trajectory
-from dvqp.objective import Objective
+from dvqp.step import Advance, Stepper
 
 MAX_RECORD_SECONDS = 300.0
 """Driven motion kept for "save", s of simulated time (the most recent)."""
@@ -47,8 +40,8 @@ class Sample:
 
     Attributes
     ----------
-    state : KinematicState
-        The kinematics.
+    q, tool, points : ndarray, shapes (n,), (4,), (k, 3)
+        The configuration (rad), the tool ``[l, z, h, α]`` and the body points ``[l, z, h]``.
     w : float
         Objective value.
     min_clearance, probe_clearance : float
@@ -59,39 +52,51 @@ class Sample:
         Probe axis from the radial direction, rad.
     self_distance : float
         Smallest distance between non-adjacent guarded links, m (inf: none).
-    excess : Excess
-        Worst exact limit excess here, against the start.
+    excess : float
+        Worst exact limit excess here (its unit), against the start.
+    kept : bool
+        Every limit is kept here (to its tolerance).
     """
 
-    state: KinematicState
+    q: NDArray[np.float64]
+    tool: NDArray[np.float64]
+    points: NDArray[np.float64]
     w: float
     min_clearance: float
     probe_clearance: float
     closest: str | None
     tilt: float
     self_distance: float
-    excess: Excess
+    excess: float
+    kept: bool
 
     @classmethod
-    def of(
-        cls, state: KinematicState, objective: Objective, obstacles: ObstacleSet, excess: Excess
-    ) -> Sample:
-        """Evaluate ``state``."""
-        w = float(objective.evaluate(state).value)
-        apart = self_distance(state)[0]
-        if not len(obstacles):
-            return cls(state, w, math.inf, math.inf, None, tilt(state), apart, excess)
-        near = proximity(state, obstacles)
-        clearance, part, j = near.closest()
-        where = f"{part}/obstacle{j + 1}"
-        return cls(state, w, clearance, near.probe_clearance(), where, tilt(state), apart, excess)
+    def of(cls, stepper: Stepper) -> Sample:
+        """The state ``stepper`` has loaded (copied)."""
+        a, k = stepper.arrays, stepper.robot.n_points
+        tilt, apart, clearance, probe, closest = (float(v) for v in a.diagnostics)
+        where = None
+        if closest >= 0:
+            obstacle, part = divmod(int(closest), 2 * k + 1)
+            name = point_label(part, k) if part <= k else link_label(part - k - 1, k)
+            where = f"{name}/obstacle{obstacle + 1}"
+        excess = stepper.excess_now
+        return cls(a.state.q.copy(), a.state.tool.copy(), a.state.guarded[:-1].copy(),
+                   float(a.objective.value[0]), clearance, probe, where, tilt, apart,
+                   float(excess[0]), bool(excess[1] <= 1.0))  # fmt: skip
 
     def row(self) -> NDArray[np.float64]:
         """Packed: q, tool, points, then :data:`SCALARS`."""
-        s, e = self.state, self.excess
-        scalars = [self.w, self.min_clearance, self.probe_clearance, self.tilt,
-                   self.self_distance, max(e.value, 0.0), 0.0 if e.broken else 1.0]  # fmt: skip
-        return np.concatenate([s.q, s.tool, s.points.ravel(), scalars])
+        scalars = [
+            self.w,
+            self.min_clearance,
+            self.probe_clearance,
+            self.tilt,
+            self.self_distance,
+            max(self.excess, 0.0),
+            1.0 if self.kept else 0.0,
+        ]
+        return np.concatenate([self.q, self.tool, self.points.ravel(), scalars])
 
 
 class Recording:
@@ -106,8 +111,7 @@ class Recording:
     """
 
     def __init__(self, first: Sample, dt: float) -> None:
-        state = first.state
-        self.dt, self.n, self.k = dt, state.n, state.k
+        self.dt, self.n, self.k = dt, first.q.shape[0], first.points.shape[0]
         limit = max(1, int(MAX_RECORD_SECONDS / dt))
         self.samples: deque[NDArray[np.float64]] = deque([first.row()], maxlen=limit + 1)
         self.steps: deque[tuple[NDArray[np.float64], str]] = deque(maxlen=limit)
@@ -116,7 +120,7 @@ class Recording:
         self, before: Sample, moved: Advance, after: Sample, command: NDArray, took: float
     ) -> bool:
         """Record a step and the sample it reached, unless it is idle; True if recorded."""
-        motion = float(np.max(np.abs(after.state.q - before.state.q)))
+        motion = float(np.max(np.abs(after.q - before.q)))
         if not np.any(command) and motion <= IDLE_MOTION and moved.step.success:
             return False
         step = moved.step

@@ -1,10 +1,10 @@
 """The console's simulation: one scene, one resolver, a held JOG command, stepped on demand.
 
 :class:`ConsoleSession` is safe to share between the clock thread that calls :meth:`step`
-and the server that sets commands, resets and reads snapshots. A step is the same guarded,
-exactly verified step as ``dvqp plan`` makes (:func:`dvqp.motion.advance.advance`), from the
-scene's start and on its limits; it is computed outside the lock, so a command or a snapshot
-never waits for a solver. The resolver is touched by the stepping thread only.
+and the server that sets commands, resets and reads snapshots. A step is the same compiled,
+exactly verified step as ``dvqp plan`` makes (:func:`dvqp.step.advance`), from the scene's
+start and on its limits; it is computed outside the lock, so a command or a snapshot never
+waits for a solver. The stepper is touched by the stepping thread only.
 """
 
 from __future__ import annotations
@@ -20,13 +20,11 @@ from numpy.typing import ArrayLike, NDArray
 from dvqp.console import protocol
 from dvqp.console.recording import Recording, Sample
 from dvqp.errors import DvqpError
-from dvqp.kinematics.state import KinematicState
-from dvqp.limits.excess import NO_EXCESS
-from dvqp.motion.advance import Advance, advance
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.registry import check_name, make_resolver
 from dvqp.resolution.step import Step
 from dvqp.scenes.scene import Scene
+from dvqp.step import Advance, Stepper, advance
 
 
 class Ramp:
@@ -76,19 +74,18 @@ class ConsoleSession:
     def __init__(self, scene: Scene, backend: str = "daqp") -> None:
         self.scene, self.backend = scene, check_name(backend)
         self.resolver = make_resolver(backend, scene.spec())
-        self.verify = bool(getattr(self.resolver, "holds_limits", True))
-        self.start = KinematicState.compute(scene.robot, scene.q0, scene.pipe_radius)
-        self._first = self._evaluate(self.start, NO_EXCESS)
+        self.verify = self.resolver.holds_limits
+        self.stepper = Stepper(scene.robot, scene.pipe_radius, self.resolver, scene.q0, scene.dt,
+                               scene.obstacles)  # fmt: skip
+        self.stepper.start(scene.q0)
+        self._first = Sample.of(self.stepper)
         self._lock = threading.Lock()
         self._generation = 0
         self._version = self._applied = 0
         self._ramp = Ramp(round(scene.ramp / scene.dt))
         self.reset()
-        self.step()  # warm up the solver and the kinematics, so the first live steps are fast
+        self.step()  # warm up the solver and the step, so the first live steps are fast
         self.reset()
-
-    def _evaluate(self, state: KinematicState, excess: Any) -> Sample:
-        return Sample.of(state, self.scene.objective, self.scene.obstacles, excess)
 
     def reset(self) -> None:
         """Back to the scene's start, no command, an empty record (warm starts forgotten)."""
@@ -99,10 +96,10 @@ class ConsoleSession:
             self._command, self._velocity = np.zeros(4), np.zeros(4)
             self._ramp.clear()
             self._clamped: str | None = None
-            self._step = Step(np.zeros(self.start.n), True, "optimal", 0.0, 0.0, None)
+            self._step = Step(np.zeros(self.scene.robot.n), True, "optimal", 0.0, 0.0, None)
             self._substeps, self._t, self._seq = 1, 0.0, 0
             self._recording = Recording(self._first, self.scene.dt)
-            self._stale_resolver = True
+            self._restart = "start"
 
     def jog(self, velocity: ArrayLike) -> str | None:
         """Hold the tool velocity ``[l̇, ż, ḣ, α̇]`` (clamped); return the clamping note or None."""
@@ -122,7 +119,7 @@ class ConsoleSession:
             self._command, self._velocity, self._clamped = np.zeros(4), np.zeros(4), None
             self._ramp.clear()
             self._version += 1
-            self._stale_resolver = True
+            self._restart = self._restart or "rest"
 
     @property
     def command(self) -> NDArray[np.float64]:
@@ -144,14 +141,12 @@ class ConsoleSession:
         """Advance one ``dt`` with the command in effect; a reset meanwhile discards it."""
         with self._lock:
             generation, before, version = self._generation, self._sample, self._version
-            stale, self._stale_resolver = self._stale_resolver, False
+            restart, self._restart = self._restart, ""
             command = self._ramp(self._command)
-        if stale:
-            self._restart_resolver()
         started = time.perf_counter()
-        moved = self._advance(before.state, command)
-        excess = moved.excess if moved.step.success else before.excess
-        after = self._evaluate(moved.state, excess)
+        self._restarted(restart, before)
+        moved = self._advance(command)
+        after = Sample.of(self.stepper)
         took = time.perf_counter() - started
         with self._lock:
             if generation != self._generation:
@@ -163,23 +158,26 @@ class ConsoleSession:
             self._seq += 1
             self._applied = version
 
-    def _restart_resolver(self) -> None:
-        """Forget warm starts, and what limits that remember motion remember (as ``plan``)."""
-        self.resolver.reset()
-        for limit in self.resolver.spec.limits:
-            reset = getattr(limit, "reset", None)
-            if reset is not None:
-                reset()
+    def _restarted(self, restart: str, before: Sample) -> None:
+        """Back at the start (``"start"``), or from rest where the arm is (``"rest"``): warm
+        starts forgotten, and what limits that remember motion remember (as ``plan``)."""
+        if restart == "start":
+            self.stepper.start(self.scene.q0)
+        elif restart == "rest":
+            for limit in self.resolver.spec.limits:
+                limit.reset()
+            if self.stepper.solver is not None:
+                self.stepper.solver.reset()
 
-    def _advance(self, state: KinematicState, command: NDArray[np.float64]) -> Advance:
+    def _advance(self, command: NDArray[np.float64]) -> Advance:
         """One verified step; an error of the step (a singular configuration) fails it."""
-        scene = self.scene
+        q = self.stepper.state.q.copy()
         try:
-            return advance(scene.robot, scene.pipe_radius, self.resolver, state, command,
-                           scene.dt, start=self.start, verify=self.verify)  # fmt: skip
+            return advance(self.stepper, command, self.scene.dt, verify=self.verify)
         except DvqpError as exc:
-            failed = Step(np.zeros(state.n), False, f"failed: {exc}", math.inf, 0.0, None)
-            return Advance(state, failed, 1, NO_EXCESS)
+            self.stepper.load(q)
+            failed = Step(np.zeros_like(q), False, f"failed: {exc}", math.inf, 0.0, None)
+            return Advance(failed, 1)
 
     def snapshot(self) -> dict[str, Any]:
         """The ``state`` message: time, tool, body points, status, clearance, task error, ...
@@ -192,14 +190,13 @@ class ConsoleSession:
             command, velocity = self._command.copy(), self._velocity.copy()
             clamped, substeps = self._clamped, self._substeps
             recorded = len(self._recording)
-        state = sample.state
         return {
-            "type": "state", "t": round(t, 6), "tool": protocol.rounded(state.tool),
-            "points": protocol.rounded(state.points), "status": step.status,
+            "type": "state", "t": round(t, 6), "tool": protocol.rounded(sample.tool),
+            "points": protocol.rounded(sample.points), "status": step.status,
             "min_clearance": protocol.finite(sample.min_clearance),
             "task_error": protocol.finite(step.task_error, 9), "closest": sample.closest,
             "probe_clearance": protocol.finite(sample.probe_clearance),
-            "tilt": protocol.finite(sample.tilt), "limits_kept": not sample.excess.broken,
+            "tilt": protocol.finite(sample.tilt), "limits_kept": sample.kept,
             "substeps": substeps, "command": protocol.rounded(command),
             "velocity": protocol.rounded(velocity),
             "clamped": clamped, "seq": seq, "recorded_steps": recorded,

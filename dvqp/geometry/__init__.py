@@ -1,6 +1,20 @@
 """Obstacles in the developed view and the body's proximity to them."""
 
 from dvqp.geometry.obstacle import Obstacle, ObstacleSet
-from dvqp.geometry.proximity import Proximity, min_clearance, proximity
+from dvqp.geometry.proximity import (
+    Proximity,
+    distances,
+    min_clearance,
+    proximity,
+    segment_distances,
+)
 
-__all__ = ["Obstacle", "ObstacleSet", "Proximity", "min_clearance", "proximity"]
+__all__ = [
+    "Obstacle",
+    "ObstacleSet",
+    "Proximity",
+    "distances",
+    "min_clearance",
+    "proximity",
+    "segment_distances",
+]

@@ -1,24 +1,52 @@
-"""Where the arm is relative to the obstacles, computed once per state and shared.
+"""Where the arm is relative to the obstacles: signed distances of every guarded part.
 
-The objective's obstacle terms, the QP's dampers and the clearance diagnostic all need the
-signed distances of the guarded parts to every obstacle: the k body points and the probe (the
-tool point), the k−1 body links and the probe holder (last body point to the tool).
-:func:`proximity` computes them once for a :class:`~dvqp.kinematics.state.KinematicState` and
-an :class:`ObstacleSet` and caches the result on the state, so each step does that geometry
-once.
+The guarded parts are the k body points and the probe (the tool point), the k−1 body links and
+the probe holder (last body point to the tool). A run's step measures them once per state
+(:mod:`dvqp.geometry.measure`); :func:`proximity` measures one state on its own, with the same
+compiled kernels, and :func:`distances` any points.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp.geometry.measure import ShapeArrays, measure_chain, penalties, user_rows
 from dvqp.geometry.obstacle import ObstacleSet
-from dvqp.geometry.shapes import ShapeDistances
+from dvqp.geometry.shapes import Shape
 from dvqp.kinematics.state import KinematicState
+from dvqp.workspace import ProximityBuffers, as_struct
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class ShapeDistances:
+    """Signed distances of m points (or segments) to J shapes.
+
+    Attributes
+    ----------
+    distance : ndarray, shape (J, m)
+        Signed distance, m (negative inside).
+    normal : ndarray, shape (J, m, 2)
+        ``∇d`` with respect to the point (for a segment: at its closest point).
+    penalty : ndarray, shape (J, m)
+        ``e`` of the objective, m² (negative inside).
+    penalty_gradient : ndarray, shape (J, m, 2)
+        ``∇e``, m.
+    t : ndarray, shape (J, m)
+        For segments: parameter in [0, 1] of the closest point (zeros for points).
+    """
+
+    distance: Array
+    normal: Array
+    penalty: Array
+    penalty_gradient: Array
+    t: Array
 
 
 @dataclass(frozen=True)
@@ -31,26 +59,40 @@ class Proximity:
     Attributes
     ----------
     points : ShapeDistances
-        Arrays (J, k+1, ...): distance, normal ``∇_p d``, penalty and its gradient.
+        Arrays (J, k+1, ...).
     links : ShapeDistances
-        Arrays (J, k, ...), at each link's closest point ``p̄ = p_i + t (p_{i+1} − p_i)``.
+        Arrays (J, k, ...), at each link's closest point.
     """
 
     points: ShapeDistances
     links: ShapeDistances
 
+    @classmethod
+    def of(cls, near: ProximityBuffers) -> Proximity:
+        """Views of proximity buffers."""
+        points = ShapeDistances(
+            near.point_distance,
+            near.point_normal,
+            near.point_penalty,
+            near.point_penalty_gradient,
+            np.zeros_like(near.point_distance),
+        )
+        links = ShapeDistances(near.link_distance, near.link_normal, near.link_penalty,
+                               near.link_penalty_gradient, near.link_t)  # fmt: skip
+        return cls(points, links)
+
     @property
-    def point_clearance(self) -> NDArray[np.float64]:
+    def point_clearance(self) -> Array:
         """Signed clearance of each guarded point to each obstacle, m, shape (J, k+1)."""
         return self.points.distance
 
     @property
-    def link_clearance(self) -> NDArray[np.float64]:
+    def link_clearance(self) -> Array:
         """Signed clearance of each guarded link to each obstacle, m, shape (J, k)."""
         return self.links.distance
 
     @property
-    def link_t(self) -> NDArray[np.float64]:
+    def link_t(self) -> Array:
         """Parameter in [0, 1] of each link's closest point, shape (J, k)."""
         return self.links.t
 
@@ -90,20 +132,25 @@ def link_label(i: int, k: int) -> str:
     return "holder" if i == k - 1 else f"link{i + 1}"
 
 
-def proximity(state: KinematicState, obstacles: ObstacleSet) -> Proximity:
-    """The :class:`Proximity` of ``state`` to ``obstacles``, computed once and cached."""
-    cache = state.cache
-    found = cache.get(obstacles)
-    if found is not None:
-        return found  # type: ignore[no-any-return]
-    lz = state.guarded[:, :2]
-    period = 2.0 * np.pi * state.radius
-    result = Proximity(obstacles.points(lz, period), obstacles.segments(lz[:-1], lz[1:], period))
-    cache[obstacles] = result
-    return result
+def measure(shapes: Sequence[Shape], chain: Array, period: float) -> ProximityBuffers:
+    """Every distance of the points ``chain`` (m, ≥ 2) and the links between them to
+    ``shapes``, penalties included, in new buffers (J, m) and (J, m − 1)."""
+    packed = ShapeArrays.of(shapes, period)
+    near = ProximityBuffers.allocate(len(shapes), chain.shape[0] - 1)
+    points = np.ascontiguousarray(chain, dtype=np.float64)
+    measure_chain(as_struct(packed), points, as_struct(near))
+    user_rows(shapes, packed.code, points, period, near)
+    penalties(packed.size, as_struct(near))
+    return near
 
 
-def min_clearance(state: KinematicState, obstacles: ObstacleSet) -> float:
+def proximity(state: KinematicState, obstacles: ObstacleSet | Sequence[Shape]) -> Proximity:
+    """The :class:`Proximity` of ``state``'s guarded parts to ``obstacles``."""
+    shapes = tuple(obstacles)
+    return Proximity.of(measure(shapes, np.array(state.guarded), 2.0 * np.pi * state.radius))
+
+
+def min_clearance(state: KinematicState, obstacles: ObstacleSet | Sequence[Shape]) -> float:
     """Smallest signed clearance (m) of any guarded part to ``obstacles``.
 
     Negative inside an obstacle; ``inf`` with no obstacles.
@@ -111,3 +158,28 @@ def min_clearance(state: KinematicState, obstacles: ObstacleSet) -> float:
     if not len(obstacles):
         return math.inf
     return proximity(state, obstacles).min_clearance()
+
+
+def distances(
+    obstacles: ObstacleSet | Sequence[Shape], lz: Array, period: float
+) -> tuple[Array, Array]:
+    """Signed distances (J, m) and normals (J, m, 2) of m points ``lz`` (m, 2) to every
+    obstacle (l differences wrapped modulo ``period``, m)."""
+    points = np.asarray(lz, dtype=np.float64).reshape(-1, 2)
+    chain = np.vstack([points, points[-1:]])  # a chain needs two points: the last, twice
+    near = measure(tuple(obstacles), chain, period)
+    m = points.shape[0]
+    return near.point_distance[:, :m].copy(), near.point_normal[:, :m].copy()
+
+
+def segment_distances(
+    obstacles: ObstacleSet | Sequence[Shape], a: Array, b: Array, period: float
+) -> tuple[Array, Array, Array]:
+    """Smallest signed distances (J, m), their parameters ``t`` (J, m) and the normals there
+    (J, m, 2) of m segments ``a → b`` (each (m, 2)) to every obstacle."""
+    a2, b2 = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    chain = np.stack([a2, b2], axis=1).reshape(-1, 2)  # a0, b0, a1, b1, ...: links 0, 2, ...
+    near = measure(tuple(obstacles), chain, period)
+    cut = slice(0, None, 2)
+    return (near.link_distance[:, cut].copy(), near.link_t[:, cut].copy(),
+            near.link_normal[:, cut].copy())  # fmt: skip

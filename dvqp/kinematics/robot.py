@@ -8,6 +8,7 @@ frames and a tool frame works. The base frame's z axis is the pipe axis.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -16,9 +17,10 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
-from dvqp._files import c_output_captured
-from dvqp.errors import DvqpError, ParameterError
+from dvqp.errors import ParameterError
 from dvqp.kinematics.dh import DHRow, check_transform, fixed_part, ndt13_table
+from dvqp.kinematics.model import ModelArrays
+from dvqp.kinematics.urdf import urdf_model
 
 NDT13_POINT_JOINTS = (4, 6, 8, 10, 13)
 """Joints (1-based) whose output frames are the paper's five body points."""
@@ -33,7 +35,7 @@ class Robot:
     Parameters
     ----------
     model
-        Pinocchio model with ``nq == nv == n`` (revolute joints).
+        Pinocchio model with ``nq == nv == n``: revolute and prismatic joints about fixed axes.
     point_frames
         Names of the body-point frames, in order along the chain (k >= 2).
     tool_frame
@@ -85,7 +87,13 @@ class Robot:
         if np.any(qd <= 0):
             raise ParameterError("qd_max", "must be > 0 for every joint")
         self.qd_max = _validate.readonly(qd)
-        self.data = model.createData()
+        self._arrays = ModelArrays.of(model, self.frame_ids)  # refuses other joint types
+
+    def model_arrays(self) -> ModelArrays:
+        """The model's constants for the compiled kinematics, with scratch arrays of their own
+        (each run or evaluation owns one)."""
+        a = self._arrays
+        return dataclasses.replace(a, work=np.zeros_like(a.work), world=np.zeros_like(a.world))
 
     @property
     def frame_names(self) -> tuple[str, ...]:
@@ -229,66 +237,8 @@ class Robot:
         ParameterError
             ``urdf``: a joint of a type other than the above; ``frames``: no such frame.
         """
-        noise: list[str] = []
-        try:
-            with c_output_captured(noise):
-                model = pin.buildModelFromUrdf(str(path))
-        except (RuntimeError, ValueError) as exc:
-            detail = f" ({noise[0]})" if noise else ""
-            raise DvqpError(f"{path}: cannot load URDF: {exc}{detail}") from exc
-        model = _bounded_revolute(model)
+        model = urdf_model(path)
         if qd_max is None:
             vel = np.asarray(model.velocityLimit, dtype=float)
             qd_max = np.where(np.isfinite(vel) & (vel > 0), vel, DEFAULT_QD_MAX)
         return cls(model, points, tool, q_min=q_min, q_max=q_max, qd_max=qd_max, name=model.name)
-
-
-UNBOUNDED_REVOLUTE = {"JointModelRUBX": pin.JointModelRX, "JointModelRUBY": pin.JointModelRY,
-                      "JointModelRUBZ": pin.JointModelRZ}  # fmt: skip
-"""Pinocchio's joints for a URDF ``continuous`` joint about x, y, z (nq = 2: cos, sin) and their
-nq = 1 twins (any other axis: ``JointModelRevoluteUnboundedUnaligned``, see :func:`_twin`)."""
-
-
-def _bounded_revolute(model: pin.Model) -> pin.Model:
-    """``model`` with each continuous joint (nq = 2) as a revolute one without limits (nq = 1).
-
-    The joints, bodies and frames keep their names, placements, inertias and order; any other
-    joint with ``nq != nv`` is refused (``ParameterError`` named ``urdf``).
-    """
-    twins = [_twin(model.joints[i]) for i in range(1, model.njoints)]
-    for name, joint, twin in zip(model.names[1:], model.joints[1:], twins, strict=True):
-        if joint.nq != joint.nv and twin is None:
-            raise ParameterError(
-                "urdf", f"joint {name!r} is a {joint.shortname().removeprefix('JointModel')} "
-                "joint: only revolute, continuous and prismatic joints are supported"
-            )  # fmt: skip
-    if all(twin is None for twin in twins):
-        return model
-    out = pin.Model()
-    out.name = model.name
-    for i, twin in enumerate(twins, start=1):
-        joint = model.joints[i]
-        q = slice(joint.idx_q, joint.idx_q + joint.nq)
-        lo, hi = model.lowerPositionLimit[q], model.upperPositionLimit[q]
-        if twin is not None:
-            lo, hi = np.array([-np.inf]), np.array([np.inf])
-        v = slice(joint.idx_v, joint.idx_v + joint.nv)
-        out.addJoint(model.parents[i], joint.extract() if twin is None else twin,
-                     model.jointPlacements[i], model.names[i], model.effortLimit[v],
-                     model.velocityLimit[v], lo, hi)  # fmt: skip
-        out.appendBodyToJoint(i, model.inertias[i], pin.SE3.Identity())
-    for frame in list(model.frames)[1:]:
-        out.addFrame(pin.Frame(frame), False)
-    return out
-
-
-def _twin(joint: pin.JointModel) -> pin.JointModel | None:
-    """The nq = 1 revolute joint of a continuous (nq = 2) one; None for any other joint."""
-    kind = joint.shortname()
-    if kind in UNBOUNDED_REVOLUTE:
-        return UNBOUNDED_REVOLUTE[kind]()
-    if kind != "JointModelRevoluteUnboundedUnaligned":
-        return None
-    data = joint.createData()  # the axis is not exposed: read it from the motion subspace
-    joint.calc(data, np.array([1.0, 0.0]))
-    return pin.JointModelRevoluteUnaligned(*np.asarray(data.S, dtype=float).reshape(6)[3:])

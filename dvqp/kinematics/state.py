@@ -1,24 +1,24 @@
-"""One kinematics update per step: the state every other computation reads.
+"""The kinematics of one configuration, as every other computation reads it.
 
-:func:`KinematicState.compute` runs Pinocchio's forward kinematics and frame Jacobians once
-for the body points and the tool, maps them to the developed view, and freezes the result
-(all arrays are read-only). The objective, the baseline and the QP constraints only read it.
+A :class:`KinematicState` holds the frames, frame Jacobians and developed-view coordinates of
+the body points and the tool. A run's state is a read-only view of its step's buffers
+(:meth:`KinematicState.view`: it changes as the run moves on, as pink's ``Configuration``
+does); :meth:`KinematicState.compute` evaluates one configuration on its own, with the same
+compiled kinematics (:func:`dvqp.kinematics.model.kinematics`), into arrays of its own.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
-from dvqp.kinematics import developed_view as dv
+from dvqp.errors import SingularConfigurationError
+from dvqp.kinematics.model import kinematics
 from dvqp.kinematics.robot import Robot
-
-_LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+from dvqp.workspace import StateBuffers, as_struct
 
 
 @dataclass(frozen=True)
@@ -37,24 +37,19 @@ class KinematicState:
         Unit z axes of the same frames (the last one is the probe's axis).
     frame_jacobians : ndarray, shape (k+1, 6, n)
         ``[J_v; J_ω]`` of the same frames in the base orientation (Pinocchio's
-        LOCAL_WORLD_ALIGNED): ``ȯ = J_v Q̇``, ``ω = J_ω Q̇``; a user task reads these.
+        LOCAL_WORLD_ALIGNED): ``ȯ = J_v Q̇``, ``ω = J_ω Q̇``.
     guarded : ndarray, shape (k+1, 3)
         DV positions ``[l, z, h]`` (m) of every guarded point: the k body points, then the
         probe (the tool point). Consecutive points bound the guarded links: the k−1 body links,
         then the probe holder (last body point to the tool).
     guarded_jacobians : ndarray, shape (k+1, 3, n)
         ``∂[l, z, h]/∂Q`` of the same points, m/rad.
-    points : ndarray, shape (k, 3)
-        Body points in DV, ``[l, z, h]`` (m): ``guarded[:-1]``.
-    point_jacobians : ndarray, shape (k, 3, n)
-        ``∂[l, z, h]/∂Q`` of each body point, m/rad: ``guarded_jacobians[:-1]``.
+    points, point_jacobians : ndarray, shapes (k, 3), (k, 3, n)
+        The body points alone: ``guarded[:-1]``, ``guarded_jacobians[:-1]``.
     tool : ndarray, shape (4,)
         Tool DV coordinates ``[l, z, h, α]`` (m, m, m, rad).
     tool_jacobian : ndarray, shape (4, n)
         The DV task Jacobian ``J̄(Q)``.
-    cache : dict
-        Quantities derived from this state once and shared: the proximity to an obstacle
-        set (:func:`dvqp.geometry.proximity`), an objective's value and gradient.
     """
 
     q: NDArray[np.float64]
@@ -68,7 +63,6 @@ class KinematicState:
     point_jacobians: NDArray[np.float64]
     tool: NDArray[np.float64]
     tool_jacobian: NDArray[np.float64]
-    cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def n(self) -> int:
@@ -81,55 +75,42 @@ class KinematicState:
         return int(self.points.shape[0])
 
     @classmethod
-    def compute(cls, robot: Robot, q: ArrayLike, radius: float) -> KinematicState:
-        """Run forward kinematics and frame Jacobians once and map them to the DV.
+    def view(cls, buffers: StateBuffers, radius: float) -> KinematicState:
+        """Read-only views of ``buffers``: they show whatever state the buffers hold now."""
+        views = {}
+        for name in ("q", "origins", "axes", "frame_jacobians", "guarded", "guarded_jacobians",
+                     "tool", "tool_jacobian"):  # fmt: skip
+            views[name] = getattr(buffers, name).view()
+            views[name].flags.writeable = False
+        g, gj = views["guarded"], views["guarded_jacobians"]
+        return cls(radius=float(radius), points=g[:-1], point_jacobians=gj[:-1], **views)
 
-        Parameters
-        ----------
-        robot
-            The manipulator (its Pinocchio ``data`` is used as scratch space).
-        q
-            Joint configuration, rad, shape (n,).
-        radius
-            Pipe radius, m, > 0.
+    @classmethod
+    def compute(cls, robot: Robot, q: ArrayLike, radius: float) -> KinematicState:
+        """The kinematics of ``q`` (rad, shape (n,)) in a pipe of ``radius`` (m).
 
         Raises
         ------
-        ShapeError
-            ``q`` has the wrong length.
+        ShapeError, ParameterError
+            ``q`` has the wrong length or is not finite; ``radius`` is not > 0.
         SingularConfigurationError
-            A point or the tool lies on the pipe axis.
+            A body point or the tool lies on the pipe axis.
         """
-        qv = robot.check_q(q)  # a copy
-        model, data = robot.model, robot.data
-        pin.computeJointJacobians(model, data, qv)
-        pin.updateFramePlacements(model, data)
-        ids = robot.frame_ids
-        frames = np.array([data.oMf[i].homogeneous for i in ids])  # (m, 4, 4)
-        jac = np.array([pin.getFrameJacobian(model, data, i, _LWA) for i in ids])  # (m, 6, n)
-        origins = frames[:, :3, 3]
-        axes = frames[:, :3, 2]
+        buffers = StateBuffers.allocate(robot.n, robot.n_points)
+        buffers.q[:] = robot.check_q(q)
         r = _validate.positive("radius", radius)
-        pos, lin = dv.position_and_rows(origins, jac[:, :3, :], r, robot.frame_names)
-        alpha, alpha_row = dv.heading_row(origins[-1], axes[-1], jac[-1])
-        tool = np.empty(4)
-        tool[:3] = pos[-1]
-        tool[3] = alpha
-        tool_jac = np.empty((4, jac.shape[2]))
-        tool_jac[:3] = lin[-1]
-        tool_jac[3] = alpha_row
-        ro = _validate.readonly
-        pos, lin = ro(pos), ro(lin)
-        return cls(
-            q=ro(qv),
-            radius=float(radius),
-            origins=ro(origins),
-            axes=ro(axes),
-            frame_jacobians=ro(jac),
-            guarded=pos,
-            guarded_jacobians=lin,
-            points=pos[:-1],
-            point_jacobians=lin[:-1],
-            tool=ro(tool),
-            tool_jacobian=ro(tool_jac),
-        )
+        singular = kinematics(as_struct(robot.model_arrays()), r, as_struct(buffers))
+        if singular != -1:
+            raise singular_frame(robot, int(singular), buffers.origins[singular], buffers.q.copy())
+        return cls.view(buffers, r)
+
+
+def singular_frame(
+    robot: Robot, frame: int, origin: NDArray[np.float64], q: object = None
+) -> SingularConfigurationError:
+    """The error of guarded frame ``frame`` found on the pipe axis (at ``origin``, m)."""
+    rho = float(np.hypot(origin[0], origin[1]))
+    name = robot.frame_names[frame]
+    return SingularConfigurationError(
+        f"frame {name!r} lies on the pipe axis (rho = {rho:.3g} m)", q
+    )

@@ -1,13 +1,13 @@
 """Limits of the QP step, one concept per module.
 
-Each limit has a ``name`` and ``compute(state, dt)`` returning a :class:`Constraint` or a
-:class:`Bounds` (the :class:`Limit` protocol); the distance limits derive from
-:class:`VelocityDamper`, which owns the damper's right-hand side.
+A limit derives from :class:`Limit` (rows ``Constraint(G, h)`` or a ``Bounds`` box); the
+distance limits derive from :class:`VelocityDamper`, which owns the damper's right-hand side
+and the exact verification of its distances.
 """
 
 from dvqp.limits.acceleration import DEFAULT_QDD_MAX, AccelerationLimit
-from dvqp.limits.damper import Distances, VelocityDamper, damper_rhs
-from dvqp.limits.excess import NO_EXCESS, Excess, VerifiedLimit, worst_excess
+from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, damper_value
+from dvqp.limits.excess import NO_EXCESS, Excess
 from dvqp.limits.joint_position import JointPositionLimit
 from dvqp.limits.joint_velocity import JointVelocityLimit
 from dvqp.limits.limit import Bounds, Constraint, Limit
@@ -15,9 +15,10 @@ from dvqp.limits.obstacle_damper import ObstacleDamper
 from dvqp.limits.probe_height import ProbeHeight
 from dvqp.limits.self_collision import SelfCollision, self_distance
 from dvqp.limits.surface_height import SurfaceHeight
-from dvqp.limits.tilt import TiltLimit, tilt, tilt_cosine, tilt_sine
+from dvqp.limits.tilt import TiltLimit
 
 __all__ = [
+    "DEFAULT_DECELERATION",
     "DEFAULT_QDD_MAX",
     "NO_EXCESS",
     "AccelerationLimit",
@@ -34,11 +35,6 @@ __all__ = [
     "SurfaceHeight",
     "TiltLimit",
     "VelocityDamper",
-    "VerifiedLimit",
-    "damper_rhs",
+    "damper_value",
     "self_distance",
-    "tilt",
-    "tilt_cosine",
-    "tilt_sine",
-    "worst_excess",
 ]

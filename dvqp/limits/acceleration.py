@@ -10,29 +10,32 @@ left, i.e. ``Q̇ ≤ −a dt + sqrt(a² dt² + 2 a D)`` (and the mirror bound to
 The limit remembers the velocity of the last step it was told about: the resolution loop
 calls :meth:`AccelerationLimit.observe` after each accepted (sub)step and
 :meth:`AccelerationLimit.reset` at the start of a run (at rest). Both write into the same
-array for the limit's whole life, which the compiled kernel (:meth:`AccelerationLimit.kernel`)
-reads.
+array for the limit's whole life, which the compiled step reads.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
-from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.kinematics.robot import Robot
-from dvqp.kinematics.state import KinematicState
-from dvqp.limits.bounds_kernels import acceleration_bounds
-from dvqp.limits.limit import Bounds
+from dvqp.limits.limit import Limit
 
 DEFAULT_QDD_MAX = 10.0
 """rad/s²: the default joint acceleration limit of the NDT arm's drives."""
 
 
-class AccelerationLimit:
-    """``|Q̇ − Q̇_prev| ≤ q̈_max dt`` and the braking bound toward the position limits.
+Array = NDArray[np.float64]
+
+
+class AccelerationLimit(Limit):
+    """``|Q̇ − Q̇_prev| ≤ q̈_max dt`` and the braking bound toward the position limits
+    (compiled: :func:`acceleration_bounds`; at most one in a step).
 
     Parameters
     ----------
@@ -69,25 +72,24 @@ class AccelerationLimit:
         place."""
         np.copyto(self._previous, qdot)
 
-    def compute(self, state: KinematicState, dt: float) -> Bounds:
-        """The box of this step, rad/s, shape (n,) each."""
-        a = self.qdd_max
-        lb = self._previous - a * dt
-        ub = self._previous + a * dt
-        ub = np.minimum(ub, _braking(a, dt, self.q_max - state.q))
-        lb = np.maximum(lb, -_braking(a, dt, state.q - self.q_min))
-        # a joint that cannot brake in time any more keeps its position limit, not this bound
-        return Bounds(np.minimum(lb, ub), ub)
 
-    def kernel(self, plan: StepPlan) -> Kernel:
-        """The box at ``plan.state.q`` around :attr:`previous` (read live at every call),
-        intersected into ``plan.lb``, ``plan.ub``."""
-        args = (plan.state.q, self.q_min, self.q_max, self.qdd_max, self._previous, plan.dt,
-                plan.lb, plan.ub)  # fmt: skip
-        return Kernel(acceleration_bounds, args)
+@njit(cache=True, inline="always")
+def _braking(a: float, dt: float, room: float) -> float:
+    """Fastest velocity toward a limit ``room`` (rad) away that still stops before it, rad/s:
+    ``Q̇ dt + Q̇²/(2a) ≤ room`` (an unlimited side, ``room = inf``, gives inf)."""
+    return -a * dt + math.sqrt((a * dt) ** 2 + 2.0 * a * max(room, 0.0))
 
 
-def _braking(a: NDArray[np.float64], dt: float, room: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Fastest velocity toward a limit ``room`` (rad) away that still stops before it, rad/s."""
-    # an unlimited joint: room = inf gives inf (no bound), without warnings
-    return -a * dt + np.sqrt((a * dt) ** 2 + 2.0 * a * np.maximum(room, 0.0))
+@njit(cache=True)
+def acceleration_bounds(q: Array, q_min: Array, q_max: Array, qdd_max: Array, previous: Array,
+                        dt: float, lb: Array, ub: Array) -> None:  # fmt: skip
+    """The box ``|Q̇ − Q̇_prev| ≤ q̈_max dt`` capped by the braking bounds, intersected into
+    ``lb``, ``ub`` in place. A joint that cannot brake in time any more keeps its position
+    limit, not this bound (``lb = min(low, high)``)."""
+    for i in range(q.shape[0]):
+        a = qdd_max[i]
+        low, high = previous[i] - a * dt, previous[i] + a * dt
+        high = min(high, _braking(a, dt, q_max[i] - q[i]))
+        low = max(low, -_braking(a, dt, q[i] - q_min[i]))
+        lb[i] = max(lb[i], min(low, high))
+        ub[i] = min(ub[i], high)

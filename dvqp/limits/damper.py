@@ -11,15 +11,13 @@ Above ``d_safe``, ``d`` decays at most geometrically toward it, no faster than t
 speed for a deceleration ``a``, and does not cross it at first order. A second-order drift of
 at most ``δ`` (the damper's verification tolerance, 0.1 mm) below it is pulled back, so it
 settles at about ``|ε|/γ`` instead of adding up step after step; the return is asked no faster
-than one step's acceleration. A part deeper inside (it started there) may not get worse, and
-no escape it might not be able to make is demanded; the objective pushes body points out of
-obstacles and toward the orbital level. A subclass implements :meth:`VelocityDamper.distances`;
-the base owns the right-hand side.
+than one step's acceleration. A part deeper inside (it started there) may not get worse.
 
-The compiled step (:mod:`dvqp.compiled`) uses the scalar twin
-:func:`~dvqp.limits.damper_kernels.damper_value` of :func:`damper_rhs`, the same operations in
-the same order (equal bit for bit); a built-in damper's :meth:`~VelocityDamper.kernel` writes
-its rows with it.
+A damper only measures its distances (``d``, ``∂d/∂Q``, whether the row applies); the rows and
+their exact verification are the same compiled code for every damper (:func:`damper_rows`,
+:func:`damper_values`). dvqp's dampers measure in compiled kernels of their own modules; one of
+yours derives from :class:`VelocityDamper` and implements :meth:`VelocityDamper.distances` in
+NumPy, or brings a kernel (:meth:`VelocityDamper.kernel`).
 """
 
 from __future__ import annotations
@@ -29,13 +27,15 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
+from numba import njit
+from numpy.typing import ArrayLike, NDArray
 
-from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits.excess import NO_EXCESS, Excess
-from dvqp.limits.limit import Constraint
+from dvqp.limits.limit import Limit
+from dvqp.workspace import Kernel, StepPlan
+
+Array = NDArray[np.float64]
 
 DEFAULT_DECELERATION = 1.0
 """m/s²: the default braking of a damper's approach, within what the arm's joints, limited to
@@ -50,44 +50,21 @@ class Distances:
     ----------
     value : ndarray, shape (p,)
         ``d``, m.
-    gradient : ndarray, shape (p, n), or None
-        ``∂d/∂Q``, m/rad (None where only the values are wanted, for verification).
+    gradient : ndarray, shape (p, n)
+        ``∂d/∂Q``, m/rad.
     safe : float or ndarray of shape (p,)
         ``d_safe``, m.
     describe : callable, optional
         Labels of the p rows, computed only when asked.
     """
 
-    value: NDArray[np.float64]
-    gradient: NDArray[np.float64] | None
-    safe: float | NDArray[np.float64]
+    value: Array
+    gradient: Array
+    safe: float | Array
     describe: Callable[[], tuple[str, ...]] | None = field(default=None, repr=False)
 
 
-def damper_rhs(
-    distance: NDArray[np.float64],
-    safe: float | NDArray[np.float64],
-    gain: float,
-    dt: float,
-    depth: float,
-    deceleration: float = math.inf,
-) -> NDArray[np.float64]:
-    """``γ/dt · (d − d_safe)``, capped above ``d_safe`` by the braking speed
-    ``sqrt(2 a (d − d_safe))``; below it, a drift of at most ``δ`` is pulled back no faster
-    than one step's acceleration ``a·dt``, and deeper (a start inside the margin) the distance
-    may only not shrink (0): m/s, the right-hand side of every damper row."""
-    room = distance - safe
-    # a drift of at most δ below the safe value is pulled back; deeper (a start inside the
-    # margin) the distance may only not shrink: an escape it may not be able to make is not
-    # demanded
-    rhs = np.where(room < -depth, 0.0, gain / dt * room)
-    if math.isinf(deceleration):
-        return rhs
-    # above: brake in time; below: ask for no faster a return than one step's acceleration
-    return np.clip(rhs, -deceleration * dt, np.sqrt(2.0 * deceleration * np.maximum(room, 0.0)))
-
-
-class VelocityDamper:
+class VelocityDamper(Limit):
     """Base of the damper limits.
 
     Parameters
@@ -99,13 +76,22 @@ class VelocityDamper:
         ``a`` (m/s², or the distance's unit per s²), > 0: the approach speed is at most
         ``sqrt(2 a (d − d_safe))``, so a part slows down in time for joints whose accelerations
         are limited; ``inf`` removes the cap.
+
+    Attributes
+    ----------
+    quantity, unit : str
+        What the distance is and its unit, for reports (``"clearance"``, ``"m"``).
+    tolerance : float
+        How far below ``min(d_safe, d at the start)`` an integrated step may end (its unit).
+    reach : float
+        A row applies only while its distance is below this (``inf``: always).
     """
 
     name = "damper"
     quantity = "distance"
-    """What the distance is, for reports (``"clearance"``, ``"height"``)."""
+    unit = "m"
     tolerance = 1e-4
-    """m: how far below ``min(d_safe, d at the start)`` an integrated step may end."""
+    reach = math.inf
 
     def __init__(self, gain: float = 0.5, deceleration: float = DEFAULT_DECELERATION) -> None:
         if not 0.0 < float(gain) <= 1.0:
@@ -116,55 +102,77 @@ class VelocityDamper:
         self.deceleration = float(deceleration)
 
     def distances(self, state: KinematicState) -> Distances:
-        """The distances this damper keeps at ``state``, with their gradients (the rows)."""
-        raise NotImplementedError
-
-    def all_distances(self, state: KinematicState) -> Distances:
-        """Every distance the damper guards, in a fixed order, gradients not needed.
-
-        The default is :meth:`distances`; a damper that adds rows only for nearby pairs
-        returns all pairs here, so a pair that jumps from far to inside its margin in one
-        step is caught.
-        """
-        return self.distances(state)
-
-    def params(self, safe: float) -> tuple[float, float, float, float]:
-        """``(d_safe, γ, δ, a)``: the parameter tuple of the compiled damper kernels
-        (:mod:`dvqp.limits.damper_kernels`), with ``δ`` the tolerance."""
-        return (float(safe), self.gain, float(self.tolerance), self.deceleration)
+        """The distances this damper keeps at ``state``, with their gradients: implement it
+        for a damper of your own (the same number of distances at every state of a run)."""
+        raise NotImplementedError(f"{type(self).__name__} has no distances(state)")
 
     def kernel(self, plan: StepPlan) -> Kernel | None:
-        """The compiled rows (see :class:`~dvqp.limits.limit.Limit`); a subclass without one
-        raises NotImplementedError, so the run takes the reference path."""
-        raise NotImplementedError(f"{type(self).__name__} has no compiled kernel")
+        """Optionally, the distances as a compiled kernel: ask for them once
+        (``distance, gradient, usable = plan.damper_rows(count)``) and return a
+        :class:`~dvqp.workspace.Kernel` writing ``d``, ``∂d/∂Q`` and whether each row applies
+        from ``plan.state`` at every state; its safe value is then :attr:`safe`."""
+        return None
 
-    def verifier(self, plan: StepPlan) -> Kernel | None:
-        """The compiled verification values (see :mod:`dvqp.limits.excess`); a subclass without
-        one raises NotImplementedError, so the run takes the reference path."""
-        raise NotImplementedError(f"{type(self).__name__} has no compiled verifier")
+    @property
+    def safe(self) -> float | ArrayLike:
+        """``d_safe`` of the distances of a damper with a kernel (m)."""
+        raise NotImplementedError(f"{type(self).__name__} has no safe value")
 
-    def compute(self, state: KinematicState, dt: float) -> Constraint:
-        """``−∂d/∂Q · Q̇ ≤ γ/dt · max(d − d_safe, −δ)``, one row per distance."""
-        d = self.distances(state)
-        if d.gradient is None:
-            raise ValueError(f"{type(self).__name__}.distances must return gradients")
-        rhs = damper_rhs(d.value, d.safe, self.gain, dt, self.tolerance, self.deceleration)
-        return Constraint(-d.gradient, rhs, d.describe)
+    def labels(self, k: int) -> tuple[str, ...]:
+        """What each distance is, for reports (``k``: the arm's body points); none by default
+        (a report then numbers them after :attr:`name`)."""
+        return ()
 
-    def excess(self, start: KinematicState, state: KinematicState) -> Excess:
-        """How far ``state`` is below ``min(d_safe, d(start))``, m, for the worst distance."""
-        floor = start.cache.get((self, "floor"))
-        if floor is None:  # the start's floors are the same at every step of a run
-            b = self.all_distances(start)
-            floor = np.minimum(b.safe, b.value)
-            start.cache[(self, "floor")] = floor
-        a = self.all_distances(state)
-        if a.value.shape[0] == 0:
-            return NO_EXCESS
-        over = floor - a.value
-        i = int(np.argmax(over))
-        label = a.describe()[i] if a.describe is not None and over[i] > 0.0 else ""
-        return Excess(
-            float(over[i]), self.tolerance, label, self.quantity, "m",
-            float(a.value[i]), float(floor[i]),
-        )  # fmt: skip
+
+@dataclass(frozen=True)
+class DamperArrays:
+    """Every damper row's parameters (D,): ``safe``, ``gain`` γ, ``depth`` δ (the tolerance),
+    ``deceleration`` a, ``reach`` (a row applies below it) and ``angle`` (bool: verified as
+    ``asin(min(d, 1))``, the tilt)."""
+
+    safe: Array
+    gain: Array
+    depth: Array
+    deceleration: Array
+    reach: Array
+    angle: NDArray[np.bool_]
+
+
+@njit(cache=True)
+def damper_value(distance: float, safe: float, gain: float, dt: float, depth: float,
+                 deceleration: float) -> float:  # fmt: skip
+    """The right-hand side of a damper row (see the module docstring), m/s."""
+    room = distance - safe
+    rhs = 0.0 if room < -depth else gain / dt * room
+    if math.isinf(deceleration):
+        return rhs
+    low, high = -deceleration * dt, math.sqrt(2.0 * deceleration * max(room, 0.0))
+    return min(max(rhs, low), high)
+
+
+@njit(cache=True)
+def damper_rows(params, dampers, dt: float, G: Array, h: Array) -> None:  # type: ignore[no-untyped-def]
+    """Rows ``r`` of ``G``, ``h`` from damper r's distance (``dampers``, packed
+    :class:`~dvqp.workspace.DamperBuffers`; ``params`` a packed :class:`DamperArrays`):
+    ``−∂d/∂Q · Q̇ ≤ rhs`` where the row applies (usable, below its reach), else
+    ``0 · Q̇ ≤ +inf``."""
+    for r in range(params.safe.shape[0]):
+        d = dampers.distance[r]
+        if dampers.usable[r] and d < params.reach[r]:
+            for c in range(G.shape[1]):
+                G[r, c] = -dampers.gradient[r, c]
+            h[r] = damper_value(d, params.safe[r], params.gain[r], dt, params.depth[r],
+                                params.deceleration[r])  # fmt: skip
+        else:
+            for c in range(G.shape[1]):
+                G[r, c] = 0.0
+            h[r] = np.inf
+
+
+@njit(cache=True)
+def damper_values(angle, distance: Array, values: Array, start: int) -> None:  # type: ignore[no-untyped-def]
+    """The verified values of the damper rows at ``values[start:]``: the distances, or the
+    angle ``asin(min(d, 1))`` of an ``angle`` row."""
+    for r in range(distance.shape[0]):
+        d = distance[r]
+        values[start + r] = math.asin(min(d, 1.0)) if angle[r] else d

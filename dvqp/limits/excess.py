@@ -1,42 +1,23 @@
 """Exact verification of a step: how far the integrated motion went past each limit.
 
 The QP holds the limits linearised one step ahead; the motion that is integrated may still
-go past them (second-order terms, large steps). After each step the resolution loop evaluates
-every limit that can verify itself (the :class:`VerifiedLimit` protocol) at the configuration
-actually reached, without linearisation, and keeps the worst :class:`Excess`.
+go past them (second-order terms, large steps). After each step every verified limit's exact
+quantities (clearances, heights, tilt, joint room, ...) are evaluated at the configuration
+reached, without linearisation, and the worst :class:`Excess` is kept.
 
-A limit is kept if its quantity stays at or above ``min(bound, value at the start of the
-run)``: a part that starts closer than its margin may stay there but may not get worse, and
-small excesses cannot add up from step to step.
-
-Compiled verification. A verified limit also provides ``verifier(plan)``: a
-:class:`~dvqp.compiled.plan.Kernel` that writes the limit's exact quantities at
-``plan.state`` into ``slot = plan.verified(limit, count, safe, tolerance)`` (None when there is
-nothing to check, e.g. a tilt limit with ``min_tilt = 0`` or a damper without obstacles;
-NotImplementedError when it cannot be compiled). With the values at the run's start,
-``floor = minimum(safe, values_at_start)`` (fixed for the run), the limit's
-:meth:`VerifiedLimit.excess` value at a state is ``max(floor − values)`` over its slice, its
-tolerance is ``tolerance``, and :func:`worst_excess` is the entry of largest
-``(floor − value) / tolerance`` over all slices. The values are:
-
-- a damper: its distances in the order of ``all_distances`` (m; safe ``d_safe``, tolerance
-  0.1 mm): an obstacle damper every point's clearance (J × (k+1), obstacle-major), then every
-  link's (J × k); the surface height the k body points' heights; the probe height the probe's;
-  self-collision every non-adjacent pair's distance;
-- joint positions ``[q_max − q, q − q_min]`` (2n, rad; safe 0, tolerance 1e-6 rad; ``inf`` on
-  an unlimited side, so ``floor − value = −inf`` there, never NaN);
-- the tilt ``asin(min(sin θ, 1))`` (one value, rad; safe ``asin(min(sin θ_min, 1))``,
-  tolerance 1e-3 rad).
+A quantity is kept if it stays at or above ``min(safe, value at the start of the run)``: a
+part that starts closer than its margin may stay there but may not get worse, and small
+excesses cannot add up from step to step.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
 
-from dvqp.kinematics.state import KinematicState
+from numba import njit
+
+from dvqp.workspace.buffers import Array
 
 
 @dataclass(frozen=True)
@@ -54,7 +35,7 @@ class Excess:
     quantity : str
         ``"clearance"``, ``"height"``, ``"tilt"``, ``"joint position"``, ...
     unit : str
-        ``"m"``, ``"rad"`` or ``"rad/s"``.
+        ``"m"`` or ``"rad"``.
     actual, bound : float
         The value reached and the bound it had to keep.
     """
@@ -81,43 +62,27 @@ class Excess:
         """One line, e.g. ``"probe/obstacle3 clearance 0.0061 m < 0.0099 m (by 3.8 mm)"``."""
         if math.isinf(self.value):
             return f"{self.label} ({self.quantity})"
-        if self.unit == "m":
-            by = f"{self.value * 1e3:.3g} mm"
-        else:
-            by = f"{self.value:.3g} {self.unit}"
+        by = f"{self.value * 1e3:.3g} mm" if self.unit == "m" else f"{self.value:.3g} {self.unit}"
         below = "<" if self.quantity not in ("joint position", "joint velocity") else "past"
-        return (
-            f"{self.label} {self.quantity} {self.actual:.4g} {self.unit} {below} "
-            f"{self.bound:.4g} {self.unit} (by {by})"
-        )
+        return (f"{self.label} {self.quantity} {self.actual:.4g} {self.unit} {below} "
+                f"{self.bound:.4g} {self.unit} (by {by})")  # fmt: skip
 
 
-NO_EXCESS = Excess(value=-float("inf"), tolerance=1.0)
-"""What a limit with nothing to check reports."""
+NO_EXCESS = Excess(value=-math.inf, tolerance=1.0)
+"""What a step with nothing to check reports."""
 
 
-@runtime_checkable
-class VerifiedLimit(Protocol):
-    """A limit that can check a motion exactly (all built-in limits can)."""
-
-    def excess(self, start: KinematicState, state: KinematicState) -> Excess:
-        """The worst excess at ``state`` of a run that started at ``start``."""
-        ...
-
-
-def worst_excess(limits: Iterable[object], start: KinematicState, state: KinematicState) -> Excess:
-    """The worst :class:`Excess` (largest ``value / tolerance``) of every verifiable limit.
-
-    Limits without an ``excess`` method (a user's limit may have none) are not checked.
-    """
-    worst = NO_EXCESS
-    for limit in limits:
-        check = getattr(limit, "excess", None)
-        if check is None:
-            continue
-        found = check(start, state)
-        if found.ratio > worst.ratio or math.isnan(found.ratio):  # a NaN is the worst
-            worst = found
-            if math.isnan(found.ratio):
+@njit(cache=True)
+def worst_excess(values: Array, floor: Array, tolerance: Array, out: Array) -> int:
+    """``out = [floor − value, (floor − value)/tolerance]`` of the value of largest ratio
+    (``[−inf, −inf]`` if none); returns its index, or −1. A NaN is the worst (never kept)."""
+    best, best_v, best_r = -1, -math.inf, -math.inf
+    for i in range(values.shape[0]):
+        over = floor[i] - values[i]
+        ratio = over / tolerance[i]
+        if ratio > best_r or ratio != ratio:
+            best, best_v, best_r = i, over, ratio
+            if ratio != ratio:
                 break
-    return worst
+    out[0], out[1] = best_v, best_r
+    return best

@@ -3,17 +3,18 @@
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
+from numpy.typing import NDArray
 
-from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.kinematics.robot import Robot
-from dvqp.kinematics.state import KinematicState
-from dvqp.limits.bounds_kernels import joint_position_bounds, joint_room_values
-from dvqp.limits.excess import Excess
-from dvqp.limits.limit import Bounds
+from dvqp.limits.limit import Limit
+
+Array = NDArray[np.float64]
 
 
-class JointPositionLimit:
-    """``(q_min − q)/dt ≤ Q̇ ≤ (q_max − q)/dt`` (rad/s), from the robot's limits.
+class JointPositionLimit(Limit):
+    """``(q_min − q)/dt ≤ Q̇ ≤ (q_max − q)/dt`` (rad/s), from the robot's limits (compiled:
+    :func:`position_bounds`; verified exactly: :func:`joint_room`).
 
     Infinite limits give infinite bounds. A joint already past a limit (which the planner never
     produces from a valid start) may not move further out: its bound is clipped at 0.
@@ -32,32 +33,22 @@ class JointPositionLimit:
         self.q_min = robot.q_min
         self.q_max = robot.q_max
 
-    def compute(self, state: KinematicState, dt: float) -> Bounds:
-        """The box at ``state.q``, shape (n,) each."""
-        lb = np.minimum((self.q_min - state.q) / dt, 0.0)
-        ub = np.maximum((self.q_max - state.q) / dt, 0.0)
-        return Bounds(lb, ub)
 
-    def excess(self, start: KinematicState, state: KinematicState) -> Excess:
-        """How far ``state.q`` is past the limits (or past ``start.q`` if that was out)."""
-        upper = np.maximum(self.q_max, start.q)
-        lower = np.minimum(self.q_min, start.q)
-        over = np.maximum(state.q - upper, lower - state.q)
-        i = int(np.argmax(over))
-        bound = upper[i] if state.q[i] > upper[i] else lower[i]
-        label = f"joint{i + 1}" if over[i] > 0.0 else ""
-        return Excess(
-            float(over[i]), self.tolerance, label, "joint position", "rad", float(state.q[i]),
-            float(bound),
-        )  # fmt: skip
+@njit(cache=True)
+def position_bounds(q: Array, q_min: Array, q_max: Array, dt: float, lb: Array,
+                    ub: Array) -> None:  # fmt: skip
+    """``min((q_min − q)/dt, 0) ≤ Q̇ ≤ max((q_max − q)/dt, 0)``, intersected into ``lb``,
+    ``ub`` in place."""
+    for i in range(q.shape[0]):
+        lb[i] = max(lb[i], min((q_min[i] - q[i]) / dt, 0.0))
+        ub[i] = min(ub[i], max((q_max[i] - q[i]) / dt, 0.0))
 
-    def kernel(self, plan: StepPlan) -> Kernel:
-        """The box at ``plan.state.q``, intersected into ``plan.lb``, ``plan.ub``."""
-        args = (plan.state.q, self.q_min, self.q_max, plan.dt, plan.lb, plan.ub)
-        return Kernel(joint_position_bounds, args)
 
-    def verifier(self, plan: StepPlan) -> Kernel:
-        """``[q_max − q, q − q_min]``, rad, shape (2n,), safe value 0 (``inf`` where a joint
-        is unlimited: never the worst)."""
-        slot = plan.verified(self, 2 * plan.n, 0.0, self.tolerance)
-        return Kernel(joint_room_values, (plan.state.q, self.q_min, self.q_max, slot))
+@njit(cache=True)
+def joint_room(q: Array, q_min: Array, q_max: Array, values: Array, start: int) -> None:
+    """The verified values ``[q_max − q, q − q_min]`` (rad, 2n) at ``values[start:]``
+    (``inf`` on an unlimited side: never the worst)."""
+    n = q.shape[0]
+    for i in range(n):
+        values[start + i] = q_max[i] - q[i]
+        values[start + n + i] = q[i] - q_min[i]

@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
-from dvqp.compiled.plan import Kernel, StepPlan
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
 from dvqp.kinematics.robot import Robot
-from dvqp.kinematics.state import KinematicState
-from dvqp.limits.bounds_kernels import joint_velocity_bounds
-from dvqp.limits.limit import Bounds
+from dvqp.limits.limit import Limit
 
 
-class JointVelocityLimit:
-    """``−q̇_max ≤ Q̇ ≤ q̇_max`` (rad/s), from the robot's ``qd_max``, shape (n,).
+class JointVelocityLimit(Limit):
+    """``−q̇_max ≤ Q̇ ≤ q̇_max`` (rad/s), from the robot's ``qd_max``, shape (n,) (compiled:
+    :func:`velocity_bounds`).
 
     A bound of the QP held exactly by every accepted solution (the solution check recomputes
     it), so it needs no exact verification of the integrated motion.
@@ -21,10 +23,11 @@ class JointVelocityLimit:
     def __init__(self, robot: Robot) -> None:
         self.qd_max = robot.qd_max
 
-    def compute(self, state: KinematicState, dt: float) -> Bounds:
-        """The constant box (``state`` and ``dt`` are not used)."""
-        return Bounds(-self.qd_max, self.qd_max.copy())
 
-    def kernel(self, plan: StepPlan) -> Kernel:
-        """The constant box, intersected into ``plan.lb``, ``plan.ub``."""
-        return Kernel(joint_velocity_bounds, (self.qd_max, plan.lb, plan.ub))
+@njit(cache=True)
+def velocity_bounds(qd_max: NDArray[np.float64], lb: NDArray[np.float64],
+                    ub: NDArray[np.float64]) -> None:  # fmt: skip
+    """``−q̇_max ≤ Q̇ ≤ q̇_max``, intersected into ``lb``, ``ub`` in place."""
+    for i in range(qd_max.shape[0]):
+        lb[i] = max(lb[i], -qd_max[i])
+        ub[i] = min(ub[i], qd_max[i])

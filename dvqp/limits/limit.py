@@ -1,37 +1,22 @@
 """What a limit gives the QP: inequalities ``Constraint(G, h)`` or a ``Bounds`` box.
 
-A limit is any object with a ``name`` and ``compute(state, dt)`` returning one of the two (the
-:class:`Limit` protocol). :func:`dvqp.resolution.qp.build_qp` stacks the constraints in the
-order the limits are given and intersects the boxes.
-
-Compiled step. A limit may also provide ``kernel(plan)``, returning a
-:class:`~dvqp.compiled.plan.Kernel` built once for a :class:`~dvqp.compiled.plan.StepPlan`, or
-None when it adds nothing (a tilt limit with ``min_tilt = 0``, a damper without obstacles). It
-raises NotImplementedError when it cannot be compiled (a user's damper, an obstacle shape
-without a proximity kernel): the run then takes the reference path. A kernel of
-
-- a **box** intersects its bounds into ``plan.lb``, ``plan.ub`` in place (``lb = max(lb,
-  own)``, ``ub = min(ub, own)``); the engine resets them to ``∓inf`` before the step's bounds
-  kernels, which then leave the reference's intersected box;
-- **constraints** asks once for a fixed number of rows (``plan.constraint_rows(count)``) and
-  writes all of them at every step: the rows ``compute`` returns, in the same order, and every
-  row that ``compute`` would leave out at that state as ``G = 0``, ``h = +inf``.
-
-Kernels read the step ``dt`` from ``plan.dt[0]`` and the state from ``plan.state`` (obstacle
-dampers from ``plan.proximity(obstacles)``, self-collision from ``plan.self_pairs()``: the
-``plan.geometry`` kernels run before them), all bound once as views of the plan's buffers.
+dvqp's own limits are compiled (each module holds its kernels). A limit of your own derives
+from :class:`Limit` and implements :meth:`Limit.compute` in NumPy (pink's shape), or brings a
+compiled kernel (:meth:`Limit.kernel`); a distance kept above a safe value derives from
+:class:`~dvqp.limits.VelocityDamper` instead. A run calls a limit of your own after the compiled
+parts, on the same state, and writes its rows into the same QP.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.kinematics.state import KinematicState
+from dvqp.workspace import Kernel, StepPlan
 
 
 @dataclass(frozen=True)
@@ -42,10 +27,10 @@ class Constraint:
     ----------
     G : ndarray, shape (p, n)
     h : ndarray, shape (p,)
-        Usually m/s (a damper) or rad/s.
+        Usually m/s (a damper) or rad/s; ``+inf`` for a row that does not apply.
     describe : callable, optional
         Returns what each row holds, e.g. ``"point3/obstacle1"``; called only when
-        :attr:`labels` is read, so the per-step hot path formats no strings.
+        :attr:`labels` is read.
     """
 
     G: NDArray[np.float64]
@@ -65,25 +50,17 @@ class Constraint:
         return int(self.h.shape[0])
 
     @staticmethod
-    def empty(n: int) -> Constraint:
-        """No rows, for n variables."""
-        return Constraint(np.zeros((0, n)), np.zeros(0))
-
-    @staticmethod
     def stack(parts: Sequence[Constraint], n: int) -> Constraint:
-        """All rows of ``parts`` in order (an empty constraint if there are none)."""
+        """All rows of ``parts`` in order (no row if there are none)."""
         parts = [p for p in parts if p.rows]
         if not parts:
-            return Constraint.empty(n)
-        if len(parts) == 1:
-            return parts[0]
+            return Constraint(np.zeros((0, n)), np.zeros(0))
 
         def describe() -> tuple[str, ...]:
             return tuple(label for p in parts for label in p.labels)
 
-        return Constraint(
-            np.vstack([p.G for p in parts]), np.concatenate([p.h for p in parts]), describe
-        )
+        return Constraint(np.vstack([p.G for p in parts]), np.concatenate([p.h for p in parts]),
+                          describe)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -93,29 +70,39 @@ class Bounds:
     lb: NDArray[np.float64]
     ub: NDArray[np.float64]
 
-    def intersect(self, other: Bounds) -> Bounds:
-        """The tighter of two boxes."""
-        return Bounds(np.maximum(self.lb, other.lb), np.minimum(self.ub, other.ub))
 
-
-@runtime_checkable
-class Limit(Protocol):
+class Limit:
     """A hard limit of the QP step, linear in ``Q̇`` at the current state.
 
-    Implement ``name`` and :meth:`compute`; pass the object in ``StepSpec.limits`` (or
-    ``dvqp.plan(..., limits=[...])``). The pseudoinverse baseline ignores limits.
+    Pass it in ``StepSpec.limits`` (or ``dvqp.plan(..., limits=[...])``); the pseudoinverse
+    baseline ignores limits.
+
+    Attributes
+    ----------
+    name : str
+        A label for reports.
     """
 
-    name: str
+    name: str = "limit"
 
     def compute(self, state: KinematicState, dt: float) -> Constraint | Bounds:
-        """The limit's rows at ``state`` for a step of ``dt`` seconds.
+        """The limit's rows at ``state`` for a step of ``dt`` seconds (a limit of your own).
 
-        Parameters
-        ----------
-        state
-            Kinematics of this step (read-only).
-        dt
-            Step, s, > 0.
+        A :class:`Constraint` must have the same number of rows at every state of a run
+        (``h = +inf`` for a row that does not apply).
         """
-        ...
+        raise NotImplementedError(f"{type(self).__name__} has no compute(state, dt)")
+
+    def kernel(self, plan: StepPlan) -> Kernel | None:
+        """Optionally, the limit's rows as a compiled kernel: ask ``plan`` for rows once
+        (``G, h = plan.constraint_rows(p)``) and return a :class:`~dvqp.workspace.Kernel`
+        writing them from ``plan.state`` and ``plan.dt`` at every step (or intersecting its
+        box into ``plan.lb``, ``plan.ub``). None (the default): :meth:`compute` is used."""
+        return None
+
+    def observe(self, qdot: NDArray[np.float64], dt: float) -> None:
+        """The joint velocity (rad/s) applied over the step just taken (a limit that remembers
+        motion keeps it; the default forgets it)."""
+
+    def reset(self) -> None:
+        """A run starts (at rest): forget what was observed."""

@@ -9,71 +9,28 @@ closest points; exact). With ``n = (c_i − c_j)/d`` and the frames' linear Jaco
     ∂d/∂Q = nᵀ ((1 − s) J_{a_i} + s J_{b_i} − (1 − t) J_{a_j} − t J_{b_j})
 
 (the envelope theorem: moving the closest points along their segments does not change d to
-first order). One damper row per pair closer than ``margin + influence``.
-
-The compiled step computes the pairs' geometry once per state into the plan's pair buffers
-(:func:`pairs_kernel`, with the same in-place routine the reference path uses); the rows
-kernel (:meth:`SelfCollision.kernel`) reads them.
+first order). One damper row per pair, applying while closer than ``margin + influence``.
 """
 
 from __future__ import annotations
 
-import functools
-from collections.abc import Callable
+import math
 from typing import ClassVar
 
 import numpy as np
 from numba import njit
-from numpy.typing import NDArray
 
 from dvqp import _validate
-from dvqp.compiled.plan import Kernel, SelfPairBuffers, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.geometry.proximity import link_label
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
-from dvqp.limits.damper_kernels import copy_values
-from dvqp.limits.self_collision_kernels import pair_distances_into, self_rows
-
-Array = NDArray[np.float64]
-
-
-@functools.cache
-def link_pairs(k: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """Indices ``(i, j)`` of the non-adjacent pairs among the k guarded links (``j ≥ i + 2``)."""
-    i, j = np.triu_indices(k, 2)
-    return _validate.readonly(i.astype(np.int64)), _validate.readonly(j.astype(np.int64))
-
-
-@njit(cache=True)
-def pair_distances(o: Array, pi: NDArray[np.int64], pj: NDArray[np.int64]):  # type: ignore[no-untyped-def]
-    """Distance, unit normal ``c_i − c_j``, ``s`` and ``t`` of the link pairs ``(pi, pj)``
-    of the chain of points ``o``: segment ``o[pi] → o[pi+1]`` against ``o[pj] → o[pj+1]``.
-
-    Ericson's clamped closest points (*Real-Time Collision Detection*, 5.1.9), exact for
-    parallel and degenerate segments too; compiled (:func:`pair_distances_into`, which the
-    compiled step calls in place)."""
-    p = pi.shape[0]
-    dist, normal, ss, tt = np.empty(p), np.empty((p, 3)), np.empty(p), np.empty(p)
-    pair_distances_into(o, pi, pj, dist, normal, ss, tt)
-    return dist, normal, ss, tt
-
-
-def pairs_kernel(plan: StepPlan) -> tuple[SelfPairBuffers, Kernel]:
-    """The pair buffers of ``plan``'s k guarded links and the kernel that fills them in place
-    from ``plan.state.origins`` (once per state; see :meth:`StepPlan.self_pairs`)."""
-    i, j = link_pairs(plan.k)
-    p = i.shape[0]
-    pairs = SelfPairBuffers(i, j, np.zeros(p), np.zeros((p, 3)), np.zeros(p), np.zeros(p))
-    args = (plan.state.origins, i, j, pairs.distance, pairs.normal, pairs.s, pairs.t)
-    return pairs, Kernel(pair_distances_into, args)
-
-
-_CACHE_KEY = "self-collision pairs"
+from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
+from dvqp.workspace import PairBuffers, as_struct
 
 
 class SelfCollision(VelocityDamper):
-    """Keeps every pair of non-adjacent guarded links at least ``margin`` apart (3-D).
+    """Keeps every pair of non-adjacent guarded links at least ``margin`` apart (3-D;
+    compiled: :func:`pair_distances`, :func:`self_distances`).
 
     Parameters
     ----------
@@ -84,6 +41,8 @@ class SelfCollision(VelocityDamper):
         m, > 0: pairs farther than ``margin + influence`` add no row.
     gain
         ``γ`` in (0, 1].
+    deceleration
+        ``a``, m/s².
     """
 
     name = "self"
@@ -105,68 +64,86 @@ class SelfCollision(VelocityDamper):
         if not np.isfinite(self.margin):
             raise ParameterError("margin", "must be finite")
 
-    @staticmethod
-    def _geometry(state: KinematicState) -> tuple[Array, Array, Array, Array, Array]:
-        """Per pair: distance, unit normal, s, t, and the pair indices (once per state)."""
-        found = state.cache.get(_CACHE_KEY)
-        if found is not None:
-            return found  # type: ignore[no-any-return]
-        o = np.ascontiguousarray(state.origins)  # (k+1, 3): the body points, then the tool
-        i, j = link_pairs(state.k)
-        dist, normal, s, t = pair_distances(o, i, j)
-        found = (dist, normal, s, t, np.stack([i, j]))
-        state.cache[_CACHE_KEY] = found
-        return found
+    @property
+    def safe(self) -> float:
+        """``margin``, m."""
+        return self.margin
 
-    def distances(self, state: KinematicState) -> Distances:
-        """Distances (m) of the pairs within ``margin + influence`` and their gradients."""
-        dist, normal, s, t, (i, j) = self._geometry(state)
-        near = np.flatnonzero(dist < self.margin + self.influence)
-        jv = state.frame_jacobians[:, :3, :]  # (k+1, 3, n)
-        sn, tn = s[near, None, None], t[near, None, None]
-        ii, jj = i[near], j[near]
-        moving = (1 - sn) * jv[ii] + sn * jv[ii + 1] - (1 - tn) * jv[jj] - tn * jv[jj + 1]
-        gradient = (normal[near, :, None] * moving).sum(axis=1)
-        return Distances(dist[near], gradient, self.margin, _labels(ii, jj, state.k))
+    @property
+    def reach(self) -> float:  # type: ignore[override]
+        """``margin + influence``, m."""
+        return self.margin + self.influence
 
-    def all_distances(self, state: KinematicState) -> Distances:
-        """Every non-adjacent pair's distance, m (no gradients), for verification."""
-        dist, _, _, _, (i, j) = self._geometry(state)
-        return Distances(dist, None, self.margin, _labels(i, j, state.k))
-
-    def kernel(self, plan: StepPlan) -> Kernel | None:
-        """One row per non-adjacent pair (``link_pairs(k)`` order), from the plan's pair
-        buffers (:meth:`StepPlan.self_pairs`, run before it); None with no pair."""
-        pairs = plan.self_pairs()
-        if pairs.i.shape[0] == 0:
-            return None
-        G, h = plan.constraint_rows(pairs.i.shape[0])
-        reach = self.margin + self.influence
-        return Kernel(self_rows, (pairs.i, pairs.j, pairs.distance, pairs.normal, pairs.s,
-                                  pairs.t, plan.state.frame_jacobians, reach,
-                                  self.params(self.margin), plan.dt, G, h))  # fmt: skip
-
-    def verifier(self, plan: StepPlan) -> Kernel | None:
-        """Every pair's distance, m (safe value ``margin``); None with no pair."""
-        pairs = plan.self_pairs()
-        count = pairs.i.shape[0]
-        if count == 0:
-            return None
-        slot = plan.verified(self, count, self.margin, self.tolerance)
-        return Kernel(copy_values, (pairs.distance, slot))
+    def labels(self, k: int) -> tuple[str, ...]:
+        """The pairs' names, e.g. ``"link1/link3"``, ``"link2/holder"``."""
+        i, j = np.triu_indices(k, 2)
+        return tuple(f"{link_label(a, k)}/{link_label(b, k)}" for a, b in zip(i, j, strict=True))
 
 
-def _labels(i: NDArray[np.int64], j: NDArray[np.int64], k: int) -> Callable[[], tuple[str, ...]]:
-    """The pairs' names, e.g. ``"link1/link3"``, ``"link2/holder"``, computed when asked."""
-    return lambda: tuple(
-        f"{link_label(a, k)}/{link_label(b, k)}" for a, b in zip(i, j, strict=True)
-    )
+@njit(cache=True)
+def pair_distances(o, pairs) -> None:  # type: ignore[no-untyped-def]
+    """Distance, unit normal ``c_i − c_j``, ``s`` and ``t`` of the link pairs of the chain of
+    points ``o`` (k+1, 3) into ``pairs`` (a packed PairBuffers): segment ``o[i] → o[i+1]``
+    against ``o[j] → o[j+1]``. Ericson's clamped closest points (*Real-Time Collision
+    Detection*, 5.1.9), exact for parallel and degenerate segments too."""
+    eps = 1e-18
+    for m in range(pairs.i.shape[0]):
+        a, b, c, d = o[pairs.i[m]], o[pairs.i[m] + 1], o[pairs.j[m]], o[pairs.j[m] + 1]
+        d1x, d1y, d1z = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+        d2x, d2y, d2z = d[0] - c[0], d[1] - c[1], d[2] - c[2]
+        rx, ry, rz = a[0] - c[0], a[1] - c[1], a[2] - c[2]
+        aa = d1x * d1x + d1y * d1y + d1z * d1z
+        e = d2x * d2x + d2y * d2y + d2z * d2z
+        f = d2x * rx + d2y * ry + d2z * rz
+        if aa <= eps and e <= eps:
+            s, t = 0.0, 0.0
+        elif aa <= eps:
+            s, t = 0.0, min(max(f / e, 0.0), 1.0)
+        else:
+            cc = d1x * rx + d1y * ry + d1z * rz
+            if e <= eps:
+                s, t = min(max(-cc / aa, 0.0), 1.0), 0.0
+            else:
+                bb = d1x * d2x + d1y * d2y + d1z * d2z
+                denom = aa * e - bb * bb
+                s = min(max((bb * f - cc * e) / denom, 0.0), 1.0) if denom > eps * aa * e else 0.0
+                t = (bb * s + f) / e
+                if t < 0.0:
+                    s, t = min(max(-cc / aa, 0.0), 1.0), 0.0
+                elif t > 1.0:
+                    s, t = min(max((bb - cc) / aa, 0.0), 1.0), 1.0
+        x = (a[0] + s * d1x) - (c[0] + t * d2x)
+        y = (a[1] + s * d1y) - (c[1] + t * d2y)
+        z = (a[2] + s * d1z) - (c[2] + t * d2z)
+        dist = math.sqrt(x * x + y * y + z * z)
+        scale = max(dist, 1e-15)
+        pairs.distance[m], pairs.s[m], pairs.t[m] = dist, s, t
+        pairs.normal[m, 0], pairs.normal[m, 1], pairs.normal[m, 2] = x / scale, y / scale, z / scale
+
+
+@njit(cache=True)
+def self_distances(pairs, jac, start, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
+    """Every pair's distance (m) and ``∂d/∂Q`` (see the module docstring) from row ``start``
+    (``jac`` the frames' (k+1, 6, n) Jacobians)."""
+    for m in range(pairs.i.shape[0]):
+        i, j, sm, tm, r = pairs.i[m], pairs.j[m], pairs.s[m], pairs.t[m], start + m
+        distance[r], usable[r] = pairs.distance[m], True
+        for c in range(gradient.shape[1]):
+            grad = 0.0
+            for x in range(3):
+                moving = (1 - sm) * jac[i, x, c] + sm * jac[i + 1, x, c]
+                moving = moving - (1 - tm) * jac[j, x, c] - tm * jac[j + 1, x, c]
+                grad += pairs.normal[m, x] * moving
+            gradient[r, c] = grad
 
 
 def self_distance(state: KinematicState) -> tuple[float, str]:
-    """The smallest distance (m) between non-adjacent guarded links, and the pair's name."""
-    dist, _, _, _, (i, j) = SelfCollision._geometry(state)
-    if dist.shape[0] == 0:
-        return float("inf"), ""
-    m = int(np.argmin(dist))
-    return float(dist[m]), f"{link_label(int(i[m]), state.k)}/{link_label(int(j[m]), state.k)}"
+    """The smallest distance (m) between non-adjacent guarded links of ``state``, and the
+    pair's name (``inf`` and ``""`` without such pairs)."""
+    pairs = PairBuffers.allocate(state.k)
+    if pairs.i.shape[0] == 0:
+        return math.inf, ""
+    pair_distances(np.array(state.origins), as_struct(pairs))
+    m = int(np.argmin(pairs.distance))
+    names = f"{link_label(int(pairs.i[m]), state.k)}/{link_label(int(pairs.j[m]), state.k)}"
+    return float(pairs.distance[m]), names

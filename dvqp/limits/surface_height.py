@@ -5,16 +5,15 @@ from __future__ import annotations
 from typing import ClassVar
 
 import numpy as np
+from numba import njit
 
-from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.errors import ParameterError
-from dvqp.kinematics.state import KinematicState
-from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper
-from dvqp.limits.damper_kernels import height_rows, height_values
+from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
 
 
 class SurfaceHeight(VelocityDamper):
-    """``h_i ≥ h_min`` for every body point, as a damper row each (labels ``"point3/height"``).
+    """``h_i ≥ h_min`` for every body point, as a damper row each (labels ``"point3/height"``;
+    compiled: :func:`height_distances`).
 
     Parameters
     ----------
@@ -22,6 +21,8 @@ class SurfaceHeight(VelocityDamper):
         ``h_min``, m (finite).
     gain
         ``γ`` in (0, 1].
+    deceleration
+        ``a``, m/s².
     """
 
     name = "height"
@@ -42,24 +43,22 @@ class SurfaceHeight(VelocityDamper):
             raise ParameterError("min_height", "must be finite")
         self.min_height = float(min_height)
 
-    def distances(self, state: KinematicState) -> Distances:
-        """The body points' heights h (m) and ``∂h/∂Q``, safe value ``h_min``."""
-        k = state.points.shape[0]
-        return Distances(
-            state.points[:, 2],
-            state.point_jacobians[:, 2, :],
-            self.min_height,
-            lambda: tuple(f"point{i + 1}/height" for i in range(k)),
-        )
+    @property
+    def safe(self) -> float:
+        """``h_min``, m."""
+        return self.min_height
 
-    def kernel(self, plan: StepPlan) -> Kernel:
-        """k rows, one per body point (all always apply), from ``plan.state``."""
-        G, h = plan.constraint_rows(plan.k)
-        s = plan.state
-        params = self.params(self.min_height)
-        return Kernel(height_rows, (s.guarded, s.guarded_jacobians, 0, params, plan.dt, G, h))
+    def labels(self, k: int) -> tuple[str, ...]:
+        """``"point1/height"``, ... one per body point."""
+        return tuple(f"point{i + 1}/height" for i in range(k))
 
-    def verifier(self, plan: StepPlan) -> Kernel:
-        """The k body points' heights, m (safe value ``h_min``)."""
-        slot = plan.verified(self, plan.k, self.min_height, self.tolerance)
-        return Kernel(height_values, (plan.state.guarded, 0, slot))
+
+@njit(cache=True)
+def height_distances(guarded, jacobians, first, count, start, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
+    """Heights ``h`` (m) and ``∂h/∂Q`` of the guarded points ``first .. first + count − 1``
+    (``guarded`` (k+1, 3), ``jacobians`` (k+1, 3, n)), from row ``start``."""
+    for m in range(count):
+        p, r = first + m, start + m
+        distance[r], usable[r] = guarded[p, 2], True
+        for c in range(gradient.shape[1]):
+            gradient[r, c] = jacobians[p, 2, c]

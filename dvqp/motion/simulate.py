@@ -2,47 +2,56 @@
 
 ``simulate`` integrates ``q_{k+1} = q_k + dt·Q̇_k`` (explicit Euler, as the paper's JOG), where
 ``Q̇_k`` is the resolver's answer to the command ``ẋ_k``, optionally with position feedback
-toward a DV reference: ``ẋ = ẋ_d + K·(x_d − x)`` with l and α differences wrapped.
+toward a DV reference: ``ẋ = ẋ_d + K·(x_d − x)`` with l and α differences wrapped. Every step
+is the compiled step (:class:`~dvqp.step.Stepper`), verified exactly
+(:func:`~dvqp.step.advance`).
 """
 
 from __future__ import annotations
 
 import contextlib
 import threading
+import time
 from collections.abc import Callable, Iterator
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
-from dvqp.compiled.engine import compile_step
-from dvqp.compiled.run import run_compiled
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry.obstacle import ObstacleSet
+from dvqp.kinematics.developed_view import wrap, wrap_angle
 from dvqp.kinematics.robot import Robot
-from dvqp.kinematics.state import KinematicState
-from dvqp.motion.advance import MAX_HALVINGS
 from dvqp.motion.recorder import TrajectoryRecorder
-from dvqp.motion.run import Run, dv_error, run_reference
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.step import Resolver
-
-ENGINES = ("auto", "compiled", "reference")
-"""How :func:`simulate` steps: see its ``engine`` parameter."""
+from dvqp.step import MAX_HALVINGS, Stepper, advance
 
 COMPILE_NOTICE_SECONDS = 1.0
 """s: compiling the step for longer than this is announced through ``notice``."""
-COMPILE_NOTICE = "compiling the step (first run; cached after)"
+COMPILE_NOTICE = "compiling the step: the first run only, about half a minute (cached after)"
 
-__all__ = ["COMPILE_NOTICE", "ENGINES", "dv_error", "simulate"]
+__all__ = ["COMPILE_NOTICE", "dv_error", "simulate"]
+
+
+def dv_error(
+    reference: NDArray[np.float64], actual: NDArray[np.float64], radius: float
+) -> NDArray[np.float64]:
+    """``x_d − x`` of DV coordinates (…, 4) with l wrapped modulo 2πR and α modulo 2π."""
+    e = np.asarray(reference, dtype=float) - np.asarray(actual, dtype=float)
+    e[..., 0] = wrap(e[..., 0], radius)
+    e[..., 3] = wrap_angle(e[..., 3])
+    return e
 
 
 @contextlib.contextmanager
 def _noticed(notice: Callable[[str], None] | None) -> Iterator[None]:
-    """Call ``notice`` if the block still runs after :data:`COMPILE_NOTICE_SECONDS`."""
+    """Call ``notice`` if the block still runs after :data:`COMPILE_NOTICE_SECONDS`, and once
+    more when it ends, with how long it took."""
     if notice is None:
         yield
         return
+    started = time.perf_counter()
     timer = threading.Timer(COMPILE_NOTICE_SECONDS, notice, (COMPILE_NOTICE,))
     timer.daemon = True
     timer.start()
@@ -50,6 +59,8 @@ def _noticed(notice: Callable[[str], None] | None) -> Iterator[None]:
         yield
     finally:
         timer.cancel()
+        if timer.finished.is_set() and time.perf_counter() - started > COMPILE_NOTICE_SECONDS:
+            notice(f"compiled the step in {time.perf_counter() - started:.0f} s")
 
 
 def _check_commands(
@@ -82,7 +93,6 @@ def simulate(
     verify: bool | None = None,
     max_halvings: int = MAX_HALVINGS,
     progress: Callable[[int, int], None] | None = None,
-    engine: str = "auto",
     notice: Callable[[str], None] | None = None,
 ) -> Trajectory:
     """Run the commands from ``q0`` and return the trajectory.
@@ -105,20 +115,16 @@ def simulate(
         ``K`` (1/s) of the feedback, >= 0.
     verify
         Check every limit of the resolver's spec exactly after each step, splitting or failing
-        steps that break one (:func:`dvqp.motion.advance.advance`). Default: if the resolver
-        holds limits (the QP); the baseline's excess is measured and recorded only.
+        steps that break one (:func:`dvqp.step.advance`). Default: if the resolver holds
+        limits (the QP); the baseline's excess is measured and recorded only.
     max_halvings
         Most times a step is halved to keep the limits.
     progress
         Called as ``progress(k, N)`` after each step.
-    engine
-        ``"auto"``: the compiled step (:mod:`dvqp.compiled`) when every part of the run has a
-        kernel, else the reference path; ``"compiled"`` (raise if it cannot be compiled) or
-        ``"reference"`` (Pinocchio and NumPy, the path the compiled one is tested against).
     notice
         Called with one line (e.g. for a progress bar) if compiling the step takes longer than
-        :data:`COMPILE_NOTICE_SECONDS`: the first run of a composition of tasks, terms, limits
-        and shapes compiles it; later runs load it from the cache.
+        :data:`COMPILE_NOTICE_SECONDS` (the first run after installing dvqp compiles it; later
+        runs load it from numba's cache), and once more when compiling is done.
 
     Notes
     -----
@@ -130,28 +136,26 @@ def simulate(
     gain = _validate.positive("feedback_gain", feedback_gain, strict=False)
     radius = _validate.positive("pipe_radius", pipe_radius)
     cmd, ref = _check_commands(commands, reference)
-    obstacles = ObstacleSet() if obstacles is None else obstacles
-    check = getattr(resolver, "holds_limits", True) if verify is None else verify
-    if engine not in ENGINES:
-        raise ParameterError("engine", f"must be one of {', '.join(ENGINES)}, got {engine!r}")
+    check = resolver.holds_limits if verify is None else verify
     q_start = robot.check_q(q0, "q0")
-    KinematicState.compute(robot, q_start, radius)  # a singular start raises here
-    resolver.reset()
-    for limit in resolver.spec.limits:  # limits that remember motion start at rest
-        reset = getattr(limit, "reset", None)
-        if reset is not None:
-            reset()
-    record = TrajectoryRecorder(cmd.shape[0], robot.n, robot.n_points, obstacles)
-    run = Run(robot, radius, resolver, q_start, cmd, ref, gain, dt, check, max_halvings, record,
-              progress)  # fmt: skip
-    compiled = None
-    if engine != "reference":
-        with _noticed(notice):
-            compiled = compile_step(robot, radius, resolver, obstacles, check, record.arrays)
-    if compiled is None and engine == "compiled":
-        raise ParameterError("engine", "a part of this run has no compiled kernel")
-    if compiled is None:
-        run_reference(run)
-    else:
-        run_compiled(compiled, run)
-    return record.trajectory(dt, radius, getattr(resolver, "name", type(resolver).__name__))
+    record = TrajectoryRecorder(cmd.shape[0], robot.n, robot.n_points)
+    with _noticed(notice):
+        stepper = Stepper(robot, radius, resolver, q_start, dt, obstacles, record.arrays)
+        stepper.start(q_start)
+        if cmd.shape[0]:  # compile (or load) the step's every call now, then start afresh
+            stepper.resolve(cmd[0], dt)
+            stepper.record_at[0] = 0
+            stepper.start(q_start)
+    feedback = ref is not None and gain > 0.0
+    started = time.perf_counter()
+    for i in range(cmd.shape[0]):
+        xdot = cmd[i]
+        if feedback:
+            xdot = xdot + gain * dv_error(ref[i], stepper.state.tool, radius)  # type: ignore[index]
+        moved = advance(stepper, xdot, dt, verify=check, max_halvings=max_halvings, record=i + 1)
+        now = time.perf_counter()
+        record.step(i, moved, now - started)
+        started = now
+        if progress is not None:
+            progress(i + 1, cmd.shape[0])
+    return record.trajectory(dt, radius, resolver.name)

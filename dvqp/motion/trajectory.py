@@ -34,7 +34,7 @@ ARRAYS = (
 """The arrays every trajectory file holds."""
 
 DIAGNOSTICS = ("probe_clearance", "tilt", "self_distance", "limit_excess", "limits_kept",
-               "substeps", "qddot", "solver_time", "compiled")  # fmt: skip
+               "substeps", "qddot", "solver_time")  # fmt: skip
 """Arrays added in dvqp 0.2; files written before hold none of them (loaded as empty)."""
 
 CONVENTIONS = {
@@ -110,10 +110,6 @@ class Trajectory:
     solver_time : ndarray, shape (N,)
         Of ``solve_time``, the time spent in the QP backend's calls (the baseline: its linear
         algebra), s.
-    compiled : ndarray of bool, shape (N,)
-        The step was taken by the compiled path (:mod:`dvqp.compiled`); False where the
-        reference path took it (a relaxed or braking step, a split or large step, a run whose
-        parts are not all compiled).
     qddot : ndarray, shape (N, n)
         Joint acceleration at the start of each step, ``(qdot[k] − qdot[k−1]) / dt`` with the
         run starting at rest, rad/s².
@@ -144,7 +140,6 @@ class Trajectory:
     self_distance: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     qddot: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 0)))
     solver_time: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
-    compiled: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
 
     @classmethod
     def from_samples(

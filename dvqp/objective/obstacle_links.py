@@ -1,23 +1,21 @@
-"""Repulsion of the links from the obstacle circles (paper eq. 13–15)."""
+"""Repulsion of the links from the obstacles (paper eq. 13–15)."""
 
 from __future__ import annotations
 
-import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike
 
-from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.geometry.obstacle import ObstacleSet
-from dvqp.geometry.proximity import proximity
-from dvqp.kinematics.state import KinematicState
-from dvqp.objective import term_kernels
-from dvqp.objective.term import Term, per_point, point_gains
+from dvqp.objective.term import Array, ObjectiveTerm, point_gains, pull_points
 
 
-class ObstacleLinks:
-    """``Σ_j ³w_j = Σ_j Σ_i ½ w_j k̂_i e_ij`` over the links ``[p_i, p_{i+1}]``.
+class ObstacleLinks(ObjectiveTerm):
+    """``Σ_j ³w_j = Σ_j Σ_i ½ w_j k̂_i e_ij`` over the body links ``[p_i, p_{i+1}]``
+    (compiled: :func:`obstacle_links`).
 
     ``e_ij`` is obstacle j's penalty at the closest point of link i (a circle:
-    ``D_ij² − R_j²``); ``k̂_i = k¹_i`` where that point is interior and inside, else 0.
+    ``D_ij² − R_j²``); ``k̂_i = k¹_i`` where that point is interior and inside, else 0. The
+    probe holder (the last guarded link) is left to the dampers.
 
     Parameters
     ----------
@@ -33,38 +31,35 @@ class ObstacleLinks:
         self.obstacles = ObstacleSet.of(obstacles)
         self.k_obstacle = point_gains("k_obstacle", k_obstacle)
 
-    def evaluate(self, state: KinematicState) -> Term:
-        """Value and ``Σ w k̂ ½ ∇eᵀ ((1−t) ∂p_i + t ∂p_{i+1})`` (the ∂t term vanishes)."""
-        obstacles = self.obstacles
-        if not len(obstacles):
-            return Term(0.0, np.zeros(state.n))
-        near = proximity(state, obstacles).links
-        k = state.k  # the body links; the holder (last guarded link) is left to the dampers
-        t = near.t[:, : k - 1]
-        excess = near.penalty[:, : k - 1]  # (J, k-1): e at the closest point
-        active = (excess < 0.0) & (t > 0.0) & (t < 1.0)
-        if not active.any():
-            return Term(0.0, np.zeros(state.n))
-        k1 = per_point("k_obstacle", self.k_obstacle, k)
-        coef = obstacles.weights[:, None] * k1[None, :-1] * active
-        value = 0.5 * float(np.sum(coef * excess))
-        a = coef[..., None] * (-0.5 * near.penalty_gradient[:, : k - 1])  # (J, k-1, 2)
-        at_points = np.zeros((k, 2))
-        at_points[:-1] += (a * (1.0 - t)[..., None]).sum(axis=0)
-        at_points[1:] += (a * t[..., None]).sum(axis=0)
-        grad = -np.einsum("kc,kcn->n", at_points, state.point_jacobians[:, :2, :])
-        return Term(value, grad)
 
-    def kernel(self, plan: StepPlan) -> Kernel | None:
-        """The compiled term (:func:`~dvqp.objective.term_kernels.obstacle_links`), reading
-        the plan's proximity buffers; None if a shape of the set has no kernel."""
-        near = plan.proximity(self.obstacles)
-        if near is None:
-            return None
-        k1 = np.array(per_point("k_obstacle", self.k_obstacle, plan.k), dtype=np.float64)
-        weights = np.array(self.obstacles.weights, dtype=np.float64)
-        args = (near.link_penalty, near.link_penalty_gradient, near.link_t, weights, k1,
-                plan.state.guarded_jacobians, np.zeros((plan.k, 2)))  # fmt: skip
-        return Kernel(
-            term_kernels.obstacle_links, (*args, plan.objective_value, plan.objective_gradient)
-        )
+@njit(cache=True)
+def obstacle_links(
+    penalty: Array,
+    penalty_gradient: Array,
+    link_t: Array,
+    coef: Array,
+    jacobians: Array,
+    at_points: Array,
+    value: Array,
+    gradient: Array,
+) -> None:
+    """Add ``Σ_j Σ_i ½ c_ji e_ji`` over the body links whose closest point is interior
+    (``0 < t < 1``) and inside obstacle j to ``value``, the gradient shared by the link's ends
+    as ``(1 − t, t)`` (the ∂t term vanishes). ``penalty``, ``link_t`` (J, k) and
+    ``penalty_gradient`` (J, k, 2) are the guarded links'; ``coef`` (J, k − 1) is
+    ``w_j k¹_i``; ``at_points`` (k, 2) is scratch."""
+    at_points[:, :] = 0.0
+    total = 0.0
+    for j in range(coef.shape[0]):
+        for i in range(coef.shape[1]):
+            e, t, c = penalty[j, i], link_t[j, i], coef[j, i]
+            if e < 0.0 and t > 0.0 and t < 1.0 and c != 0.0:
+                total += c * e
+                al = c * (-0.5 * penalty_gradient[j, i, 0])
+                az = c * (-0.5 * penalty_gradient[j, i, 1])
+                at_points[i, 0] += al * (1.0 - t)
+                at_points[i, 1] += az * (1.0 - t)
+                at_points[i + 1, 0] += al * t
+                at_points[i + 1, 1] += az * t
+    value[0] += 0.5 * total
+    pull_points(at_points, jacobians, gradient)

@@ -1,20 +1,17 @@
-"""Repulsion of the body points from the obstacle circles (paper eq. 12)."""
+"""Repulsion of the body points from the obstacles (paper eq. 12)."""
 
 from __future__ import annotations
 
-import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike
 
-from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.geometry.obstacle import ObstacleSet
-from dvqp.geometry.proximity import proximity
-from dvqp.kinematics.state import KinematicState
-from dvqp.objective import term_kernels
-from dvqp.objective.term import Term, per_point, point_gains
+from dvqp.objective.term import Array, ObjectiveTerm, point_gains, pull_points
 
 
-class ObstaclePoints:
-    """``Σ_j ²w_j = Σ_j Σ_i ½ w_j k̂_i e_ij``, ``k̂_i = k¹_i`` inside obstacle j, else 0.
+class ObstaclePoints(ObjectiveTerm):
+    """``Σ_j ²w_j = Σ_j Σ_i ½ w_j k̂_i e_ij``, ``k̂_i = k¹_i`` inside obstacle j, else 0
+    (compiled: :func:`obstacle_points`).
 
     ``e`` is the shape's penalty (:mod:`dvqp.geometry.shapes.shape`): ``‖S_j − p_i‖² − R_j²``
     for a circle, as in the paper.
@@ -33,35 +30,23 @@ class ObstaclePoints:
         self.obstacles = ObstacleSet.of(obstacles)
         self.k_obstacle = point_gains("k_obstacle", k_obstacle)
 
-    def evaluate(self, state: KinematicState) -> Term:
-        """Value and ``Σ w k̂ ½ ∇eᵀ ∂p/∂Q`` (point Jacobian rows l, z); a circle:
-        ``−Σ w k̂ (S − p)ᵀ ∂p/∂Q``."""
-        obstacles = self.obstacles
-        if not len(obstacles):
-            return Term(0.0, np.zeros(state.n))
-        near = proximity(state, obstacles).points
-        k = state.k  # the body points; the probe (last guarded point) is the task's
-        excess = near.penalty[:, :k]  # (J, k): e, negative inside (a circle: ‖S − p‖² − R²)
-        inside = excess < 0.0
-        if not inside.any():
-            return Term(0.0, np.zeros(state.n))
-        k1 = per_point("k_obstacle", self.k_obstacle, k)
-        coef = obstacles.weights[:, None] * k1[None, :] * inside
-        value = 0.5 * float(np.sum(coef * excess))
-        v = (coef[..., None] * (-0.5 * near.penalty_gradient[:, :k])).sum(axis=0)  # (k, 2)
-        grad = -np.einsum("kc,kcn->n", v, state.point_jacobians[:, :2, :])
-        return Term(value, grad)
 
-    def kernel(self, plan: StepPlan) -> Kernel | None:
-        """The compiled term (:func:`~dvqp.objective.term_kernels.obstacle_points`), reading
-        the plan's proximity buffers; None if a shape of the set has no kernel."""
-        near = plan.proximity(self.obstacles)
-        if near is None:
-            return None
-        k1 = np.array(per_point("k_obstacle", self.k_obstacle, plan.k), dtype=np.float64)
-        weights = np.array(self.obstacles.weights, dtype=np.float64)
-        args = (near.point_penalty, near.point_penalty_gradient, weights, k1,
-                plan.state.guarded_jacobians, np.zeros((plan.k, 2)))  # fmt: skip
-        return Kernel(
-            term_kernels.obstacle_points, (*args, plan.objective_value, plan.objective_gradient)
-        )
+@njit(cache=True)
+def obstacle_points(penalty: Array, penalty_gradient: Array, coef: Array, jacobians: Array,
+                    at_points: Array, value: Array, gradient: Array) -> None:  # fmt: skip
+    """Add ``Σ_j Σ_i ½ c_ji e_ji`` over the body points inside obstacle j (``e < 0``) to
+    ``value`` and ``Σ ½ c ∇eᵀ ∂p/∂Q`` to ``gradient``. ``penalty`` (J, k+1) and
+    ``penalty_gradient`` (J, k+1, 2) are the guarded points'; ``coef`` (J, k) is
+    ``w_j k¹_i`` (0 for an obstacle the term does not see); ``at_points`` (k, 2) is scratch."""
+    k = coef.shape[1]
+    at_points[:, :] = 0.0
+    total = 0.0
+    for j in range(coef.shape[0]):
+        for i in range(k):
+            e, c = penalty[j, i], coef[j, i]
+            if e < 0.0 and c != 0.0:
+                total += c * e
+                at_points[i, 0] += c * (-0.5 * penalty_gradient[j, i, 0])
+                at_points[i, 1] += c * (-0.5 * penalty_gradient[j, i, 1])
+    value[0] += 0.5 * total
+    pull_points(at_points, jacobians, gradient)

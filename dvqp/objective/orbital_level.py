@@ -3,17 +3,15 @@
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike
 
-from dvqp.compiled.plan import Kernel, StepPlan
 from dvqp.errors import ParameterError
-from dvqp.kinematics.state import KinematicState
-from dvqp.objective import term_kernels
-from dvqp.objective.term import Term, per_point, point_gains
+from dvqp.objective.term import Array, ObjectiveTerm, point_gains
 
 
-class OrbitalLevel:
-    """``¹w = −Σ_i ½ k²_i (h_i − h*)²``.
+class OrbitalLevel(ObjectiveTerm):
+    """``¹w = −Σ_i ½ k²_i (h_i − h*)²`` (compiled: :func:`orbital_level`).
 
     Parameters
     ----------
@@ -31,20 +29,18 @@ class OrbitalLevel:
         self.level = float(level)
         self.k_height = point_gains("k_height", k_height)
 
-    def evaluate(self, state: KinematicState) -> Term:
-        """Value and ``−Σ_i k²_i (h_i − h*) ∂h_i/∂Q``."""
-        dh = state.points[:, 2] - self.level
-        kh = per_point("k_height", self.k_height, dh.shape[0])
-        value = -0.5 * float(kh @ (dh * dh))
-        grad = -(kh * dh) @ state.point_jacobians[:, 2, :]
-        return Term(value, grad)
 
-    def kernel(self, plan: StepPlan) -> Kernel:
-        """The compiled term (:func:`~dvqp.objective.term_kernels.orbital_level`): adds its
-        value and gradient to ``plan.objective_value`` and ``plan.objective_gradient``."""
-        kh = np.array(per_point("k_height", self.k_height, plan.k), dtype=np.float64)
-        s = plan.state
-        args = (s.guarded, s.guarded_jacobians, self.level, kh)
-        return Kernel(
-            term_kernels.orbital_level, (*args, plan.objective_value, plan.objective_gradient)
-        )
+@njit(cache=True)
+def orbital_level(guarded: Array, jacobians: Array, level: float, k_height: Array,
+                  value: Array, gradient: Array) -> None:  # fmt: skip
+    """Add ``−Σ_i ½ k²_i (h_i − h*)²`` to ``value`` (1,) and ``−Σ_i k²_i (h_i − h*) ∂h_i/∂Q``
+    to ``gradient`` (n,), over the k body points (``k_height`` (k,), 1/m²; ``level`` h*, m;
+    ``guarded`` (k+1, 3) and ``jacobians`` (k+1, 3, n) the guarded points')."""
+    total = 0.0
+    for i in range(k_height.shape[0]):
+        dh = guarded[i, 2] - level
+        total += k_height[i] * (dh * dh)
+        c = k_height[i] * dh
+        for col in range(gradient.shape[0]):
+            gradient[col] -= c * jacobians[i, 2, col]
+    value[0] += -0.5 * total

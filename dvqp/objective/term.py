@@ -1,16 +1,26 @@
-"""One term of the objective ``w(Q)``: its value and gradient at a state."""
+"""One term of the objective ``w(Q)``: what every term is, and what the compiled ones share.
+
+dvqp's own terms (:class:`~dvqp.objective.OrbitalLevel`, :class:`~dvqp.objective.ObstaclePoints`,
+:class:`~dvqp.objective.ObstacleLinks`) are compiled: each module holds its kernel, which ADDS
+the term's value and ``∂w/∂Q`` to the step's (zeroed once per state). A term of your own derives
+from :class:`ObjectiveTerm` and implements :meth:`ObjectiveTerm.evaluate` in NumPy: a run
+adds it after the compiled terms, on the same state.
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.kinematics.state import KinematicState
+from dvqp.workspace import Kernel, StepPlan
+
+Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -21,29 +31,30 @@ class Term:
     gradient: NDArray[np.float64]
 
 
-@runtime_checkable
-class ObjectiveTerm(Protocol):
+class ObjectiveTerm:
     """A term of ``w(Q)``, which the resolution step maximises in the task's null space.
 
-    Implement ``name`` and :meth:`evaluate`; :class:`~dvqp.objective.Objective` adds the
-    terms up.
-
-    Optionally, for the compiled step, a term may also have ``kernel(plan) ->
-    Kernel | None`` (not a member of this protocol): a :class:`~dvqp.compiled.plan.Kernel`
-    that ADDS the term's value and gradient to ``plan.objective_value`` (1,) and
-    ``plan.objective_gradient`` (n,) at the state in ``plan.state``, with the same math as
-    :meth:`evaluate`. A term without it (or returning None) makes the run take the reference
-    (uncompiled) path.
+    Attributes
+    ----------
+    name : str
+        A label for reports.
     """
 
-    name: str
+    name: str = "term"
 
     def evaluate(self, state: KinematicState) -> Term:
-        """Value and gradient ``∂w/∂Q`` (shape (n,)) of the term at ``state``."""
-        ...
+        """Value and gradient ``∂w/∂Q`` (shape (n,)) of the term at ``state``: implement it for
+        a term of your own (dvqp's terms are compiled and read through the step)."""
+        raise NotImplementedError(f"{type(self).__name__} has no evaluate(state)")
+
+    def kernel(self, plan: StepPlan) -> Kernel | None:
+        """Optionally, the term as a compiled kernel ADDING its value and gradient to
+        ``plan.objective_value`` (1,) and ``plan.objective_gradient`` (n,) at ``plan.state``.
+        None (the default): :meth:`evaluate` is used."""
+        return None
 
 
-def point_gains(name: str, value: ArrayLike) -> NDArray[np.float64]:
+def point_gains(name: str, value: ArrayLike) -> Array:
     """A per-body-point gain: a scalar or a vector (one per point), finite and >= 0."""
     arr = np.asarray(value, dtype=np.float64)
     if arr.ndim > 1:
@@ -55,10 +66,22 @@ def point_gains(name: str, value: ArrayLike) -> NDArray[np.float64]:
     return _validate.readonly(arr.copy())
 
 
-def per_point(name: str, gains: NDArray[np.float64], k: int) -> NDArray[np.float64]:
+def per_point(name: str, gains: Array, k: int) -> Array:
     """``gains`` for k body points, shape (k,) (a scalar is repeated)."""
     if gains.ndim == 0:
         return np.full(k, float(gains))
     if gains.shape[0] != k:
         raise ShapeError(name, (k,), gains.shape)
-    return gains
+    return np.array(gains)
+
+
+@njit(cache=True, inline="always")
+def pull_points(at_points: Array, jacobians: Array, gradient: Array) -> None:
+    """``gradient −= Σ_i at_points[i] · ∂[l, z]_i/∂Q`` over the k body points
+    (``at_points`` (k, 2), ``jacobians`` the guarded points' (k+1, 3, n))."""
+    for i in range(at_points.shape[0]):
+        al, az = at_points[i, 0], at_points[i, 1]
+        if al == 0.0 and az == 0.0:
+            continue
+        for col in range(gradient.shape[0]):
+            gradient[col] -= al * jacobians[i, 0, col] + az * jacobians[i, 1, col]

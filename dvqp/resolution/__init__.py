@@ -1,8 +1,7 @@
-"""Redundancy resolution: the step's spec, the QP built from it, and the resolvers."""
+"""Redundancy resolution: the step's spec, the resolvers and the registry of their names."""
 
 from dvqp.resolution.pinv import PseudoinverseResolver
-from dvqp.resolution.qp import StepQP, StepTerms, build_qp, limit_rows, step_terms
-from dvqp.resolution.qp_resolver import QPResolver
+from dvqp.resolution.qp import QPResolver
 from dvqp.resolution.registry import available_resolvers, make_resolver
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver, Step
@@ -12,12 +11,7 @@ __all__ = [
     "QPResolver",
     "Resolver",
     "Step",
-    "StepQP",
     "StepSpec",
-    "StepTerms",
     "available_resolvers",
-    "build_qp",
-    "limit_rows",
     "make_resolver",
-    "step_terms",
 ]

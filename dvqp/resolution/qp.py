@@ -1,4 +1,4 @@
-"""The per-step QP, assembled by pure functions so every backend gets the identical problem.
+"""The per-step QP and its resolver: strict, else relaxed, else braking, on any backend.
 
 Decision variable ``x = Q̇`` (rad/s), or ``x = [Q̇; s]`` when the hard tasks are relaxed by a
 slack ``s`` (task units per s)::
@@ -9,171 +9,139 @@ slack ``s`` (task units per s)::
                 lb ≤ Q̇ ≤ ub                                  the limits' bounds
 
 ``H, c`` are the soft tasks' costs (none in the paper). With no active inequality the KKT
-conditions are exactly the weighted pseudoinverse step (:mod:`dvqp.resolution.pinv`), which
-is built from the same :func:`step_terms`.
+conditions are exactly the weighted pseudoinverse step (:mod:`dvqp.resolution.pinv`). The
+step writes the problem's arrays in place (:class:`~dvqp.workspace.QPBuffers`); every backend
+gets the identical problem, set up once (``solvers.Problem.trusted`` over those arrays) and then
+only updated. When the strict problem has no accepted answer (the tasks and the limits
+conflict, or the answer does not pass the residual check), the relaxed one is solved: the step
+keeps every limit and reports its task error (``"relaxed"``). If that fails too (the limits
+conflict among themselves), the step brakes: the velocity closest to rest within the joint
+bounds (``"braking"``), which the exact check of the integrated motion then accepts, splits or
+fails.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp.kinematics.state import KinematicState
-from dvqp.limits.limit import Bounds, Constraint
+import solvers
+from dvqp.errors import BackendError
 from dvqp.resolution.spec import StepSpec
-from solvers import Problem
+from dvqp.resolution.step import Resolver
+from dvqp.workspace import QPBuffers
 
 
-@dataclass(frozen=True)
-class StepTerms:
-    """The unconstrained part of a step: metric, cost and hard-task equality.
+def make_backend(name: str) -> solvers.Backend:
+    """A fresh QP backend by name (see :func:`solvers.available_backends`).
 
-    Attributes
-    ----------
-    weights : ndarray, shape (n,)
-        Diagonal of ``W``.
-    soft_hessian : ndarray, shape (n, n), or None
-        ``H`` of the soft tasks (None without soft tasks).
-    gradient : ndarray, shape (n,)
-        ``g − c``: what the step follows (``g = λ ∂w/∂Q``, ``c`` from the soft tasks).
-    A : ndarray, shape (m, n)
-        Stacked Jacobians of the hard tasks.
-    b : ndarray, shape (m,)
-        Their wanted velocities.
+    Raises
+    ------
+    BackendError
+        Unknown or not installed; the message lists the installed backends.
     """
-
-    weights: NDArray[np.float64]
-    soft_hessian: NDArray[np.float64] | None
-    gradient: NDArray[np.float64]
-    A: NDArray[np.float64]
-    b: NDArray[np.float64]
-
-    def task_error(self, qdot: NDArray[np.float64]) -> float:
-        """``‖A Q̇ − b‖∞`` of the hard tasks."""
-        return float(np.abs(self.A @ qdot - self.b).max())
+    try:
+        return solvers.make_backend(name)
+    except solvers.SolverError as exc:
+        raise BackendError(str(exc)) from exc
 
 
-@dataclass(frozen=True)
-class StepQP:
-    """The QP of one step and what its rows mean.
-
-    Attributes
-    ----------
-    problem : solvers.Problem
-        The QP handed to a backend.
-    terms : StepTerms
-        Its unconstrained part.
-    inequalities : Constraint
-        The rows of ``problem.G`` over ``Q̇`` (their labels say what each holds).
-    bounds : Bounds
-        The box on ``Q̇``, rad/s.
-    relaxed : bool
-        The hard tasks carry a slack (the last m variables).
-    """
-
-    problem: Problem
-    terms: StepTerms
-    inequalities: Constraint
-    bounds: Bounds
-    relaxed: bool
-
-    @property
-    def labels(self) -> tuple[str, ...]:
-        """One label per inequality row, e.g. ``"link2/obstacle1"``."""
-        return self.inequalities.labels
-
-
-def step_terms(
-    spec: StepSpec, state: KinematicState, command: NDArray[np.float64], dt: float
-) -> StepTerms:
-    """Evaluate the tasks and the objective of ``spec`` at ``state`` (pure)."""
-    n = state.n
-    hard_rows, hessian, gradient = [], None, spec.objective.scaled_gradient(state)
-    for task in spec.tasks:
-        rows = task.compute(state, command, dt)
-        if task.hard:
-            hard_rows.append(rows)
-            continue
-        h, c = rows.objective()
-        hessian = h if hessian is None else hessian + h
-        gradient = gradient - c
-    if len(hard_rows) == 1:
-        A, b = hard_rows[0].jacobian, hard_rows[0].velocity
-    else:
-        A = np.vstack([r.jacobian for r in hard_rows])
-        b = np.concatenate([r.velocity for r in hard_rows])
-    return StepTerms(spec.diagonal(n), hessian, gradient, A, b)
-
-
-def limit_rows(spec: StepSpec, state: KinematicState, dt: float) -> tuple[Constraint, Bounds]:
-    """The limits of ``spec`` at ``state``: stacked constraints and intersected bounds."""
-    n = state.n
-    parts: list[Constraint] = []
-    box = Bounds(np.full(n, -np.inf), np.full(n, np.inf))
-    first_box = True
-    for limit in spec.limits:
-        rows = limit.compute(state, dt)
-        if isinstance(rows, Bounds):
-            box = rows if first_box else box.intersect(rows)
-            first_box = False
-        else:
-            parts.append(rows)
-    return Constraint.stack(parts, n), box
-
-
-def build_qp(
-    spec: StepSpec,
-    state: KinematicState,
-    command: NDArray[np.float64],
-    dt: float,
-    *,
-    relax: bool = False,
-    parts: tuple[StepTerms, Constraint, Bounds] | None = None,
-) -> StepQP:
-    """Assemble the QP of one step (pure: no solver involved).
+class QPResolver(Resolver):
+    """Resolves each step with a QP on a :mod:`solvers` backend.
 
     Parameters
     ----------
     spec
-        Tasks, objective, limits, weights.
-    state
-        Kinematics of this step.
-    command
-        The operator's tool DV velocity, shape (4,).
-    dt
-        Step, s.
-    relax
-        Add the slack ``s`` on the hard tasks.
-    parts
-        The terms, inequalities and bounds of this state if already computed (e.g. by the
-        strict problem of the same step), so a relaxed retry does not evaluate them again.
+        Tasks, objective, limits and weights of the run.
+    backend
+        Backend name, e.g. ``"daqp"``, ``"osqp"``, ``"qpsolvers:quadprog"``, or a zero-argument
+        callable returning a fresh :class:`solvers.Backend` (a run makes two: the strict and the
+        relaxed problem keep their own warm starts).
     """
-    if parts is None:
-        parts = (step_terms(spec, state, command, dt), *limit_rows(spec, state, dt))
-    terms, ineq, box = parts
-    P = spec.hessian(state.n)
-    if terms.soft_hessian is not None:
-        P = P + terms.soft_hessian
-    G, h = (ineq.G, ineq.h) if ineq.rows else (None, None)
-    if not relax:
-        problem = Problem(P=P, q=-terms.gradient, A=terms.A, b=terms.b, G=G, h=h,
-                          lb=box.lb, ub=box.ub)  # fmt: skip
-        return StepQP(problem, terms, ineq, box, relaxed=False)
-    m = terms.A.shape[0]
-    inf = np.full(m, np.inf)
-    P_relaxed = np.zeros((state.n + m, state.n + m))
-    P_relaxed[: state.n, : state.n] = P
-    P_relaxed[state.n :, state.n :] = np.diag(np.full(m, spec.task_weight))
-    problem = Problem(
-        P=P_relaxed,
-        q=np.concatenate([-terms.gradient, np.zeros(m)]),
-        A=np.hstack([terms.A, -np.eye(m)]),
-        b=terms.b,
-        G=np.hstack([G, np.zeros((ineq.rows, m))]) if G is not None else None,
-        h=h,
-        lb=np.concatenate([box.lb, -inf]),
-        ub=np.concatenate([box.ub, inf]),
-    )
-    return StepQP(problem, terms, ineq, box, relaxed=True)
+
+    holds_limits = True
+
+    def __init__(self, spec: StepSpec, backend: str | Callable[[], solvers.Backend]) -> None:
+        super().__init__(spec)
+        factory = (lambda: make_backend(backend)) if isinstance(backend, str) else backend
+        self.factory: Callable[[], solvers.Backend] = factory
+        self.name = backend if isinstance(backend, str) else factory().name
+        if isinstance(backend, str):
+            factory()  # an unknown name fails here, not in the first step
+
+
+@dataclass
+class Answer:
+    """A QP solve: ``x`` (rad/s, None when even braking is impossible), the status
+    (``"optimal"``, ``"relaxed"``, ``"braking"``, or why it failed), the backend's iterations
+    and the time inside its calls (s)."""
+
+    x: NDArray[np.float64] | None
+    status: str
+    iterations: int | None
+    solver_time: float
+
+
+class QPSolver:
+    """The step's QP over the plan's arrays, on two backends (strict and relaxed).
+
+    Parameters
+    ----------
+    factory
+        Makes a backend.
+    qp
+        The problem's arrays, rewritten in place every step.
+    task_weight
+        ``ρ`` of the relaxed problem's slack.
+    """
+
+    def __init__(self, factory: Callable[[], solvers.Backend], qp: QPBuffers,
+                 task_weight: float) -> None:  # fmt: skip
+        self.qp = qp
+        n, m, p = qp.cost.shape[0], qp.b.shape[0], qp.h.shape[0]
+        G, h = (qp.G, qp.h) if p else (None, None)
+        self.strict = solvers.Problem.trusted(qp.P, qp.cost, qp.A, qp.b, G, h, qp.lb, qp.ub)
+        P_r = np.zeros((n + m, n + m))
+        P_r[n:, n:] = np.diag(np.full(m, task_weight))
+        A_r = np.zeros((m, n + m))
+        A_r[:, n:] = -np.eye(m)
+        G_r = np.zeros((p, n + m)) if p else None
+        inf = np.full(m, np.inf)
+        self.relaxed = solvers.Problem.trusted(
+            P_r, np.zeros(n + m), A_r, qp.b, G_r, h, np.concatenate([qp.lb, -inf]),
+            np.concatenate([qp.ub, inf]),
+        )  # fmt: skip
+        self.backends = factory(), factory()
+
+    def solve(self) -> Answer:
+        """Strict, else relaxed, else braking (``x`` a view, valid until the next solve)."""
+        strict, relaxed = self.backends
+        solution = strict.solve(self.strict)
+        spent, status = solution.solver_time, "optimal"
+        if not solution.found:
+            self._load_relaxed()
+            solution = relaxed.solve(self.relaxed)
+            spent, status = spent + solution.solver_time, "relaxed"
+        if solution.found and solution.x is not None:
+            return Answer(solution.x[: self.qp.cost.shape[0]], status, solution.iterations, spent)
+        qp = self.qp
+        if np.any(qp.lb > qp.ub):
+            return Answer(None, f"failed: {solution.message}", solution.iterations, spent)
+        return Answer(np.clip(0.0, qp.lb, qp.ub), "braking", solution.iterations, spent)
+
+    def _load_relaxed(self) -> None:
+        """Copy the strict problem's data into the relaxed one's ``Q̇`` columns."""
+        qp, r = self.qp, self.relaxed
+        n = qp.cost.shape[0]
+        r.P[:n, :n], r.q[:n], r.A[:, :n] = qp.P, qp.cost, qp.A
+        r.lb[:n], r.ub[:n] = qp.lb, qp.ub
+        if r.G is not None:
+            r.G[:, :n] = qp.G
+
+    def reset(self) -> None:
+        """Forget the backends' warm starts."""
+        for backend in self.backends:
+            backend.reset()

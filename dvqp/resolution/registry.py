@@ -10,9 +10,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import solvers
+from dvqp._versions import __version__
 from dvqp.errors import BackendError
 from dvqp.resolution.pinv import PseudoinverseResolver
-from dvqp.resolution.qp_resolver import QPResolver
+from dvqp.resolution.qp import QPResolver
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 
@@ -57,8 +58,6 @@ def default_resolvers() -> list[str]:
 
 def describe_resolvers() -> list[ResolverInfo]:
     """One :class:`ResolverInfo` per name of :func:`available_resolvers`, in that order."""
-    from dvqp import __version__
-
     infos = [ResolverInfo(PINV, "dvqp", __version__, "pseudoinverse baseline, paper eq. 18")]
     for b in solvers.describe_backends():
         infos.append(ResolverInfo(b.name, b.distribution, b.version, b.note))

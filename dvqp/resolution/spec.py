@@ -10,7 +10,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
-from dvqp.limits.limit import Limit
+from dvqp.limits import AccelerationLimit, Limit
 from dvqp.objective.objective import Objective
 from dvqp.tasks.task import Task
 
@@ -30,7 +30,7 @@ class StepSpec:
     objective
         ``w(Q)``, followed as ``g = λ ∂w/∂Q`` in the hard tasks' null space.
     limits
-        Hard limits of the QP (ignored by the baseline), in row order.
+        Hard limits of the QP (ignored by the baseline); at most one acceleration limit.
     weights
         Diagonal of ``W`` (> 0), scalar or shape (n,).
     task_weight
@@ -42,20 +42,16 @@ class StepSpec:
     limits: tuple[Limit, ...] = ()
     weights: ArrayLike = 1.0
     task_weight: float = DEFAULT_TASK_WEIGHT
-    _diagonals: dict[int, NDArray[np.float64]] = field(
-        default_factory=dict, init=False, repr=False, compare=False
-    )
-    _hessians: dict[int, NDArray[np.float64]] = field(
-        default_factory=dict, init=False, repr=False, compare=False
-    )
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "tasks", tuple(self.tasks))
         object.__setattr__(self, "limits", tuple(self.limits))
-        if not any(getattr(t, "hard", False) for t in self.tasks):
+        _check_kind("tasks", self.tasks, Task)
+        _check_kind("limits", self.limits, Limit)
+        if not any(t.hard for t in self.tasks):
             raise ParameterError("tasks", "need at least one hard task (e.g. ToolTask())")
-        _check_methods("tasks", self.tasks, "compute")
-        _check_methods("limits", self.limits, "compute")
+        if sum(isinstance(limit, AccelerationLimit) for limit in self.limits) > 1:
+            raise ParameterError("limits", "at most one AccelerationLimit in a step")
         w = np.asarray(self.weights, dtype=np.float64)
         if w.ndim > 1:
             raise ShapeError("weights", (-1,), w.shape)
@@ -66,30 +62,16 @@ class StepSpec:
         object.__setattr__(self, "task_weight", tw)
 
     def diagonal(self, n: int) -> NDArray[np.float64]:
-        """The diagonal of ``W`` for n joints, shape (n,) (read-only, built once)."""
-        found = self._diagonals.get(n)
-        if found is None:
-            found = _validate.readonly(_validate.broadcast("weights", self.weights, n))
-            self._diagonals[n] = found
-        return found
-
-    def hessian(self, n: int) -> NDArray[np.float64]:
-        """``W = diag(weights)`` for n joints, shape (n, n) (read-only, built once)."""
-        found = self._hessians.get(n)
-        if found is None:
-            found = _validate.readonly(np.diag(self.diagonal(n)))
-            self._hessians[n] = found
-        return found
+        """The diagonal of ``W`` for n joints, shape (n,)."""
+        return _validate.broadcast("weights", self.weights, n)
 
     def with_extra(self, tasks: Sequence[Task] = (), limits: Sequence[Limit] = ()) -> StepSpec:
         """A copy with more tasks and limits appended."""
-        return StepSpec(
-            (*self.tasks, *tasks), self.objective, (*self.limits, *limits), self.weights,
-            self.task_weight,
-        )  # fmt: skip
+        return StepSpec((*self.tasks, *tasks), self.objective, (*self.limits, *limits),
+                        self.weights, self.task_weight)  # fmt: skip
 
 
-def _check_methods(name: str, items: Sequence[object], method: str) -> None:
+def _check_kind(name: str, items: Sequence[object], kind: type) -> None:
     for i, item in enumerate(items):
-        if not callable(getattr(item, method, None)) or not hasattr(item, "name"):
-            raise ParameterError(f"{name}[{i}]", f"needs a name and a {method}(state, ...) method")
+        if not isinstance(item, kind):
+            raise ParameterError(f"{name}[{i}]", f"must be a dvqp.{kind.__name__} (derive from it)")

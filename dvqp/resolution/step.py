@@ -1,24 +1,21 @@
-"""The interface every redundancy resolver implements, and the result of one step."""
+"""What every resolver is, and the result of one step."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Protocol
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
-from dvqp.kinematics.state import KinematicState
 from dvqp.resolution.spec import StepSpec
 
 COMMAND_SIZE = 4
 """Length of the operator's command ``[l̇, ż, ḣ, α̇]``."""
 
 
-@dataclass(frozen=True)
-class Step:
-    """The joint velocity chosen for one step and how it was obtained.
+class Step(NamedTuple):
+    """The joint velocity chosen for one step and how it was obtained (immutable).
 
     Attributes
     ----------
@@ -27,9 +24,9 @@ class Step:
     success : bool
         The step satisfies every hard limit of the resolver (checked, not the solver's word).
     status : str
-        ``"optimal"``, ``"relaxed"`` (task slack used), or the failure reason.
+        ``"optimal"``, ``"relaxed"`` (task slack used), ``"braking"``, or the failure reason.
     task_error : float
-        ``‖A·Q̇ − b‖∞`` of the hard tasks (m/s or rad/s).
+        ``‖A·Q̇ − b‖∞`` of the hard tasks (m/s or rad/s; ``inf`` for a failed step).
     solve_time : float
         Wall time of the resolution (QP assembly + solve + check, or the pseudoinverse), s.
     iterations : int or None
@@ -59,29 +56,21 @@ def check_command(command: ArrayLike) -> NDArray[np.float64]:
     return _validate.vector("command", command, COMMAND_SIZE)
 
 
-class Resolver(Protocol):
-    """Chooses ``Q̇`` for the tasks of a :class:`StepSpec`, following ``λ∇w`` in the rest."""
+class Resolver:
+    """Chooses ``Q̇`` for the tasks of a :class:`StepSpec`, following ``λ∇w`` in the rest.
 
-    name: str
-    spec: StepSpec
-    holds_limits: bool
-    """True if the resolver keeps ``spec.limits`` (then runs are verified against them)."""
+    Attributes
+    ----------
+    name : str
+        Its registry name (``"pinv"``, ``"daqp"``, ...).
+    spec : StepSpec
+        What a step is made of.
+    holds_limits : bool
+        True if it keeps ``spec.limits`` (then runs are verified against them).
+    """
 
-    def resolve(self, state: KinematicState, command: ArrayLike, dt: float) -> Step:
-        """One step.
+    name: str = "resolver"
+    holds_limits: bool = True
 
-        Parameters
-        ----------
-        state
-            Kinematics at the current configuration.
-        command
-            The operator's tool DV velocity ``[l̇, ż, ḣ, α̇]`` (m/s, m/s, m/s, rad/s),
-            shape (4,).
-        dt
-            Step length, s (used by position limits and dampers).
-        """
-        ...
-
-    def reset(self) -> None:
-        """Forget any state carried between steps (warm starts)."""
-        ...
+    def __init__(self, spec: StepSpec) -> None:
+        self.spec = spec

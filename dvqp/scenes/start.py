@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 
 from dvqp.errors import DvqpError
 from dvqp.geometry.obstacle import ObstacleSet
+from dvqp.geometry.proximity import distances
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
 from dvqp.scenes.fields import Fields, join
@@ -35,9 +36,9 @@ def check_start(
         if h < 0.0:
             part = "the tool" if i == robot.n_points else f"body point {i + 1}"
             f.fail("robot.q0", f"{part} (frame {frame!r}) starts inside the pipe: h = {h:.4g} m")
-    period = 2.0 * np.pi * radius
+    inside, _ = distances(obstacles, tool[None, :2], 2.0 * np.pi * radius)
     for i, o in enumerate(obstacles):
-        d = float(o.point_distance(tool[None, :2], period)[0][0])
+        d = float(inside[i, 0])
         if d < 0.0:
             f.fail(
                 join("obstacles", i),

@@ -3,19 +3,20 @@
 A hard task is an equality of the QP; when the equality conflicts with the limits, the
 relaxed problem gives it a slack with the large weight ``ρ`` and the step reports its task
 error. A soft task adds ``½ Σ_i w_i (J_i Q̇ − v_i)²`` to the QP's cost, as pink's tasks do.
-Any object with ``name``, ``hard`` and :meth:`Task.compute` is a task.
+dvqp's own task (:class:`~dvqp.tasks.ToolTask`) is compiled; a task of your own derives from
+:class:`Task` and implements :meth:`Task.compute` in NumPy.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.kinematics.state import KinematicState
+from dvqp.workspace import Kernel, StepPlan
 
 
 @dataclass(frozen=True)
@@ -50,8 +51,7 @@ class TaskRows:
         return weighted @ self.jacobian, -(weighted @ self.velocity)
 
 
-@runtime_checkable
-class Task(Protocol):
+class Task:
     """What the joint velocities should do this step.
 
     Attributes
@@ -60,21 +60,13 @@ class Task(Protocol):
         A label for reports.
     hard : bool
         True: an equality (relaxed only if it conflicts with the limits); False: a cost.
-
-    Notes
-    -----
-    Optionally, for the compiled step, a task may also have ``kernel(plan) -> Kernel`` (not a
-    member of this protocol): it asks for its rows once (``A, b = plan.task_rows(m)``) and
-    returns a :class:`~dvqp.compiled.plan.Kernel` that writes ``J`` into ``A`` and ``v``
-    into ``b`` each step, from ``plan.state``, ``plan.command`` and ``plan.dt``. A task
-    without it makes the run take the reference (uncompiled) path.
     """
 
-    name: str
-    hard: bool
+    name: str = "task"
+    hard: bool = True
 
     def compute(self, state: KinematicState, command: NDArray[np.float64], dt: float) -> TaskRows:
-        """The task's rows at ``state``.
+        """The task's rows at ``state``: implement it for a task of your own.
 
         Parameters
         ----------
@@ -86,4 +78,12 @@ class Task(Protocol):
         dt
             Step, s.
         """
-        ...
+        raise NotImplementedError(f"{type(self).__name__} has no compute(state, command, dt)")
+
+    def kernel(self, plan: StepPlan) -> Kernel | None:
+        """Optionally, a hard task's rows as a compiled kernel (a soft task's cost is always
+        its :meth:`compute`'s): ask ``plan`` for rows once
+        (``A, b = plan.task_rows(m)``) and return a :class:`~dvqp.workspace.Kernel` writing
+        ``J`` and ``v`` from ``plan.state``, ``plan.command`` and ``plan.dt`` at every step.
+        None (the default): :meth:`compute` is used."""
+        return None

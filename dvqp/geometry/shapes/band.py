@@ -2,19 +2,18 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
-from numpy.typing import NDArray
+from numba import njit
 
 from dvqp import _validate
-from dvqp.compiled.plan import Kernel, ProximityBuffers, StepPlan
 from dvqp.errors import ParameterError
-from dvqp.geometry.shapes import band_kernels
 from dvqp.geometry.shapes.shape import Array, Shape
-from dvqp.geometry.shapes.shape_kernels import proximity_outputs
+
+_FLAT = 1e-15
+"""m: a link whose ends differ less in z is parallel to the band."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -39,7 +38,6 @@ class Band(Shape):
         "z": ("interval", None),
         "weight": ("weight", 1.0),
     }
-    """Scene keys -> (kind of value, default); kinds: point, length, interval, points, weight."""
 
     def __post_init__(self) -> None:
         lo, hi = float(self.z_min), float(self.z_max)
@@ -70,44 +68,31 @@ class Band(Shape):
         """``[[nan, z_min], [nan, z_max]]``: a band has edges, not a closed outline."""
         return np.array([[np.nan, self.z_min], [np.nan, self.z_max]])
 
-    def point_distance(self, lz: Array, period: float) -> tuple[Array, Array]:
-        """``max(z_min − z, z − z_max)`` and ``(0, ∓1)``."""
-        z = np.asarray(lz, dtype=np.float64)[:, 1]
-        below, above = self.z_min - z, z - self.z_max
-        d = np.maximum(below, above)
-        normal = np.zeros((z.shape[0], 2))
-        normal[:, 1] = np.where(below >= above, -1.0, 1.0)
-        return d, normal
 
-    def segment_distance(self, a: Array, b: Array, period: float) -> tuple[Array, Array, Array]:
-        """The distance is convex and piecewise linear along a segment: its minimum is at an
-        end or where the segment crosses the band's middle line (there it is ``−width/2`` and
-        has no gradient: the normal returned is 0)."""
-        za, zb = np.asarray(a)[:, 1], np.asarray(b)[:, 1]
-        mid = 0.5 * (self.z_min + self.z_max)
-        dz = zb - za
-        crossing = np.where(np.abs(dz) > 1e-15, (mid - za) / np.where(dz == 0, 1.0, dz), 0.0)
-        candidates = np.stack([np.zeros_like(za), np.ones_like(za), crossing.clip(0.0, 1.0)])
-        z = za[None] + candidates * dz[None]  # (3, m)
-        values = np.maximum(self.z_min - z, z - self.z_max)
-        k = np.argmin(values, axis=0)
-        cols = np.arange(za.shape[0])
-        t = candidates[k, cols]
-        zt = za + t * dz
-        d, n = self.point_distance(np.column_stack([np.zeros_like(zt), zt]), period)
-        # crossing the middle line the distance is −width/2 whatever the ends do: no gradient
-        n[(k == 2) & (t > 0.0) & (t < 1.0)] = 0.0
-        return d, t, n
+@njit(cache=True)
+def band_point(z_min: float, z_max: float, z: float) -> tuple[float, float]:
+    """``max(z_min − z, z − z_max)`` (m) and ``∂d/∂z`` (∓1)."""
+    below, above = z_min - z, z - z_max
+    return max(below, above), -1.0 if below >= above else 1.0
 
-    @classmethod
-    def kernel(
-        cls, shapes: Sequence[Shape], indices: NDArray[np.int64], plan: StepPlan,
-        buffers: ProximityBuffers,
-    ) -> Kernel:  # fmt: skip
-        """:func:`~dvqp.geometry.shapes.band_kernels.bands`, the edges packed once."""
-        bands = [s for s in shapes if isinstance(s, Band)]
-        z_min = np.array([b.z_min for b in bands], dtype=np.float64)
-        z_max = np.array([b.z_max for b in bands], dtype=np.float64)
-        sizes = np.array([b.size for b in bands], dtype=np.float64)
-        args = (plan.state.guarded, plan.period, z_min, z_max, sizes, indices)
-        return Kernel(band_kernels.bands, (*args, *proximity_outputs(buffers)))
+
+@njit(cache=True)
+def band_segment(z_min: float, z_max: float, za: float, zb: float) -> tuple[float, float, float]:
+    """``(d, t, ∂d/∂z)`` of a segment from z ``za`` to ``zb``. The distance is convex and
+    piecewise linear along it: its minimum is at an end or where the segment crosses the band's
+    middle line (there it is ``−width/2`` and has no gradient: 0)."""
+    dz = zb - za
+    crossing = (0.5 * (z_min + z_max) - za) / dz if abs(dz) > _FLAT else 0.0
+    crossing = min(max(crossing, 0.0), 1.0)
+    best_k, best_t = 0, 0.0
+    best = max(z_min - za, za - z_max)
+    for k in range(1, 3):
+        t = 1.0 if k == 1 else crossing
+        z = za + t * dz
+        value = max(z_min - z, z - z_max)
+        if value < best:
+            best, best_k, best_t = value, k, t
+    d, nz = band_point(z_min, z_max, za + best_t * dz)
+    if best_k == 2 and 0.0 < best_t < 1.0:
+        nz = 0.0
+    return d, best_t, nz

@@ -2,20 +2,22 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 from dvqp import _validate
-from dvqp.compiled.plan import Kernel, ProximityBuffers, StepPlan
-from dvqp.geometry.shapes import circle_kernels
-from dvqp.geometry.shapes.shape import Array, Shape, ShapeDistances, wrap_l
-from dvqp.geometry.shapes.shape_kernels import proximity_outputs
+from dvqp.geometry.shapes.shape import Array, Shape
+from dvqp.kinematics.developed_view import wrap_period
 
 _TINY = 1e-12
+"""m: a point closer than this to the centre has no normal (0)."""
+_MIN_LENGTH2 = 1e-18
+"""m²: a shorter link is a point (t = 0)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,7 +43,6 @@ class Circle(Shape):
         "radius": ("length", None),
         "weight": ("weight", 1.0),
     }
-    """Scene keys -> (kind of value, default); kinds: point, length, interval, points, weight."""
 
     def __post_init__(self) -> None:
         center = _validate.readonly(_validate.vector("center", self.center, 2))
@@ -69,69 +70,29 @@ class Circle(Shape):
         a = np.linspace(0.0, 2.0 * np.pi, 129)
         return self.center + self.radius * np.column_stack([np.cos(a), np.sin(a)])
 
-    def point_distance(self, lz: Array, period: float) -> tuple[Array, Array]:
-        """``‖S − p‖ − R`` and ``−(S − p)/‖S − p‖`` (0 at the centre)."""
-        d = Circle.batch_points([self], lz, period)
-        return d.distance[0], d.normal[0]
 
-    def segment_distance(self, a: Array, b: Array, period: float) -> tuple[Array, Array, Array]:
-        """Closest point of each segment to the centre, in closed form."""
-        d = Circle.batch_segments([self], a, b, period)
-        return d.distance[0], d.t[0], d.normal[0]
-
-    @classmethod
-    def batch_points(cls, shapes: Sequence[Shape], lz: Array, period: float) -> ShapeDistances:
-        """All circles at once: offsets ``S_j − p_i`` (J, m, 2), penalty ``‖S − p‖² − R²``."""
-        centers, radii = _pack(shapes)
-        s = _offsets(lz, centers, period)
-        dist = np.sqrt((s * s).sum(axis=-1))
-        return _distances(s, dist, radii, np.zeros_like(dist))
-
-    @classmethod
-    def batch_segments(
-        cls, shapes: Sequence[Shape], a: Array, b: Array, period: float
-    ) -> ShapeDistances:
-        """Closest point ``p̄ = a + t (b − a)``, ``t = clip((S − a)·(b − a)/‖b − a‖², 0, 1)``."""
-        centers, radii = _pack(shapes)
-        seg = np.asarray(b, dtype=np.float64) - np.asarray(a, dtype=np.float64)
-        seg[:, 0] = wrap_l(seg[:, 0], period)
-        length2 = np.maximum((seg * seg).sum(axis=-1), 1e-18)  # a zero-length link gives t = 0
-        s_start = _offsets(a, centers, period)
-        t = ((s_start * seg).sum(axis=-1) / length2).clip(0.0, 1.0)
-        r = s_start - t[..., None] * seg
-        return _distances(r, np.sqrt((r * r).sum(axis=-1)), radii, t)
-
-    @classmethod
-    def kernel(
-        cls, shapes: Sequence[Shape], indices: NDArray[np.int64], plan: StepPlan,
-        buffers: ProximityBuffers,
-    ) -> Kernel:  # fmt: skip
-        """:func:`~dvqp.geometry.shapes.circle_kernels.circles`, centres and radii packed once."""
-        centers, radii = _pack(shapes)
-        args = (plan.state.guarded, plan.period, centers, radii, indices)
-        return Kernel(circle_kernels.circles, (*args, *proximity_outputs(buffers)))
+@njit(cache=True, inline="always")
+def _from_offset(sl: float, sz: float, radius: float) -> tuple[float, float, float]:
+    """``‖s‖ − R`` and the normal ``−s/‖s‖`` (0 at the centre) from the offset ``s = S − p``."""
+    dist = math.sqrt(sl * sl + sz * sz)
+    if dist > _TINY:
+        return dist - radius, -(sl / dist), -(sz / dist)
+    return dist - radius, 0.0, 0.0
 
 
-def _pack(shapes: Sequence[Shape]) -> tuple[Array, Array]:
-    circles = [s for s in shapes if isinstance(s, Circle)]
-    return np.array([c.center for c in circles]), np.array([c.radius for c in circles])
+@njit(cache=True)
+def circle_point(cl, cz, radius, pl, pz, period):  # type: ignore[no-untyped-def]
+    """``(d, ∂d/∂l, ∂d/∂z)`` of the point ``(pl, pz)`` to the circle at ``(cl, cz)``, m."""
+    return _from_offset(wrap_period(cl - pl, period), cz - pz, radius)
 
 
-def _offsets(lz: Array, centers: Array, period: float) -> Array:
-    """``S_j − p_i`` with l wrapped: shape (J, m, 2), m."""
-    d = centers[:, None, :] - np.asarray(lz, dtype=np.float64)[None]
-    d[..., 0] = wrap_l(d[..., 0], period)
-    return d
-
-
-def _distances(s: Array, dist: Array, radii: Array, t: Array) -> ShapeDistances:
-    """From offsets ``s`` = centre minus point and their norms."""
-    safe = np.where(dist > _TINY, dist, 1.0)
-    normal = np.where((dist > _TINY)[..., None], -(s / safe[..., None]), 0.0)
-    return ShapeDistances(
-        distance=dist - radii[:, None],
-        normal=normal,
-        penalty=dist**2 - radii[:, None] ** 2,
-        penalty_gradient=-2.0 * s,
-        t=t,
-    )
+@njit(cache=True)
+def circle_segment(cl, cz, radius, al, az, bl, bz, period):  # type: ignore[no-untyped-def]
+    """``(d, t, ∂d/∂l, ∂d/∂z)`` of a segment: its closest point to the centre is
+    ``p̄ = a + t (b − a)``, ``t = clip((S − a)·(b − a)/‖b − a‖², 0, 1)`` (exact)."""
+    gl, gz = wrap_period(bl - al, period), bz - az
+    length2 = max(gl * gl + gz * gz, _MIN_LENGTH2)  # a zero-length link gives t = 0
+    sl, sz = wrap_period(cl - al, period), cz - az
+    t = min(max((sl * gl + sz * gz) / length2, 0.0), 1.0)
+    d, nl, nz = _from_offset(sl - t * gl, sz - t * gz, radius)
+    return d, t, nl, nz

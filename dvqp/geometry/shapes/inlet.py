@@ -9,7 +9,6 @@ cuts the pipe surface along ``(R sin((l − l0)/R))² + (z − z0)² = r²``: a 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -17,10 +16,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp import _validate
-from dvqp.compiled.plan import Kernel, ProximityBuffers, StepPlan
 from dvqp.errors import ParameterError
 from dvqp.geometry.shapes.polygon import Polygon
-from dvqp.geometry.shapes.polygon_kernels import polygon_kernel
 from dvqp.geometry.shapes.shape import Array, Shape
 
 VERTICES = 256
@@ -53,7 +50,6 @@ class Inlet(Shape):
         "radius": ("length", None),
         "weight": ("weight", 1.0),
     }
-    """Scene keys -> (kind of value, default); kinds: point, length, interval, points, weight."""
     polygon: Polygon = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -95,22 +91,3 @@ class Inlet(Shape):
         """512 points of the exact outline, closed."""
         points = self.curve(512)
         return np.vstack([points, points[:1]])
-
-    def point_distance(self, lz: Array, period: float) -> tuple[Array, Array]:
-        """Through the outline polygon."""
-        return self.polygon.point_distance(lz, period)
-
-    def segment_distance(self, a: Array, b: Array, period: float) -> tuple[Array, Array, Array]:
-        """Through the outline polygon."""
-        return self.polygon.segment_distance(a, b, period)
-
-    @classmethod
-    def kernel(
-        cls, shapes: Sequence[Shape], indices: NDArray[np.int64], plan: StepPlan,
-        buffers: ProximityBuffers,
-    ) -> Kernel:  # fmt: skip
-        """The outline polygons' kernel (:func:`~dvqp.geometry.shapes.polygon_kernels.polygons`)
-        with the penalty size r of each inlet."""
-        inlets = [s for s in shapes if isinstance(s, Inlet)]
-        sizes = [i.size for i in inlets]
-        return polygon_kernel([i.polygon for i in inlets], sizes, indices, plan, buffers)

@@ -1,20 +1,23 @@
-"""A simple polygon in the (l, z) plane: a weld-on pad, a bracket, a rail."""
+"""A simple polygon in the (l, z) plane: a weld-on pad, a bracket, a rail.
+
+Its compiled distances (:func:`polygon_point`, :func:`polygon_segment`) work in the polygon's
+local frame, l measured from its reference ``l_ref`` (wrapped), with the vertices as arrays
+``vl, vz`` of shape (V,).
+"""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
-from numpy.typing import NDArray
+from numba import njit
 
 from dvqp import _validate
-from dvqp.compiled.plan import Kernel, ProximityBuffers, StepPlan
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry.shapes import polygon_geometry as geo
-from dvqp.geometry.shapes import polygon_kernels as kernels
-from dvqp.geometry.shapes.shape import Array, Shape, local, local_segments
+from dvqp.geometry.shapes.shape import Array, Shape
 
 
 @dataclass(frozen=True, eq=False)
@@ -37,11 +40,8 @@ class Polygon(Shape):
         "vertices": ("points", None),
         "weight": ("weight", 1.0),
     }
-    """Scene keys -> (kind of value, default); kinds: point, length, interval, points, weight."""
     l_ref: float = field(init=False)
     local_vertices: Array = field(init=False, repr=False)
-    _vl: Array = field(init=False, repr=False)
-    _vz: Array = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         v = np.asarray(self.vertices, dtype=np.float64)
@@ -55,8 +55,6 @@ class Polygon(Shape):
         l_ref = float(v[:, 0].mean())
         object.__setattr__(self, "l_ref", l_ref)
         object.__setattr__(self, "local_vertices", _validate.readonly(v - [l_ref, 0.0]))
-        object.__setattr__(self, "_vl", np.ascontiguousarray(self.local_vertices[:, 0]))
-        object.__setattr__(self, "_vz", np.ascontiguousarray(self.local_vertices[:, 1]))
 
     @classmethod
     def from_scene(cls, values: dict[str, Any], pipe_radius: float) -> Polygon:
@@ -87,30 +85,6 @@ class Polygon(Shape):
         """The vertices, closed."""
         return np.vstack([self.vertices, self.vertices[:1]])
 
-    def point_distance(self, lz: Array, period: float) -> tuple[Array, Array]:
-        """Distance to the nearest edge, negative inside (even-odd rule)."""
-        p = local(lz, self.l_ref, period)
-        return kernels.points_signed_distance(p[:, 0], p[:, 1], self._vl, self._vz)
-
-    def segment_distance(self, a: Array, b: Array, period: float) -> tuple[Array, Array, Array]:
-        """Exact for a segment that stays outside; the deepest point, found by sampling and a
-        golden-section search, for one that enters. There the normal is the one at the deepest
-        point (one side of a kink where it lies on the medial axis)."""
-        la, lb = local_segments(a, b, self.l_ref, period)
-        return kernels.segments_signed_distance(
-            la[:, 0], la[:, 1], lb[:, 0], lb[:, 1], self._vl, self._vz
-        )
-
-    @classmethod
-    def kernel(
-        cls, shapes: Sequence[Shape], indices: NDArray[np.int64], plan: StepPlan,
-        buffers: ProximityBuffers,
-    ) -> Kernel:  # fmt: skip
-        """:func:`~dvqp.geometry.shapes.polygon_kernels.polygons`, vertices packed once."""
-        polygons = [s for s in shapes if isinstance(s, Polygon)]
-        sizes = [p.size for p in polygons]
-        return kernels.polygon_kernel(polygons, sizes, indices, plan, buffers)
-
 
 def _check_simple(v: Array) -> None:
     if v.shape[0] < 3:
@@ -124,3 +98,120 @@ def _check_simple(v: Array) -> None:
         raise ParameterError("vertices", "the polygon's edges cross (it must be simple)")
     if abs(geo.signed_area(v)) < 1e-10:
         raise ParameterError("vertices", "the polygon has no area")
+
+
+SAMPLES = 33
+"""Samples along a segment that enters the polygon, before the golden-section search."""
+GOLDEN_STEPS = 40
+INV_PHI = (math.sqrt(5.0) - 1.0) / 2.0
+
+
+@njit(cache=True)
+def polygon_point(pl: float, pz: float, vl: Array, vz: Array) -> tuple[float, float, float]:
+    """``(d, ∂d/∂l, ∂d/∂z)`` of one point (local l) to the polygon of vertices ``vl, vz``
+    (local, (V,) each): the distance to the nearest edge, negative inside (even-odd rule)."""
+    n = vl.shape[0]
+    best, cl, cz, inside, best_e = np.inf, 0.0, 0.0, False, 0
+    for i in range(n):
+        j = i + 1 if i + 1 < n else 0  # (i + 1) % n without an integer division
+        el, ez = vl[j] - vl[i], vz[j] - vz[i]
+        wl, wz = pl - vl[i], pz - vz[i]
+        len2 = el * el + ez * ez
+        t = (wl * el + wz * ez) / len2 if len2 > 0.0 else 0.0
+        t = min(max(t, 0.0), 1.0)
+        ql, qz = vl[i] + t * el, vz[i] + t * ez
+        d = math.hypot(pl - ql, pz - qz)
+        if d < best:
+            best, cl, cz, best_e = d, ql, qz, i
+        if (vz[i] > pz) != (vz[j] > pz):
+            x = vl[i] + (pz - vz[i]) * (vl[j] - vl[i]) / (vz[j] - vz[i])
+            if pl < x:
+                inside = not inside
+    sign = -1.0 if inside else 1.0
+    if best > 1e-14:
+        return sign * best, sign * (pl - cl) / best, sign * (pz - cz) / best
+    j = (best_e + 1) % n  # on the outline: the edge's outward normal
+    el, ez = vl[j] - vl[best_e], vz[j] - vz[best_e]
+    norm = math.hypot(el, ez)
+    area = 0.0
+    for i in range(n):
+        area += vl[i] * vz[(i + 1) % n] - vl[(i + 1) % n] * vz[i]
+    turn = 1.0 if area > 0.0 else -1.0
+    return 0.0, turn * ez / norm, -turn * el / norm
+
+
+@njit(cache=True)
+def _crosses(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array) -> bool:
+    n = vl.shape[0]
+    for i in range(n):
+        j = i + 1 if i + 1 < n else 0
+        o1 = (bl - al) * (vz[i] - az) - (bz - az) * (vl[i] - al)
+        o2 = (bl - al) * (vz[j] - az) - (bz - az) * (vl[j] - al)
+        o3 = (vl[j] - vl[i]) * (az - vz[i]) - (vz[j] - vz[i]) * (al - vl[i])
+        o4 = (vl[j] - vl[i]) * (bz - vz[i]) - (vz[j] - vz[i]) * (bl - vl[i])
+        if o1 * o2 <= 0.0 and o3 * o4 <= 0.0:
+            return True
+    return False
+
+
+@njit(cache=True)
+def _outside(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array):  # type: ignore[no-untyped-def]
+    """A segment that does not cross the outline: closest at an end, or at its point nearest
+    a vertex (two segments that do not cross are closest at an endpoint of one of them)."""
+    da, gal, gaz = polygon_point(al, az, vl, vz)
+    db, gbl, gbz = polygon_point(bl, bz, vl, vz)
+    d, t, nl, nz = da, 0.0, gal, gaz
+    if db < d:
+        d, t, nl, nz = db, 1.0, gbl, gbz
+    sl, sz = bl - al, bz - az
+    len2 = sl * sl + sz * sz
+    for i in range(vl.shape[0]):
+        tv = ((vl[i] - al) * sl + (vz[i] - az) * sz) / len2 if len2 > 0.0 else 0.0
+        tv = min(max(tv, 0.0), 1.0)
+        ql, qz = al + tv * sl - vl[i], az + tv * sz - vz[i]
+        dv = math.hypot(ql, qz)
+        if dv < d:
+            d, t, nl, nz = dv, tv, ql / dv, qz / dv
+    return d, t, nl, nz
+
+
+@njit(cache=True)
+def _deepest(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array):  # type: ignore[no-untyped-def]
+    """A segment that enters: the smallest signed distance along it, by sampling then a
+    golden-section search between the best sample's neighbours."""
+    sl, sz = bl - al, bz - az
+    best_k, best = 0, np.inf
+    for k in range(SAMPLES):
+        t = k / (SAMPLES - 1)
+        d = polygon_point(al + t * sl, az + t * sz, vl, vz)[0]
+        if d < best:
+            best, best_k = d, k
+    lo, hi = max(best_k - 1, 0) / (SAMPLES - 1), min(best_k + 1, SAMPLES - 1) / (SAMPLES - 1)
+    x1, x2 = hi - INV_PHI * (hi - lo), lo + INV_PHI * (hi - lo)
+    f1 = polygon_point(al + x1 * sl, az + x1 * sz, vl, vz)[0]
+    f2 = polygon_point(al + x2 * sl, az + x2 * sz, vl, vz)[0]
+    for _ in range(GOLDEN_STEPS):
+        if f1 < f2:
+            hi, x2, f2 = x2, x1, f1
+            x1 = hi - INV_PHI * (hi - lo)
+            f1 = polygon_point(al + x1 * sl, az + x1 * sz, vl, vz)[0]
+        else:
+            lo, x1, f1 = x1, x2, f2
+            x2 = lo + INV_PHI * (hi - lo)
+            f2 = polygon_point(al + x2 * sl, az + x2 * sz, vl, vz)[0]
+    t = 0.5 * (lo + hi)
+    d, nl, nz = polygon_point(al + t * sl, az + t * sz, vl, vz)
+    if best < d:  # a kink exactly at a sample
+        t = best_k / (SAMPLES - 1)
+        d, nl, nz = polygon_point(al + t * sl, az + t * sz, vl, vz)
+    return d, t, nl, nz
+
+
+@njit(cache=True)
+def polygon_segment(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array):  # type: ignore[no-untyped-def]
+    """``(d, t, ∂d/∂l, ∂d/∂z)`` of one segment: exact for a segment outside; for one that
+    enters, the deepest point to the golden-section search's precision (1e-9 of its length)."""
+    res = _outside(al, az, bl, bz, vl, vz)
+    if res[0] < 0.0 or _crosses(al, az, bl, bz, vl, vz):
+        res = _deepest(al, az, bl, bz, vl, vz)
+    return res

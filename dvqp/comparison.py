@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import platform
+import signal
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import TYPE_CHECKING, Any
@@ -17,7 +18,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from dvqp import load_scene, plan
-from dvqp.cli.progress import quiet_worker
 from dvqp.errors import DvqpError
 from dvqp.geometry import proximity
 from dvqp.kinematics import KinematicState
@@ -31,7 +31,7 @@ if TYPE_CHECKING:
 FIELDS = (
     "scene", "file", "backend", "success", "steps", "failures", "relaxed", "braking", "substepped",
     "median_step_us", "p95_step_us", "median_solver_us", "median_rest_us", "median_iterations",
-    "compiled_steps", "ratio_to_pinv", "max_task_error", "min_clearance",
+    "ratio_to_pinv", "max_task_error", "min_clearance",
     "closest", "min_probe_clearance", "min_tilt", "min_self_distance", "closest_pair",
     "max_joint_acceleration", "max_limit_excess", "worst_limit",
     "max_joint_limit_violation", "max_velocity_limit_violation", "final_tracking_error", "error",
@@ -67,8 +67,8 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
         task gave way to a limit) and ``braking`` (steps where the limits conflicted among
         themselves and the arm slowed down toward rest); ``substepped`` (steps split to keep
         a limit); median and 95th-percentile full step time (µs), the medians of the solver
-        call alone and of the rest of the step (µs), of the solver's iterations, and the
-        number of steps the compiled path took (``compiled_steps``); the largest task error
+        call alone and of the rest of the step (µs) and of the solver's iterations; the largest
+        task error
         ``‖J̄Q̇ − ẋ‖∞`` of the succeeded steps; the smallest clearance of any guarded part
         (m) and the part and obstacle that have it (``closest``); the probe's own smallest
         clearance (m); the smallest probe tilt from radial (rad); the smallest distance
@@ -105,17 +105,15 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
 
 def _solver_figures(traj: Trajectory) -> Row:
     """Medians of the solver call alone (µs), of the rest of the step (µs) and of the solver's
-    iterations (None where not reported), and the steps the compiled path took."""
+    iterations (None where not reported)."""
     if not traj.n_steps or not traj.solver_time.size:
-        return {"median_solver_us": None, "median_rest_us": None, "median_iterations": None,
-                "compiled_steps": None}  # fmt: skip
+        return {"median_solver_us": None, "median_rest_us": None, "median_iterations": None}
     solver_us = traj.solver_time * 1e6
     counted = traj.iterations[traj.iterations >= 0]
     return {
         "median_solver_us": _finite(np.median(solver_us)),
         "median_rest_us": _finite(np.median(traj.step_time * 1e6 - solver_us)),
         "median_iterations": _finite(np.median(counted)) if counted.size else None,
-        "compiled_steps": int(traj.compiled.sum()) if traj.compiled.size else None,
     }
 
 
@@ -263,3 +261,13 @@ def machine() -> dict[str, Any]:
         "cpu_count": os.cpu_count(),
         "python": platform.python_version(),
     }
+
+
+def quiet_worker() -> None:
+    """Make Ctrl-C end this worker process at once, silently (exit code 130).
+
+    For ``ProcessPoolExecutor(initializer=quiet_worker)``: workers that are not forked from
+    inside :func:`interruptible` (the ``spawn`` and ``forkserver`` start methods) then stop as
+    forked ones do, instead of each printing a traceback.
+    """
+    signal.signal(signal.SIGINT, lambda signum, frame: os._exit(130))

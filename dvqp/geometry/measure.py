@@ -1,0 +1,171 @@
+"""Signed distances of the arm's guarded chain to every obstacle, compiled.
+
+The guarded chain is the k body points then the probe (the tool point); its links join
+consecutive points (the k−1 body links, then the probe holder). :class:`ShapeArrays` packs an
+obstacle sequence once; :func:`measure_chain` writes every built-in shape's distances and
+normals into :class:`~dvqp.workspace.ProximityBuffers` (the kernels of each shape's module,
+selected per row), :func:`user_rows` those of shapes of your own (their NumPy methods), and
+:func:`penalties` every row's objective penalty ``e = d (d + 2ρ)`` and ``∇e = 2 (d + ρ) ∇d``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon, Shape
+from dvqp.geometry.shapes.band import band_point, band_segment
+from dvqp.geometry.shapes.circle import circle_point, circle_segment
+from dvqp.geometry.shapes.polygon import polygon_point, polygon_segment
+from dvqp.kinematics.developed_view import wrap_period
+from dvqp.workspace import ProximityBuffers
+
+Array = NDArray[np.float64]
+
+CIRCLE, BAND, POLYGON, OTHER = 0, 1, 2, 3
+"""Codes of the compiled shape kinds; OTHER is a shape of your own (measured in NumPy)."""
+
+
+@dataclass(frozen=True)
+class ShapeArrays:
+    """J obstacles as the compiled measurement reads them.
+
+    Attributes
+    ----------
+    period : float
+        ``2πR``, m.
+    code : (J,) int64
+        :data:`CIRCLE`, :data:`BAND`, :data:`POLYGON` (an inlet is its outline polygon) or
+        :data:`OTHER`.
+    data : (J, 3)
+        A circle's ``[l, z, r]``, a band's ``[z_min, z_max, 0]``, a polygon's ``[l_ref, 0, 0]``.
+    start, stop : (J,) int64
+        A polygon's vertices ``vl, vz[start:stop]``.
+    vl, vz : (V,)
+        Every polygon's vertices, l measured from its ``l_ref``.
+    size : (J,)
+        ``ρ`` of each obstacle's penalty, m.
+    """
+
+    period: float
+    code: NDArray[np.int64]
+    data: Array
+    start: NDArray[np.int64]
+    stop: NDArray[np.int64]
+    vl: Array
+    vz: Array
+    size: Array
+
+    @classmethod
+    def of(cls, shapes: Sequence[Shape], period: float) -> ShapeArrays:
+        """Pack ``shapes`` (dvqp's own classes compiled, any other :data:`OTHER`)."""
+        count = len(shapes)
+        code, data = np.full(count, OTHER, np.int64), np.zeros((count, 3))
+        start, stop = np.zeros(count, np.int64), np.zeros(count, np.int64)
+        vertices: list[Array] = []
+        at = 0
+        for j, shape in enumerate(shapes):
+            kind = type(shape)
+            if kind is Circle:
+                code[j], data[j] = CIRCLE, (*shape.center, shape.radius)  # type: ignore[attr-defined]
+            elif kind is Band:
+                code[j], data[j] = BAND, (shape.z_min, shape.z_max, 0.0)  # type: ignore[attr-defined]
+            elif kind in (Polygon, Inlet):
+                polygon = shape.polygon if kind is Inlet else shape  # type: ignore[attr-defined]
+                local = polygon.local_vertices
+                code[j], data[j, 0] = POLYGON, polygon.l_ref
+                start[j], stop[j] = at, at + local.shape[0]
+                vertices.append(local)
+                at += local.shape[0]
+        packed = np.concatenate(vertices) if vertices else np.zeros((0, 2))
+        return cls(
+            float(period),
+            code,
+            data,
+            start,
+            stop,
+            np.ascontiguousarray(packed[:, 0]),
+            np.ascontiguousarray(packed[:, 1]),
+            np.array([s.size for s in shapes], float),
+        )
+
+
+@njit(cache=True)
+def _point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
+    """``(d, ∂d/∂l, ∂d/∂z)`` of a point to obstacle j."""
+    code, data, period = shapes.code[j], shapes.data[j], shapes.period
+    if code == CIRCLE:
+        return circle_point(data[0], data[1], data[2], pl, pz, period)
+    if code == BAND:
+        d, nz = band_point(data[0], data[1], pz)
+        return d, 0.0, nz
+    a, b = shapes.start[j], shapes.stop[j]
+    return polygon_point(wrap_period(pl - data[0], period), pz, shapes.vl[a:b], shapes.vz[a:b])
+
+
+@njit(cache=True)
+def _segment(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
+    """``(d, t, ∂d/∂l, ∂d/∂z)`` of a segment to obstacle j."""
+    code, data, period = shapes.code[j], shapes.data[j], shapes.period
+    if code == CIRCLE:
+        return circle_segment(data[0], data[1], data[2], al, az, bl, bz, period)
+    if code == BAND:
+        d, t, nz = band_segment(data[0], data[1], az, bz)
+        return d, t, 0.0, nz
+    a, b = shapes.start[j], shapes.stop[j]
+    la = wrap_period(al - data[0], period)
+    lb = la + wrap_period(bl - al, period)
+    return polygon_segment(la, az, lb, bz, shapes.vl[a:b], shapes.vz[a:b])
+
+
+@njit(cache=True)
+def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
+    """Distances and normals of the points ``chain`` (m, ≥ 2; columns l, z, ...) and of the
+    links between consecutive points to every compiled obstacle, into ``near`` (a packed
+    :class:`~dvqp.workspace.ProximityBuffers`); rows of :data:`OTHER` shapes are left alone."""
+    m = chain.shape[0]
+    for j in range(shapes.code.shape[0]):
+        if shapes.code[j] == OTHER:
+            continue
+        for i in range(m):
+            d, nl, nz = _point(shapes, j, chain[i, 0], chain[i, 1])
+            near.point_distance[j, i] = d
+            near.point_normal[j, i, 0], near.point_normal[j, i, 1] = nl, nz
+        for i in range(m - 1):
+            d, t, nl, nz = _segment(shapes, j, chain[i, 0], chain[i, 1], chain[i + 1, 0],
+                                    chain[i + 1, 1])  # fmt: skip
+            near.link_distance[j, i], near.link_t[j, i] = d, t
+            near.link_normal[j, i, 0], near.link_normal[j, i, 1] = nl, nz
+
+
+@njit(cache=True)
+def penalties(size, near) -> None:  # type: ignore[no-untyped-def]
+    """Every row's penalty ``e = d (d + 2ρ)`` (m²) and ``∇e = 2 (d + ρ) ∇d`` (m)."""
+    for j in range(size.shape[0]):
+        rho = size[j]
+        for i in range(near.point_distance.shape[1]):
+            d = near.point_distance[j, i]
+            near.point_penalty[j, i] = d * (d + 2.0 * rho)
+            for c in range(2):
+                near.point_penalty_gradient[j, i, c] = 2.0 * (d + rho) * near.point_normal[j, i, c]
+        for i in range(near.link_distance.shape[1]):
+            d = near.link_distance[j, i]
+            near.link_penalty[j, i] = d * (d + 2.0 * rho)
+            for c in range(2):
+                near.link_penalty_gradient[j, i, c] = 2.0 * (d + rho) * near.link_normal[j, i, c]
+
+
+def user_rows(shapes: Sequence[Shape], code: NDArray[np.int64], chain: Array, period: float,
+              near: ProximityBuffers) -> None:  # fmt: skip
+    """Rows of the shapes of your own (code :data:`OTHER`): their NumPy ``point_distance`` and
+    ``segment_distance`` of ``chain`` (m, ≥ 2), written into ``near``."""
+    lz = np.ascontiguousarray(chain[:, :2])
+    for j in np.flatnonzero(code == OTHER):
+        shape = shapes[j]
+        near.point_distance[j], near.point_normal[j] = shape.point_distance(lz, period)
+        d, t, n = shape.segment_distance(lz[:-1], lz[1:], period)
+        near.link_distance[j], near.link_t[j], near.link_normal[j] = d, t, n

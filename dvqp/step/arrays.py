@@ -1,0 +1,175 @@
+"""Every array a run's compiled step reads and writes, grouped as the stages use them.
+
+:class:`Pipeline` is packed once per run into one numba struct
+(:func:`dvqp.workspace.as_struct`) and handed to the compiled stages
+(:mod:`dvqp.step.stages`). Its layout is the same for every run: a part kind a run lacks has
+arrays of size 0, so the stages compile once and are loaded from numba's cache afterwards.
+Sizes: n joints, k body points, J obstacles, D damper rows, V verified values.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from dvqp.geometry.measure import ShapeArrays
+from dvqp.kinematics.model import ModelArrays
+from dvqp.limits.damper import DamperArrays
+from dvqp.workspace import (
+    CheckBuffers,
+    DamperBuffers,
+    PairBuffers,
+    ProximityBuffers,
+    QPBuffers,
+    StateBuffers,
+)
+
+Array = NDArray[np.float64]
+Index = NDArray[np.int64]
+
+
+@dataclass(frozen=True)
+class ObjectiveArrays:
+    """dvqp's objective terms of a run, and ``w``, ``∂w/∂Q`` of the current state.
+
+    Attributes
+    ----------
+    levels, k_height : (T,), (T, k)
+        Each :class:`~dvqp.objective.OrbitalLevel`'s ``h*`` (m) and ``k²`` (1/m²).
+    point_coef, link_coef : (J, k), (J, k − 1)
+        ``Σ w_j k¹_i`` of the obstacle-point and obstacle-link terms (0 where none sees j).
+    scratch : (k, 2)
+    value, gradient : (1,), (n,)
+        ``w`` and ``∂w/∂Q``.
+    gain : float
+        ``λ``.
+    """
+
+    levels: Array
+    k_height: Array
+    point_coef: Array
+    link_coef: Array
+    scratch: Array
+    value: Array
+    gradient: Array
+    gain: float
+
+
+@dataclass(frozen=True)
+class BoundArrays:
+    """The joint limits' boxes: position ``q_min``, ``q_max`` (rad; ±inf without), velocity
+    ``qd_max`` (rad/s; inf without) and, if ``accelerate``, the acceleration limit's ``qdd_max``
+    (rad/s²), its own ``q_min``, ``q_max`` and its live ``previous`` velocity (n,) each."""
+
+    q_min: Array
+    q_max: Array
+    qd_max: Array
+    accelerate: bool
+    qdd_max: Array
+    accel_q_min: Array
+    accel_q_max: Array
+    previous: Array
+
+
+@dataclass(frozen=True)
+class MeasureArrays:
+    """Which compiled dampers measure which damper rows.
+
+    Attributes
+    ----------
+    tool_rows : (T,) int64
+        First row of ``A`` of each :class:`~dvqp.tasks.ToolTask`.
+    obstacle_start, obstacle_offsets, obstacle_members : (O,), (O + 1,), (M,) int64
+        Each obstacle damper's first row and its obstacles ``members[offsets[o]:offsets[o+1]]``.
+    heights : (H, 3) int64
+        ``[first row, first guarded point, count]`` of each height damper.
+    tilts, selves : (T,), (S,) int64
+        First row of each tilt and self-collision damper.
+    """
+
+    tool_rows: Index
+    obstacle_start: Index
+    obstacle_offsets: Index
+    obstacle_members: Index
+    heights: Index
+    tilts: Index
+    selves: Index
+
+
+@dataclass(frozen=True)
+class PinvArrays:
+    """The baseline's step (eq. 18), when ``baseline``: ``weights`` (n,) of ``W``, ``dense``
+    (soft tasks make the metric ``P``), ``damping`` μ, ``info`` (2,) the Cholesky pivots'
+    extremes, ``x`` (n,) the step."""
+
+    baseline: bool
+    weights: Array
+    dense: bool
+    damping: float
+    info: Array
+    x: Array
+
+
+@dataclass(frozen=True)
+class RecordArrays:
+    """Where the conclusion of a state is written as a trajectory sample: row ``index[0]``
+    (none when −1) of the recorder's per-sample arrays."""
+
+    index: Index
+    q: Array
+    tool: Array
+    points: Array
+    w: Array
+    limit_excess: Array
+    limits_kept: NDArray[np.bool_]
+    tilt: Array
+    self_distance: Array
+    min_clearance: Array
+    probe_clearance: Array
+
+    @classmethod
+    def none(cls, n: int, k: int) -> RecordArrays:
+        """Nothing recorded."""
+        z = np.zeros(0)
+        return cls(np.full(1, -1, np.int64), np.zeros((0, n)), np.zeros((0, 4)),
+                   np.zeros((0, k, 3)), z, z.copy(), np.zeros(0, np.bool_), z.copy(), z.copy(),
+                   z.copy(), z.copy())  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Pipeline:
+    """What the compiled stages read and write (see the module docstring).
+
+    ``dt`` (1,) and ``command`` (4,) are this step's, ``x`` (n,) the joint velocity it
+    integrates, ``motion`` (2,) the integrated step's ``[‖A x − b‖∞, largest joint motion]``;
+    ``joint_values`` and ``damper_values`` where the joint room and the damper rows start
+    among the verified values (−1: none);
+    ``diagnostics`` (5,) the state's ``[tilt, self distance, min clearance, probe clearance,
+    index of the closest part]`` over the ``recorded`` obstacle rows.
+    """
+
+    radius: float
+    dt: Array
+    command: Array
+    x: Array
+    motion: Array
+    model: ModelArrays
+    state: StateBuffers
+    shapes: ShapeArrays
+    near: ProximityBuffers
+    pairs: PairBuffers
+    objective: ObjectiveArrays
+    bounds: BoundArrays
+    measures: MeasureArrays
+    params: DamperArrays
+    dampers: DamperBuffers
+    qp: QPBuffers
+    pinv: PinvArrays
+    checks: CheckBuffers
+    joint_values: int
+    damper_values: int
+    recorded: Index
+    diagnostics: Array
+    record: RecordArrays

@@ -1,0 +1,287 @@
+"""A resolver's step compiled for one run: load a configuration, resolve a step, move.
+
+:class:`Stepper` lays out the resolver's spec once (:func:`dvqp.step.build.build`), packs its
+arrays into one numba struct and runs the compiled stages (:mod:`dvqp.step.stages`) on it, with
+the parts of your own in between (:mod:`dvqp.step.hooks`) and the QP backend (or the baseline's
+pseudoinverse) after :func:`~dvqp.step.stages.prepare`. Everything a run does goes through it:
+the common step, split substeps and interior points of a large step
+(:func:`dvqp.step.advance.advance`), the console's live steps.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+import solvers
+from dvqp.errors import ParameterError, ShapeError, SingularConfigurationError
+from dvqp.geometry.obstacle import ObstacleSet
+from dvqp.kinematics.robot import Robot
+from dvqp.kinematics.state import KinematicState, singular_frame
+from dvqp.limits import (
+    NO_EXCESS,
+    Bounds,
+    Constraint,
+    Excess,
+    JointPositionLimit,
+    Limit,
+    VelocityDamper,
+)
+from dvqp.objective import Term
+from dvqp.resolution.qp import QPResolver, QPSolver
+from dvqp.resolution.step import Resolver
+from dvqp.step import stages
+from dvqp.step.build import lay_out
+from dvqp.step.hooks import Hooks
+from dvqp.workspace import as_struct
+
+Array = NDArray[np.float64]
+
+
+class Resolution(NamedTuple):
+    """How a step's joint velocity (:attr:`Stepper.x`) was found: ``success``, ``status``
+    (``"optimal"``, ``"relaxed"``, ``"braking"`` or why it failed), the backend's
+    ``iterations``, the time inside its calls and of the whole resolution (s)."""
+
+    success: bool
+    status: str
+    iterations: int | None
+    solver_time: float
+    solve_time: float
+
+
+class Stepper:
+    """The compiled step of ``resolver`` on ``robot`` in a pipe of ``radius`` (m).
+
+    Parameters
+    ----------
+    robot, radius, resolver
+        What steps.
+    q0
+        The run's start, rad: parts of your own are sized there.
+    dt
+        The run's step, s (a step may use another).
+    obstacles
+        Obstacles whose clearances the diagnostics measure (default none).
+    samples
+        The recorder's per-sample arrays (:class:`~dvqp.step.arrays.RecordArrays` fields):
+        each state concluded while :attr:`record_at` is set is written there.
+
+    Attributes
+    ----------
+    state : KinematicState
+        Read-only views of the loaded state.
+    x : ndarray, shape (n,)
+        The joint velocity of the last resolved step, rad/s.
+    """
+
+    def __init__(self, robot: Robot, radius: float, resolver: Resolver, q0: ArrayLike,
+                 dt: float, obstacles: ObstacleSet | None = None,
+                 samples: Mapping[str, np.ndarray] | None = None) -> None:  # fmt: skip
+        spec = resolver.spec
+        self.robot, self.resolver = robot, resolver
+        self.layout, self.arrays = lay_out(robot, radius, resolver, q0, dt, obstacles, samples)
+        plan = self.layout.plan
+        self.struct = as_struct(self.arrays)
+        assert plan.qp is not None and plan.checks is not None
+        self.solver = (QPSolver(resolver.factory, plan.qp, spec.task_weight)
+                       if isinstance(resolver, QPResolver) else None)  # fmt: skip
+        self.hooks = self.layout.hooks
+        self.state = KinematicState.view(plan.state, radius)
+        self.x = self.arrays.x
+        self.record_at = self.arrays.record.index
+        """(1,) int64: row of the samples the next concluded state is written to (−1: none)."""
+        self.excess_now = plan.checks.excess
+        """(2,): ``[value, ratio]`` of the loaded state's worst excess."""
+        self.motion = self.arrays.motion
+        """(2,): ``[‖A x − b‖∞, max |dt x|]`` of the last :meth:`move`."""
+        self.limits: tuple[Limit, ...] = spec.limits
+        self._observers = [lim for lim in spec.limits if type(lim).observe is not Limit.observe
+                           and resolver.holds_limits]  # fmt: skip
+
+    def load(self, q: ArrayLike) -> bool:
+        """Evaluate the state at ``q`` (rad); False if a guarded frame is on the pipe axis."""
+        self.arrays.state.q[:] = q
+        return self._evaluate(False) == -1
+
+    def move(self) -> bool:
+        """Evaluate the state reached by :attr:`x` over ``dt`` from the loaded one; False if
+        singular. :attr:`motion` then holds the step's task error and largest joint motion."""
+        return self._evaluate(True) == -1
+
+    def _evaluate(self, integrate: bool) -> int:
+        s, hooks = self.struct, self.hooks
+        if not hooks.active:
+            return int(stages.evaluate(s, integrate, stages.MEASURE, stages.CONCLUDE))
+        status = int(stages.evaluate(s, integrate, stages.MEASURE, stages.MEASURE))
+        if status != -1:
+            return status
+        for hook in hooks.measured:
+            hook()
+        stages.evaluate(s, False, stages.ASSESS, stages.ASSESS)
+        for hook in hooks.assessed:
+            hook()
+        return int(stages.evaluate(s, False, stages.CONCLUDE, stages.CONCLUDE))
+
+    def start(self, q0: ArrayLike) -> None:
+        """Load the run's start: the limits' floors are ``min(safe, value there)``, the
+        limits that remember motion start at rest, the backends cold.
+
+        Raises
+        ------
+        SingularConfigurationError
+            A guarded frame of ``q0`` lies on the pipe axis.
+        """
+        checks = self.arrays.checks
+        for limit in self.limits:
+            limit.reset()
+        if self.solver is not None:
+            self.solver.reset()
+        if not self.load(q0):
+            raise self.singular()
+        np.minimum(checks.safe, checks.values, out=checks.floor)
+        self.load(q0)  # again, against the floors: the start's excess (and sample)
+
+    def singular(self) -> SingularConfigurationError:
+        """The error of the loaded configuration, singular."""
+        s = self.arrays.state
+        rho = np.hypot(s.origins[:, 0], s.origins[:, 1])
+        frame = int(np.argmin(rho))
+        return singular_frame(self.robot, frame, s.origins[frame], s.q.copy())
+
+    @property
+    def broken(self) -> bool:
+        """The loaded state breaks a verified limit by more than its tolerance."""
+        return not self.excess_now[1] <= 1.0
+
+    def resolve(self, command: Array, dt: float) -> Resolution:
+        """The step from the loaded state for the tool command ``command`` (4,) over ``dt``
+        (s): :attr:`x` and how it was found (its task error is known once it is integrated,
+        :meth:`move`).
+
+        Raises
+        ------
+        SingularConfigurationError
+            The baseline met a (nearly) singular task Jacobian.
+        """
+        started = time.perf_counter()
+        status = self.prepare(command, dt)
+        prepared = time.perf_counter()
+        a = self.arrays
+        if self.solver is None:
+            if status != -1:
+                raise self._pinv_error(status)
+            self.x[:] = a.pinv.x
+            return Resolution(True, "optimal", None, prepared - started, prepared - started)
+        if status != -1:
+            lb, ub = a.qp.lb[status], a.qp.ub[status]
+            why = (f"failed: the bounds on joint{status + 1}'s velocity cross "
+                   f"({lb:.4g} > {ub:.4g} rad/s)")  # fmt: skip
+            return Resolution(False, why, None, 0.0, time.perf_counter() - started)
+        answer = self.solver.solve()
+        if answer.x is not None:
+            self.x[:] = answer.x
+        return Resolution(answer.x is not None, answer.status, answer.iterations,
+                          answer.solver_time, time.perf_counter() - started)  # fmt: skip
+
+    def prepare(self, command: Array, dt: float) -> int:
+        """Write the problem of a step from the loaded state for ``command`` (4,) over ``dt``
+        (s), without solving it (:meth:`resolve` solves it): −1, or the first joint whose
+        bounds cross (QP), or a status of the baseline (its step is then not defined)."""
+        a, s, hooks = self.arrays, self.struct, self.hooks
+        if np.shape(command) != (4,):
+            raise ShapeError("command", (4,), np.shape(command))
+        a.command[:] = command
+        a.dt[0] = dt
+        status = self._prepared(s, hooks)
+        if status == stages.BAD_COMMAND:
+            raise ParameterError("command", "must be finite (no NaN or inf)")
+        return status
+
+    def _prepared(self, s: object, hooks: Hooks) -> int:
+        if not hooks.prepared:
+            return int(stages.prepare(s, stages.ROWS, stages.CLOSE))
+        if stages.prepare(s, stages.ROWS, stages.ROWS) == stages.BAD_COMMAND:
+            return stages.BAD_COMMAND
+        for hook in hooks.prepared:
+            hook()
+        return int(stages.prepare(s, stages.CLOSE, stages.CLOSE))
+
+    def _pinv_error(self, status: int) -> SingularConfigurationError:
+        if status == stages.INDEFINITE_METRIC:
+            return SingularConfigurationError("the soft tasks' metric is not positive definite")
+        lo, hi = self.arrays.pinv.info
+        return SingularConfigurationError(
+            f"task Jacobian is (nearly) rank deficient (Cholesky pivots from {lo:.3g} to "
+            f"{hi:.3g}); use a damped inverse"
+        )
+
+    def observe(self, qdot: Array, dt: float) -> None:
+        """Tell the limits that remember motion (acceleration) the velocity applied."""
+        for limit in self._observers:
+            limit.observe(qdot, dt)
+
+    def excess(self) -> Excess:
+        """The worst excess of the loaded state, named (:data:`~dvqp.limits.NO_EXCESS` with
+        nothing to verify)."""
+        c = self.arrays.checks
+        over = c.floor - c.values
+        if over.shape[0] == 0:
+            return NO_EXCESS
+        ratio = over / c.tolerance
+        i = int(np.argmax(np.where(np.isnan(ratio), np.inf, ratio)))
+        block = next(b for b in self.layout.blocks if b.start <= i < b.stop)
+        broken = not over[i] <= 0.0  # past the floor, or NaN
+        label = block.labels[i - block.start] if broken else ""
+        if broken and id(block.limit) in self.hooks.describes:
+            label = self.hooks.describes[id(block.limit)]()[i - block.start]
+        if block.limit is JointPositionLimit:
+            n = self.robot.n
+            q = float(self.arrays.state.q[(i - block.start) % n])
+            bound = q - over[i] if i - block.start < n else q + over[i]
+            return Excess(float(over[i]), float(c.tolerance[i]), label, "joint position", "rad",
+                          q, float(bound))  # fmt: skip
+        limit = block.limit
+        return Excess(float(over[i]), float(c.tolerance[i]), label, limit.quantity, limit.unit,  # type: ignore[attr-defined]
+                      float(c.values[i]), float(c.floor[i]))  # fmt: skip
+
+    def rows(self, limit: Limit) -> Constraint | Bounds:
+        """What ``limit`` put in the problem of the last :meth:`prepare`: its rows that apply
+        (``h`` finite; labelled), or for a box limit the box of all box limits, intersected."""
+        qp = self.arrays.qp
+        if id(limit) in self.hooks.constraints:
+            G, h = (self.layout.plan.view(slot) for slot in self.hooks.constraints[id(limit)])
+            applies = np.isfinite(h)
+            named = self.hooks.describes.get(id(limit))
+            labels = named() if named is not None else tuple(f"row{i}" for i in range(h.size))
+            return Constraint(G[applies], h[applies], _labels(tuple(np.array(labels)[applies])))
+        for block in self.layout.blocks:
+            if block.limit is limit:
+                rows = slice(block.start - self.layout.damper_values,
+                             block.stop - self.layout.damper_values)  # fmt: skip
+                applies = np.isfinite(qp.h[rows])
+                labels = tuple(np.asarray(block.labels, dtype=object)[applies])
+                return Constraint(qp.G[rows][applies], qp.h[rows][applies], _labels(labels))
+        if isinstance(limit, VelocityDamper):  # it has no row (e.g. no obstacle)
+            return Constraint(np.zeros((0, qp.G.shape[1])), np.zeros(0))
+        return Bounds(qp.lb.copy(), qp.ub.copy())
+
+    @property
+    def objective(self) -> Term:
+        """``w`` and ``∂w/∂Q`` (n,) of the loaded state (copies)."""
+        o = self.arrays.objective
+        return Term(float(o.value[0]), o.gradient.copy())
+
+    def problem(self) -> solvers.Problem:
+        """The strict QP of the last :meth:`resolve` (a validated copy)."""
+        qp = self.arrays.qp
+        G, h = (qp.G, qp.h) if qp.h.shape[0] else (None, None)
+        return solvers.Problem(qp.P, qp.cost, qp.A, qp.b, G, h, qp.lb, qp.ub)
+
+
+def _labels(labels: tuple[str, ...]) -> Callable[[], tuple[str, ...]]:
+    return lambda: labels

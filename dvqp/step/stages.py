@@ -1,0 +1,218 @@
+"""The compiled step, stage by stage: one readable pipeline over dvqp's part kinds.
+
+:func:`evaluate` measures a configuration (kinematics, obstacles, link pairs), assesses it (the
+objective, the dampers' distances) and concludes (the exact verification, the diagnostics, the
+trajectory's sample); :func:`prepare` writes a step's QP (the tasks' rows, the cost, the
+bounds, the damper rows) and closes it (crossed bounds, or the baseline's step). Each stage
+calls the kernels of the parts' own modules on the arrays of one packed
+:class:`~dvqp.step.arrays.Pipeline`. A run with parts of your own calls the stages one at a
+time (``first``, ``last``) and runs its parts in between (:mod:`dvqp.step.hooks`).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from dvqp.geometry.measure import measure_chain, penalties
+from dvqp.kinematics.model import kinematics
+from dvqp.limits.acceleration import acceleration_bounds
+from dvqp.limits.damper import damper_rows, damper_values
+from dvqp.limits.excess import worst_excess
+from dvqp.limits.joint_position import joint_room, position_bounds
+from dvqp.limits.joint_velocity import velocity_bounds
+from dvqp.limits.obstacle_damper import obstacle_distances
+from dvqp.limits.self_collision import pair_distances, self_distances
+from dvqp.limits.surface_height import height_distances
+from dvqp.limits.tilt import tilt_angle, tilt_distance
+from dvqp.objective.obstacle_links import obstacle_links
+from dvqp.objective.obstacle_points import obstacle_points
+from dvqp.objective.orbital_level import orbital_level
+from dvqp.resolution.pinv import NOT_DEFINITE, pinv_step
+from dvqp.tasks.tool_dv import tool_rows
+
+MEASURE, ASSESS, CONCLUDE = 0, 1, 2
+"""Stages of :func:`evaluate`."""
+ROWS, CLOSE = 0, 1
+"""Stages of :func:`prepare`."""
+SINGULAR_TASK, INDEFINITE_METRIC, BAD_COMMAND = -2, -3, -4
+"""Statuses of :func:`prepare`: the baseline's Gram matrix or metric is singular; the command
+is not finite."""
+
+
+@njit(cache=True)
+def evaluate(s, integrate, first, last) -> int:  # type: ignore[no-untyped-def]
+    """Evaluate the state at ``s.state.q`` (first ``q += dt·x`` if ``integrate``), stages
+    ``first`` to ``last``; returns −1, or the index of a singular guarded frame."""
+    if first <= MEASURE <= last:
+        if integrate:
+            _integrate(s)
+        singular = kinematics(s.model, s.radius, s.state)
+        if singular != -1:
+            return singular  # type: ignore[no-any-return]
+        measure_chain(s.shapes, s.state.guarded, s.near)
+        pair_distances(s.state.origins, s.pairs)
+    if first <= ASSESS <= last:
+        penalties(s.shapes.size, s.near)
+        _objective(s)
+        _distances(s)
+    if first <= CONCLUDE <= last:
+        _conclude(s)
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _integrate(s) -> None:  # type: ignore[no-untyped-def]
+    """``s.motion = [‖A x − b‖∞, max |dt x|]`` and ``q += dt x``."""
+    A, b, x, q, dt = s.qp.A, s.qp.b, s.x, s.state.q, s.dt[0]
+    error = 0.0
+    for r in range(A.shape[0]):
+        v = -b[r]
+        for c in range(A.shape[1]):
+            v += A[r, c] * x[c]
+        error = max(error, abs(v))
+    largest = 0.0
+    for i in range(q.shape[0]):
+        moved = q[i] + dt * x[i]
+        largest = max(largest, abs(moved - q[i]))
+        q[i] = moved
+    s.motion[0], s.motion[1] = error, largest
+
+
+@njit(cache=True, inline="always")
+def _objective(s) -> None:  # type: ignore[no-untyped-def]
+    """``w`` and ``∂w/∂Q`` of dvqp's terms (a user's are added after)."""
+    o, st, near = s.objective, s.state, s.near
+    o.value[0] = 0.0
+    for c in range(o.gradient.shape[0]):
+        o.gradient[c] = 0.0
+    for t in range(o.levels.shape[0]):
+        orbital_level(st.guarded, st.guarded_jacobians, o.levels[t], o.k_height[t], o.value,
+                      o.gradient)  # fmt: skip
+    obstacle_points(near.point_penalty, near.point_penalty_gradient, o.point_coef,
+                    st.guarded_jacobians, o.scratch, o.value, o.gradient)  # fmt: skip
+    obstacle_links(near.link_penalty, near.link_penalty_gradient, near.link_t, o.link_coef,
+                   st.guarded_jacobians, o.scratch, o.value, o.gradient)  # fmt: skip
+
+
+@njit(cache=True, inline="always")
+def _distances(s) -> None:  # type: ignore[no-untyped-def]
+    """The distances of dvqp's dampers, each into its rows."""
+    m, st, d = s.measures, s.state, s.dampers
+    out = (d.distance, d.gradient, d.usable)
+    for o in range(m.obstacle_start.shape[0]):
+        members = m.obstacle_members[m.obstacle_offsets[o] : m.obstacle_offsets[o + 1]]
+        obstacle_distances(s.near, st.guarded_jacobians, members, m.obstacle_start[o], *out)
+    for i in range(m.heights.shape[0]):
+        start, first, count = m.heights[i, 0], m.heights[i, 1], m.heights[i, 2]
+        height_distances(st.guarded, st.guarded_jacobians, first, count, start, *out)
+    for i in range(m.tilts.shape[0]):
+        tilt_distance(st.origins, st.axes, st.frame_jacobians, m.tilts[i], *out)
+    for i in range(m.selves.shape[0]):
+        self_distances(s.pairs, st.frame_jacobians, m.selves[i], *out)
+
+
+@njit(cache=True, inline="always")
+def _conclude(s) -> None:  # type: ignore[no-untyped-def]
+    """The verified values and their worst excess, the diagnostics, the sample."""
+    c, st = s.checks, s.state
+    if s.joint_values >= 0:
+        joint_room(st.q, s.bounds.q_min, s.bounds.q_max, c.values, s.joint_values)
+    if s.damper_values >= 0:
+        damper_values(s.params.angle, s.dampers.distance, c.values, s.damper_values)
+    worst_excess(c.values, c.floor, c.tolerance, c.excess)
+    _diagnostics(s)
+    if s.record.index[0] >= 0:
+        _sample(s)
+
+
+@njit(cache=True, inline="always")
+def _diagnostics(s) -> None:  # type: ignore[no-untyped-def]
+    """``[tilt, self distance, min clearance, probe clearance, closest part]`` (rad, m, m, m,
+    index ``r (2k + 1) + i`` of recorded obstacle r's point i, or ``+ k + 1`` of its link i)."""
+    st, near, out = s.state, s.near, s.diagnostics
+    out[0] = tilt_angle(st.origins, st.axes)
+    out[1] = math.inf
+    for p in range(s.pairs.distance.shape[0]):
+        out[1] = min(out[1], s.pairs.distance[p])
+    m = near.point_distance.shape[1]
+    out[2], out[3], out[4] = math.inf, math.inf, -1.0
+    for r in range(s.recorded.shape[0]):
+        j = s.recorded[r]
+        for i in range(2 * m - 1):
+            d = near.point_distance[j, i] if i < m else near.link_distance[j, i - m]
+            if d < out[2]:
+                out[2], out[4] = d, r * (2 * m - 1) + i
+        out[3] = min(out[3], near.point_distance[j, m - 1], near.link_distance[j, m - 2])
+
+
+@njit(cache=True, inline="always")
+def _sample(s) -> None:  # type: ignore[no-untyped-def]
+    """Row ``s.record.index[0]`` of the trajectory's samples."""
+    r, st, at = s.record, s.state, s.record.index[0]
+    for i in range(st.q.shape[0]):
+        r.q[at, i] = st.q[i]
+    for i in range(4):
+        r.tool[at, i] = st.tool[i]
+    for p in range(r.points.shape[1]):
+        for i in range(3):
+            r.points[at, p, i] = st.guarded[p, i]
+    r.w[at] = s.objective.value[0]
+    excess = s.checks.excess
+    r.limit_excess[at], r.limits_kept[at] = max(excess[0], 0.0), excess[1] <= 1.0
+    d = s.diagnostics
+    r.tilt[at], r.self_distance[at], r.min_clearance[at], r.probe_clearance[at] = (
+        d[0],
+        d[1],
+        d[2],
+        d[3],
+    )
+
+
+@njit(cache=True)
+def prepare(s, first, last) -> int:  # type: ignore[no-untyped-def]
+    """Write this step's problem (stage ``ROWS``) and close it (``CLOSE``): returns −1, the
+    first joint whose bounds cross (QP), :data:`SINGULAR_TASK` / :data:`INDEFINITE_METRIC`
+    (the baseline, whose step is otherwise in ``s.pinv.x``) or :data:`BAD_COMMAND`."""
+    qp, p = s.qp, s.pinv
+    if first <= ROWS <= last:
+        for i in range(4):
+            if not math.isfinite(s.command[i]):
+                return BAD_COMMAND
+        for t in range(s.measures.tool_rows.shape[0]):
+            tool_rows(s.state.tool_jacobian, s.command, qp.A, qp.b, s.measures.tool_rows[t])
+        if p.dense:
+            for i in range(qp.P.shape[0]):
+                for j in range(qp.P.shape[1]):
+                    qp.P[i, j] = p.weights[i] if i == j else 0.0
+        gain = s.objective.gain
+        for i in range(qp.cost.shape[0]):
+            qp.cost[i] = -gain * s.objective.gradient[i]
+        if not p.baseline:
+            _limits(s)
+    if first <= CLOSE <= last:
+        if p.baseline:
+            status = pinv_step(qp.A, qp.b, qp.cost, p.weights, qp.P, p.dense, p.damping, p.info,
+                               p.x)  # fmt: skip
+            if status == -1:
+                return -1
+            return INDEFINITE_METRIC if status == NOT_DEFINITE else SINGULAR_TASK
+        for i in range(qp.lb.shape[0]):
+            if qp.lb[i] > qp.ub[i]:
+                return i
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _limits(s) -> None:  # type: ignore[no-untyped-def]
+    """The bounds (reset, then every box intersected) and the damper rows."""
+    qp, b, q, dt = s.qp, s.bounds, s.state.q, s.dt[0]
+    for i in range(qp.lb.shape[0]):
+        qp.lb[i], qp.ub[i] = -math.inf, math.inf
+    position_bounds(q, b.q_min, b.q_max, dt, qp.lb, qp.ub)
+    velocity_bounds(b.qd_max, qp.lb, qp.ub)
+    if b.accelerate:
+        acceleration_bounds(q, b.accel_q_min, b.accel_q_max, b.qdd_max, b.previous, dt, qp.lb,
+                            qp.ub)  # fmt: skip
+    damper_rows(s.params, s.dampers, dt, qp.G, qp.h)

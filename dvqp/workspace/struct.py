@@ -1,0 +1,91 @@
+"""A dataclass of arrays as one numba struct: many arrays cross into compiled code as one.
+
+Calling a compiled function from Python checks and unboxes each of its arguments, about 50 ns
+an array; a step's stages read about a hundred. :func:`as_struct` packs a frozen dataclass whose
+fields are arrays, numbers or other such dataclasses into one numba structure (a StructRef
+holding the very same arrays, shared, not copied). Compiled code reads it field by field
+(``s.state.q``); from Python it crosses into compiled code in about half a microsecond, whatever
+it holds.
+
+Its numba type is made from the field names and types only, so two dataclasses of the same
+layout have the same type: a compiled function taking it is compiled once per layout and then
+loaded from numba's cache. Arrays must therefore keep their kind from run to run: every array
+field is C-contiguous and writable (:func:`as_struct` refuses others).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numba
+import numpy as np
+from numba import njit, types
+from numba.core.extending import intrinsic
+from numba.experimental import structref
+from numba.experimental.structref import _Utils
+
+
+@structref.register
+class ArraysType(types.StructRef):
+    """The numba type of a packed dataclass: its fields' names and types."""
+
+    def preprocess_fields(self, fields):  # type: ignore[no-untyped-def]
+        return tuple((name, types.unliteral(typ)) for name, typ in fields)
+
+
+class Arrays(structref.StructRefProxy):
+    """A packed dataclass on the Python side (only handed to compiled code)."""
+
+
+structref.define_boxing(ArraysType, Arrays)
+
+
+@intrinsic
+def _fill(typingctx, struct, values):  # type: ignore[no-untyped-def]
+    """Store the items of the tuple ``values`` into the fields of a new ``struct``, in order."""
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        instance, items = args
+        data = _Utils(context, builder, signature.args[0]).get_data_struct(instance)
+        for i, (name, kind) in enumerate(signature.args[0].field_dict.items()):
+            item = builder.extract_value(items, i)
+            context.nrt.incref(builder, kind, item)  # the struct holds its own reference
+            setattr(data, name, item)
+        return context.get_dummy_value()
+
+    return types.none(struct, values), codegen
+
+
+@njit(cache=True)
+def _make(struct_type, values):  # type: ignore[no-untyped-def]
+    instance = structref.new(struct_type)
+    _fill(instance, values)
+    return instance
+
+
+def as_struct(value: Any) -> Arrays:
+    """``value`` (a dataclass instance) as one numba struct of the same fields.
+
+    Fields may be arrays (C-contiguous, writable), Python or NumPy numbers and booleans, or
+    dataclasses of the same kind (packed recursively).
+
+    Raises
+    ------
+    TypeError
+        A field of another kind, or an array that is not C-contiguous and writable.
+    """
+    names, items = [], []
+    for field in dataclasses.fields(value):
+        item = getattr(value, field.name)
+        if dataclasses.is_dataclass(item):
+            item = as_struct(item)
+        elif isinstance(item, np.ndarray):
+            if not (item.flags.c_contiguous and item.flags.writeable):
+                raise TypeError(f"{field.name}: a packed array must be C-contiguous, writable")
+        elif not isinstance(item, bool | int | float | np.number | np.bool_):
+            raise TypeError(f"{field.name}: cannot pack a {type(item).__name__}")
+        names.append(field.name)
+        items.append(item)
+    kind = ArraysType([(name, numba.typeof(item)) for name, item in zip(names, items, strict=True)])
+    return _make(kind, tuple(items))  # type: ignore[no-any-return]

@@ -1,0 +1,334 @@
+"""What the limit tests check the compiled step against.
+
+The distances each limit keeps are measured here independently of the step: clearances by
+:func:`dvqp.geometry.proximity`, heights and frames by :meth:`KinematicState.compute`, the
+distance between two links by a brute-force search on the segments. The formulas are the
+NumPy ones dvqp had before its redesign (``git show 170077d:dvqp/limits/...``): the damper
+rule ``damper_rhs``, the joint boxes (position, velocity, acceleration with braking), the
+gradients of the obstacle rows and of the tilt, and the exact verification (``excess``:
+``min(safe, value at the start) − value``, the worst by its ratio to the tolerance).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from dvqp import KinematicState, Robot
+from dvqp.geometry import proximity
+from dvqp.limits import (
+    NO_EXCESS,
+    AccelerationLimit,
+    Excess,
+    JointPositionLimit,
+    JointVelocityLimit,
+    ObstacleDamper,
+    ProbeHeight,
+    SelfCollision,
+    SurfaceHeight,
+    TiltLimit,
+    VelocityDamper,
+)
+from tests.common import central_difference
+
+Array = NDArray[np.float64]
+
+
+# -- the damper rule and the joint boxes (the old NumPy code) ------------------------------
+
+
+def damper_rhs(distance: Array, safe: float | Array, gain: float, dt: float, depth: float,
+               deceleration: float = math.inf) -> Array:  # fmt: skip
+    """``γ/dt · (d − d_safe)``, capped above ``d_safe`` by the braking speed
+    ``sqrt(2 a (d − d_safe))``; below it, a drift of at most ``δ`` is pulled back no faster
+    than ``a·dt``, and deeper the distance may only not shrink (0)."""
+    room = np.asarray(distance, dtype=float) - safe
+    rhs = np.where(room < -depth, 0.0, gain / dt * room)
+    if math.isinf(deceleration):
+        return rhs
+    return np.clip(rhs, -deceleration * dt, np.sqrt(2.0 * deceleration * np.maximum(room, 0.0)))
+
+
+def position_box(q: Array, q_min: Array, q_max: Array, dt: float) -> tuple[Array, Array]:
+    """``min((q_min − q)/dt, 0) ≤ Q̇ ≤ max((q_max − q)/dt, 0)``."""
+    return np.minimum((q_min - q) / dt, 0.0), np.maximum((q_max - q) / dt, 0.0)
+
+
+def braking(a: Array, dt: float, room: Array) -> Array:
+    """The fastest speed toward a limit ``room`` away that still stops before it:
+    ``Q̇ dt + Q̇²/(2a) = room``."""
+    return -a * dt + np.sqrt((a * dt) ** 2 + 2.0 * a * np.maximum(room, 0.0))
+
+
+def acceleration_box(limit: AccelerationLimit, q: Array, dt: float) -> tuple[Array, Array]:
+    """``|Q̇ − Q̇_prev| ≤ q̈_max dt`` capped by the braking bounds (a joint that cannot brake in
+    time any more keeps its position limit: ``lb = min(lb, ub)``)."""
+    a, previous = limit.qdd_max, limit.previous
+    ub = np.minimum(previous + a * dt, braking(a, dt, limit.q_max - q))
+    lb = np.maximum(previous - a * dt, -braking(a, dt, q - limit.q_min))
+    return np.minimum(lb, ub), ub
+
+
+def joint_box(limits: Sequence[object], q: Array, dt: float) -> tuple[Array, Array]:
+    """The box of every joint limit among ``limits``, intersected."""
+    lb, ub = np.full(q.shape[0], -math.inf), np.full(q.shape[0], math.inf)
+    for limit in limits:
+        if isinstance(limit, JointPositionLimit):
+            low, high = position_box(q, limit.q_min, limit.q_max, dt)
+        elif isinstance(limit, JointVelocityLimit):
+            low, high = -limit.qd_max, limit.qd_max
+        elif isinstance(limit, AccelerationLimit):
+            low, high = acceleration_box(limit, q, dt)
+        else:
+            continue
+        lb, ub = np.maximum(lb, low), np.minimum(ub, high)
+    return lb, ub
+
+
+# -- distances measured independently of the step -------------------------------------------
+
+
+def point_segment(p: Array, c: Array, d: Array) -> Array:
+    """Distances of the points ``p`` (P, 3) to the segments ``c → d`` (P, 3)."""
+    g = d - c
+    t = np.clip(((p - c) * g).sum(-1) / np.maximum((g * g).sum(-1), 1e-300), 0.0, 1.0)
+    return np.linalg.norm(p - c - t[:, None] * g, axis=-1)  # type: ignore[no-any-return]
+
+
+def segment_distance(a: Array, b: Array, c: Array, d: Array) -> tuple[Array, Array]:
+    """Brute force: the smallest distance between the segments ``a → b`` and ``c → d`` (each
+    (P, 3)) and the ``s`` of its point on ``a → b``, by a golden-section search on ``s`` of the
+    exact point-to-segment distance (convex in ``s``)."""
+    lo, hi = np.zeros(a.shape[0]), np.ones(a.shape[0])
+    ratio = 0.5 * (math.sqrt(5.0) - 1.0)
+
+    def f(s: Array) -> Array:
+        return point_segment(a + s[:, None] * (b - a), c, d)
+
+    for _ in range(90):
+        x1, x2 = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
+        left = f(x1) <= f(x2)
+        hi, lo = np.where(left, x2, hi), np.where(left, lo, x1)
+    s = 0.5 * (lo + hi)
+    ends = np.stack([f(np.zeros_like(s)), f(np.ones_like(s)), f(s)])
+    best = ends.argmin(axis=0)
+    return ends.min(axis=0), np.choose(best, [np.zeros_like(s), np.ones_like(s), s])
+
+
+def link_pairs(k: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The non-adjacent pairs ``(i, j)``, ``j ≥ i + 2``, among k guarded links, listed."""
+    pairs = [(i, j) for i in range(k) for j in range(i + 2, k)]
+    return np.array([p[0] for p in pairs], np.int64), np.array([p[1] for p in pairs], np.int64)
+
+
+def link_name(i: int, k: int) -> str:
+    """``"link3"``, or ``"holder"`` for the last guarded link."""
+    return "holder" if i == k - 1 else f"link{i + 1}"
+
+
+def self_distances(origins: Array) -> Array:
+    """Brute-force distances of every non-adjacent pair of the chain ``origins`` (k+1, 3)."""
+    i, j = link_pairs(origins.shape[0] - 1)
+    o = np.asarray(origins, dtype=float)
+    return segment_distance(o[i], o[i + 1], o[j], o[j + 1])[0]
+
+
+def tilt_cosine(state: KinematicState) -> tuple[float, Array]:
+    """``u = cos θ`` of the probe axis to the radial direction and ``∂u/∂Q`` (the old NumPy
+    formula: ``(a × r̂)ᵀ J_ω + aᵀ (P − r̂ r̂ᵀ) J_v / ρ``)."""
+    origin, axis, jac = state.origins[-1], state.axes[-1], state.frame_jacobians[-1]
+    rho = math.hypot(origin[0], origin[1])
+    rx, ry = origin[0] / rho, origin[1] / rho
+    ax, ay, az = axis.tolist()
+    u = ax * rx + ay * ry
+    cross = np.array([-az * ry, az * rx, ax * ry - ay * rx])
+    tangential = np.array([(ax - u * rx) / rho, (ay - u * ry) / rho, 0.0])
+    return u, cross @ jac[3:] + tangential @ jac[:3]
+
+
+def tilt(state: KinematicState) -> float:
+    """θ, rad in [0, π]: the angle between the probe's axis and the radial direction at the
+    tool, from the last frame."""
+    o, a = state.origins[-1], state.axes[-1]
+    radial = np.array([o[0], o[1], 0.0]) / math.hypot(o[0], o[1])
+    return math.acos(max(-1.0, min(1.0, float(a @ radial))))
+
+
+def tilt_sine(state: KinematicState) -> float:
+    """``sin θ``: the length of the probe axis' projection on the pipe's tangent plane."""
+    o, a = state.origins[-1], state.axes[-1]
+    u = (a[0] * o[0] + a[1] * o[1]) / math.hypot(o[0], o[1])
+    return math.sqrt(max(1.0 - u * u, 0.0))
+
+
+@dataclass(frozen=True)
+class Measured:
+    """Every distance a damper keeps at one state, in its rows' order.
+
+    ``gradient`` is the old NumPy formula's ``∂d/∂Q`` (None where only finite differences
+    check it); ``applies`` says which rows apply (gradient defined, below the reach).
+    """
+
+    value: Array
+    gradient: Array | None
+    safe: Array
+    labels: tuple[str, ...]
+    applies: NDArray[np.bool_]
+
+
+def measure(limit: object, state: KinematicState) -> Measured:
+    """The distances of one of dvqp's dampers, or of a user's :class:`VelocityDamper` (its
+    own ``distances``), at ``state``."""
+    k, n = state.k, state.n
+    if type(limit) is ObstacleDamper:
+        return _clearances(limit, state)
+    if type(limit) in (SurfaceHeight, ProbeHeight):
+        rows = slice(0, k) if type(limit) is SurfaceHeight else slice(k, k + 1)
+        labels = (tuple(f"point{i + 1}/height" for i in range(k))
+                  if type(limit) is SurfaceHeight else ("probe/height",))  # fmt: skip
+        value = np.array(state.guarded[rows, 2])
+        gradient = np.array(state.guarded_jacobians[rows, 2, :])
+        return Measured(value, gradient, np.full(value.shape, limit.safe), labels,
+                        np.ones(value.shape, bool))  # fmt: skip
+    if type(limit) is TiltLimit:
+        u, du = tilt_cosine(state)
+        d = tilt_sine(state)
+        gradient = (-u / max(d, 1e-9)) * du
+        return Measured(np.array([d]), gradient[None, :], np.array([limit.safe]),
+                        ("probe/tilt",), np.ones(1, bool))  # fmt: skip
+    if type(limit) is SelfCollision:
+        i, j = link_pairs(k)
+        value = self_distances(np.array(state.origins))
+        labels = tuple(f"{link_name(a, k)}/{link_name(b, k)}" for a, b in zip(i, j, strict=True))
+        return Measured(value, None, np.full(value.shape, limit.margin), labels,
+                        value < limit.margin + limit.influence)  # fmt: skip
+    if isinstance(limit, VelocityDamper):
+        found = limit.distances(state)
+        value = np.asarray(found.value, dtype=float)
+        labels = found.describe() if found.describe is not None else ()
+        safe = np.broadcast_to(np.asarray(found.safe, dtype=float), value.shape).copy()
+        return Measured(value, np.asarray(found.gradient).reshape(-1, n), safe, labels,
+                        value < limit.reach)  # fmt: skip
+    raise TypeError(f"{type(limit).__name__} keeps no distances")
+
+
+def _clearances(limit: ObstacleDamper, state: KinematicState) -> Measured:
+    """Every (point, obstacle) then every (link, obstacle) clearance, obstacle-major, with the
+    old NumPy gradient ``n · ∂p/∂Q`` (a link: at its closest point, an envelope)."""
+    k, n = state.k, state.n
+    count = len(limit.obstacles)
+    if count == 0:
+        return Measured(np.zeros(0), np.zeros((0, n)), np.zeros(0), (), np.zeros(0, bool))
+    near = proximity(state, limit.obstacles)
+    jac = np.array(state.guarded_jacobians[:, :2, :])  # (k+1, 2, n)
+    points, links = near.points, near.links
+    point_rows = np.einsum("jpc,pcn->jpn", points.normal, jac)  # (J, k+1, n)
+    t = links.t[..., None, None]
+    between = (1.0 - t) * jac[None, :-1] + t * jac[None, 1:]  # (J, k, 2, n)
+    link_rows = np.einsum("jlc,jlcn->jln", links.normal, between)
+    point_ok = (points.normal != 0.0).any(axis=-1)
+    link_ok = (links.normal != 0.0).any(axis=-1) & (links.t > 0.0) & (links.t < 1.0)
+    value = np.concatenate([points.distance.ravel(), links.distance.ravel()])
+    gradient = np.concatenate([point_rows.reshape(-1, n), link_rows.reshape(-1, n)])
+    usable = np.concatenate([point_ok.ravel(), link_ok.ravel()])
+    labels = (
+        *(f"{'probe' if i == k else f'point{i + 1}'}/obstacle{j + 1}"
+          for j in range(count) for i in range(k + 1)),
+        *(f"{link_name(i, k)}/obstacle{j + 1}" for j in range(count) for i in range(k)),
+    )  # fmt: skip
+    return Measured(value, gradient, np.full(value.shape, limit.margin), labels,
+                    usable & (value < limit.influence))  # fmt: skip
+
+
+def distance_jacobian(limit: object, robot: Robot, q: Array, radius: float,
+                      eps: float = 1e-7) -> Array:  # fmt: skip
+    """Central differences of every distance of ``limit`` at ``q`` (p, n)."""
+
+    def values(v: Array) -> Array:
+        return measure(limit, KinematicState.compute(robot, v, radius)).value
+
+    return central_difference(values, np.asarray(q, dtype=float), eps)  # type: ignore[no-any-return]
+
+
+# -- the exact verification ------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Verified:
+    """The exact values a limit is verified on, with their safe values and labels."""
+
+    values: Array
+    safe: Array
+    tolerance: float
+    labels: tuple[str, ...]
+    quantity: str
+    unit: str
+
+
+def verified(limit: object, state: KinematicState) -> Verified | None:
+    """The values ``limit`` is verified on at ``state`` (None: nothing to verify)."""
+    if type(limit) is JointPositionLimit:
+        q = np.array(state.q)
+        names = tuple(f"joint{i + 1}" for i in range(state.n))
+        return Verified(np.concatenate([limit.q_max - q, q - limit.q_min]),
+                        np.zeros(2 * state.n), limit.tolerance, names + names,
+                        "joint position", "rad")  # fmt: skip
+    if not isinstance(limit, VelocityDamper):
+        return None
+    if type(limit) is TiltLimit:
+        if limit.min_tilt == 0.0:
+            return None
+        angle = math.asin(min(tilt_sine(state), 1.0))
+        return Verified(np.array([angle]), np.array([limit.min_tilt]), limit.tolerance,
+                        ("probe/tilt",), "tilt", "rad")  # fmt: skip
+    found = measure(limit, state)
+    if found.value.shape[0] == 0:
+        return None
+    labels = found.labels or tuple(f"{limit.name}{i + 1}" for i in range(found.value.shape[0]))
+    return Verified(found.value, found.safe, limit.tolerance, labels, limit.quantity,
+                    limit.unit)  # fmt: skip
+
+
+def worst_excess(limits: Sequence[object], start: KinematicState,
+                 state: KinematicState) -> Excess:  # fmt: skip
+    """The old rule: per value ``over = min(safe, value at start) − value``; the worst is the
+    largest ``over / tolerance`` (a NaN first), the joint room ahead of the dampers."""
+    worst, worst_ratio = NO_EXCESS, -math.inf
+    ordered = sorted(limits, key=lambda limit: type(limit) is not JointPositionLimit)
+    if sum(type(limit) is JointPositionLimit for limit in limits) > 1:
+        raise ValueError("the oracle takes one JointPositionLimit")
+    for limit in ordered:
+        at_start, now = verified(limit, start), verified(limit, state)
+        if now is None or at_start is None:
+            continue
+        over = np.minimum(at_start.safe, at_start.values) - now.values
+        ratio = over / now.tolerance
+        i = int(np.argmax(np.where(np.isnan(ratio), np.inf, ratio)))
+        if not ratio[i] > worst_ratio and not math.isnan(ratio[i]):
+            continue
+        label = now.labels[i] if over[i] > 0.0 else ""
+        if type(limit) is JointPositionLimit:
+            q = float(state.q[i % state.n])
+            bound = q - over[i] if i < state.n else q + over[i]
+            found = Excess(float(over[i]), now.tolerance, label, now.quantity, now.unit, q,
+                           float(bound))  # fmt: skip
+        else:
+            found = Excess(float(over[i]), now.tolerance, label, now.quantity, now.unit,
+                           float(now.values[i]), float(over[i] + now.values[i]))  # fmt: skip
+        worst, worst_ratio = found, float(ratio[i])
+        if math.isnan(ratio[i]):
+            break
+    return worst
+
+
+def assert_excess(found: Excess, want: Excess, atol: float = 1e-12) -> None:
+    """Two excesses agree: values to ``atol``, words exactly."""
+    assert (found.label, found.quantity, found.unit) == (want.label, want.quantity, want.unit)
+    assert found.tolerance == want.tolerance
+    for a, b in ((found.value, want.value), (found.actual, want.actual),
+                 (found.bound, want.bound)):  # fmt: skip
+        assert a == b or abs(a - b) <= atol, (found, want)

@@ -1,0 +1,317 @@
+"""Independent oracles for the resolution, step and run tests (none of dvqp's step code).
+
+- :func:`eq18`, :func:`kkt`: the baseline's step as the paper writes it (eq. 18, weighted), and
+  the minimiser of the equality-constrained QP from its KKT system;
+- :func:`frames`: the guarded frames, their developed-view coordinates and the tool's from
+  Pinocchio (not dvqp's compiled kinematics);
+- :func:`point_distances`, :func:`link_distances`: every shape's signed distance in NumPy (a
+  link by dense sampling: brute force);
+- :func:`segment_distance`: the exact distance of two 3-D segments, by the minimum of the
+  convex quadratic over the square's interior and its four edges (not Ericson's clamping);
+- :func:`verified_values`, :func:`worst_excess`: the exact values a run verifies after each
+  step, and the worst excess of a state, from the above;
+- :func:`kkt_residual`: an optimality certificate of a QP's answer (its KKT conditions, the
+  multipliers found by non-negative least squares of our own).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+from numba import njit
+from numpy.typing import NDArray
+
+from dvqp import Robot
+from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon, Shape
+from dvqp.limits import (
+    JointPositionLimit,
+    ObstacleDamper,
+    ProbeHeight,
+    SelfCollision,
+    SurfaceHeight,
+    TiltLimit,
+)
+
+Array = NDArray[np.float64]
+
+
+# -- the step ---------------------------------------------------------------------------------
+
+
+def eq18(jac: Array, xdot: Array, g: Array, weights: Array | None = None,
+         damping: float = 0.0) -> Array:  # fmt: skip
+    """Eq. 18 in its weighted form, literally: ``J⁺ ẋ + (I − J⁺ J) W⁻¹ g`` with
+    ``J⁺ = W⁻¹ Jᵀ (J W⁻¹ Jᵀ + μ² I)⁻¹`` (``W = I`` by default)."""
+    n, m = jac.shape[1], jac.shape[0]
+    w_inv = np.diag(np.ones(n) if weights is None else 1.0 / np.asarray(weights))
+    jp = w_inv @ jac.T @ np.linalg.inv(jac @ w_inv @ jac.T + damping**2 * np.eye(m))
+    return jp @ xdot + (np.eye(n) - jp @ jac) @ w_inv @ g  # type: ignore[no-any-return]
+
+
+def kkt(jac: Array, xdot: Array, g: Array, metric: Array) -> Array:
+    """The minimiser of ``½ Q̇ᵀ M Q̇ − gᵀ Q̇`` subject to ``J Q̇ = ẋ``, from its KKT system."""
+    n, m = jac.shape[1], jac.shape[0]
+    system = np.block([[metric, jac.T], [jac, np.zeros((m, m))]])
+    return np.linalg.solve(system, np.concatenate([g, xdot]))[:n]  # type: ignore[no-any-return]
+
+
+# -- kinematics -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Frames:
+    """The guarded frames of one configuration, from Pinocchio.
+
+    ``origins``, ``axes`` (k+1, 3): the body points then the tool, base frame; ``guarded``
+    (k+1, 3): ``[l, z, h]`` with ``l = R atan2(y, x)``, ``h = ρ − R``; ``tool`` (4,):
+    ``[l, z, h, α]`` with ``α = atan2(a_z, (O_x a_y − O_y a_x)/ρ)``.
+    """
+
+    origins: Array
+    axes: Array
+    guarded: Array
+    tool: Array
+
+
+def frames(robot: Robot, q: Array, radius: float) -> Frames:
+    """The guarded frames of ``q`` from Pinocchio's forward kinematics."""
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, np.asarray(q, dtype=float))
+    origins = np.array([data.oMf[f].translation for f in robot.frame_ids])
+    axes = np.array([data.oMf[f].rotation[:, 2] for f in robot.frame_ids])
+    rho = np.hypot(origins[:, 0], origins[:, 1])
+    guarded = np.column_stack(
+        [radius * np.arctan2(origins[:, 1], origins[:, 0]), origins[:, 2], rho - radius]
+    )
+    o, a = origins[-1], axes[-1]
+    alpha = math.atan2(a[2], (o[0] * a[1] - o[1] * a[0]) / rho[-1])
+    return Frames(origins, axes, guarded, np.array([*guarded[-1], alpha]))
+
+
+def wrapped(dl: Array, period: float) -> Array:
+    """``dl`` wrapped into ``[−period/2, period/2)``."""
+    return (np.asarray(dl) + 0.5 * period) % period - 0.5 * period  # type: ignore[no-any-return]
+
+
+def tilt(f: Frames) -> float:
+    """The probe axis' angle from the radial direction at the tool, rad, in [0, π]."""
+    o, a = f.origins[-1], f.axes[-1]
+    radial = np.array([o[0], o[1], 0.0]) / math.hypot(o[0], o[1])
+    return math.acos(max(-1.0, min(1.0, float(a @ radial))))
+
+
+# -- distances --------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def _polygon_loop(vl: Array, vz: Array, pl: Array, pz: Array, out: Array) -> None:
+    """Distance of each point to the nearest edge of the closed polygon ``(vl, vz)``,
+    negative inside (a crossing count along +l): a plain double loop."""
+    count = vl.shape[0]
+    for p in range(pl.shape[0]):
+        best, inside = np.inf, False
+        for e in range(count):
+            al, az, bl, bz = vl[e], vz[e], vl[(e + 1) % count], vz[(e + 1) % count]
+            el, ez = bl - al, bz - az
+            t = ((pl[p] - al) * el + (pz[p] - az) * ez) / (el * el + ez * ez)
+            t = min(max(t, 0.0), 1.0)
+            best = min(best, math.hypot(pl[p] - al - t * el, pz[p] - az - t * ez))
+            if (az > pz[p]) != (bz > pz[p]) and pl[p] < al + (pz[p] - az) / (bz - az) * el:
+                inside = not inside
+        out[p] = -best if inside else best
+
+
+def _polygon(vertices: Array, p: Array, period: float) -> Array:
+    """Signed distance of points ``p`` (m, 2) to a simple polygon, l measured from the
+    vertices' mean (wrapped)."""
+    ref = vertices[:, 0].mean()
+    out = np.empty(p.shape[0])
+    _polygon_loop(np.ascontiguousarray(vertices[:, 0] - ref), np.ascontiguousarray(vertices[:, 1]),
+                  np.ascontiguousarray(wrapped(p[:, 0] - ref, period)),
+                  np.ascontiguousarray(p[:, 1]), out)  # fmt: skip
+    return out
+
+
+def point_distances(obstacles: Sequence[Shape], p: Array, period: float) -> Array:
+    """Signed distance (m) of points ``p`` (m, 2) ``[l, z]`` to every obstacle: (J, m)."""
+    out = []
+    for shape in obstacles:
+        if type(shape) is Circle:
+            d = np.column_stack([wrapped(p[:, 0] - shape.center[0], period),
+                                 p[:, 1] - shape.center[1]])  # fmt: skip
+            out.append(np.linalg.norm(d, axis=1) - shape.radius)
+        elif type(shape) is Band:
+            out.append(np.maximum(shape.z_min - p[:, 1], p[:, 1] - shape.z_max))
+        elif type(shape) is Polygon:
+            out.append(_polygon(np.asarray(shape.vertices), p, period))
+        elif type(shape) is Inlet:  # dvqp's outline polygon of the exact intersection curve
+            out.append(_polygon(np.asarray(shape.polygon.vertices), p, period))
+        else:
+            raise TypeError(f"no oracle for {type(shape).__name__}")
+    return np.array(out).reshape(len(out), p.shape[0])
+
+
+def link_distances(obstacles: Sequence[Shape], guarded: Array, period: float,
+                   samples: int = 401) -> Array:  # fmt: skip
+    """Signed distance (m) of every guarded link to every obstacle, brute force: each link
+    sampled at ``samples`` points, then again at ``samples`` points between the neighbours of
+    each obstacle's closest sample: (J, k)."""
+    lz = guarded[:, :2]
+    coarse = np.linspace(0.0, 1.0, samples)
+    step = coarse[1]
+    out = np.zeros((len(obstacles), lz.shape[0] - 1))
+    for i in range(lz.shape[0] - 1):
+        a, b = lz[i], lz[i + 1].copy()
+        b[0] = a[0] + wrapped(b[0] - a[0], period)
+        d = point_distances(obstacles, a + coarse[:, None] * (b - a), period)
+        for j, shape in enumerate(obstacles):
+            t = coarse[np.argmin(d[j])]
+            fine = np.linspace(max(t - step, 0.0), min(t + step, 1.0), samples)
+            near = point_distances([shape], a + fine[:, None] * (b - a), period)
+            out[j, i] = min(d[j].min(), near.min())
+    return out
+
+
+def segment_distance(a: Array, b: Array, c: Array, d: Array) -> float:
+    """The distance of 3-D segments ``ab`` and ``cd``: the smallest of ``‖a + s u − c − t v‖``
+    at the interior stationary point (if in the unit square) and on the square's four edges."""
+    u, v, r = b - a, d - c, a - c
+    uu, vv, uv, ur, vr = u @ u, v @ v, u @ v, u @ r, v @ r
+    candidates = []
+    det = uu * vv - uv * uv
+    if det > 1e-14 * max(uu * vv, 1e-300):
+        s, t = np.linalg.solve([[uu, -uv], [-uv, vv]], [-ur, vr])
+        if 0.0 <= s <= 1.0 and 0.0 <= t <= 1.0:
+            candidates.append((s, t))
+    for s in (0.0, 1.0):  # t free on the edge, the convex 1-D minimum clamped
+        candidates.append((s, min(max((vr + s * uv) / vv, 0.0), 1.0) if vv > 0 else 0.0))
+    for t in (0.0, 1.0):
+        candidates.append((min(max((t * uv - ur) / uu, 0.0), 1.0) if uu > 0 else 0.0, t))
+    return min(float(np.linalg.norm(r + s * u - t * v)) for s, t in candidates)
+
+
+def self_distances(origins: Array) -> Array:
+    """Distances (m) of every pair of non-adjacent guarded links ``(i, j)``, ``j ≥ i + 2``,
+    in ``np.triu_indices(k, 2)`` order (k links between the k+1 frames)."""
+    k = origins.shape[0] - 1
+    i, j = np.triu_indices(k, 2)
+    return np.array([segment_distance(origins[a], origins[a + 1], origins[b], origins[b + 1])
+                     for a, b in zip(i, j, strict=True)])  # fmt: skip
+
+
+# -- the verification -------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Verified:
+    """Exact values of one limit at a state: ``values`` (V,), their ``safe`` value and
+    ``tolerance``, the limit's ``quantity``."""
+
+    values: Array
+    safe: float
+    tolerance: float
+    quantity: str
+
+
+def verified_values(limits: tuple, robot: Robot, q: Array, radius: float) -> list[Verified]:  # type: ignore[type-arg]
+    """The exact values each verified limit of ``limits`` keeps at ``q``, from the oracles."""
+    f = frames(robot, q, radius)
+    period = 2.0 * math.pi * radius
+    out = []
+    for limit in limits:
+        kind = type(limit)
+        if kind is JointPositionLimit:
+            values = np.concatenate([limit.q_max - q, q - limit.q_min])
+            out.append(Verified(values, 0.0, limit.tolerance, "joint position"))
+        elif kind is ObstacleDamper and len(limit.obstacles):
+            points = point_distances(limit.obstacles, f.guarded[:, :2], period)
+            links = link_distances(limit.obstacles, f.guarded, period)
+            values = np.concatenate([points.ravel(), links.ravel()])
+            out.append(Verified(values, limit.margin, limit.tolerance, limit.quantity))
+        elif kind is SurfaceHeight:
+            out.append(Verified(f.guarded[:-1, 2], limit.min_height, limit.tolerance,
+                                limit.quantity))  # fmt: skip
+        elif kind is ProbeHeight:
+            out.append(Verified(f.guarded[-1:, 2], limit.floor, limit.tolerance, limit.quantity))
+        elif kind is TiltLimit and limit.min_tilt > 0.0:
+            angle = tilt(f)
+            out.append(Verified(np.array([min(angle, math.pi - angle)]), limit.min_tilt,
+                                limit.tolerance, limit.quantity))  # fmt: skip
+        elif kind is SelfCollision:
+            out.append(Verified(self_distances(f.origins), limit.margin, limit.tolerance,
+                                limit.quantity))  # fmt: skip
+    return out
+
+
+def worst_excess(start: list[Verified], now: list[Verified]) -> tuple[float, float, str]:
+    """``(value, ratio, quantity)`` of the worst excess at a state (``now``) of a run that
+    started at ``start``: ``value = min(safe, value at the start) − value``, the worst by
+    ``value / tolerance``."""
+    best = (-math.inf, -math.inf, "")
+    for s, v in zip(start, now, strict=True):
+        over = np.minimum(s.safe, s.values) - v.values
+        i = int(np.argmax(over / v.tolerance))
+        if over[i] / v.tolerance > best[1]:
+            best = (float(over[i]), float(over[i] / v.tolerance), v.quantity)
+    return best
+
+
+# -- optimality -------------------------------------------------------------------------------
+
+
+def active_rows(G: Array | None, h: Array | None, lb: Array, ub: Array, x: Array,
+                tol: float = 1e-7) -> Array:  # fmt: skip
+    """The outward normals (rows) of the inequalities ``x`` holds within ``tol`` of equality:
+    rows of ``G``, ``−e_i`` at a lower bound, ``e_i`` at an upper bound."""
+    n = x.shape[0]
+    rows = [] if G is None else [G[i] for i in np.flatnonzero(h - G @ x < tol)]  # type: ignore[operator]
+    rows += [-np.eye(n)[i] for i in np.flatnonzero(x - lb < tol)]
+    rows += [np.eye(n)[i] for i in np.flatnonzero(ub - x < tol)]
+    return np.array(rows).reshape(-1, n)
+
+
+def nnls(M: Array, d: Array, tol: float = 1e-13) -> tuple[Array, float]:
+    """``argmin ‖M z − d‖`` over ``z ≥ 0`` and the residual (Lawson and Hanson's active set)."""
+    k = M.shape[1]
+    z, passive = np.zeros(k), np.zeros(k, dtype=bool)
+    for _ in range(3 * k + 10):
+        w = M.T @ (d - M @ z)
+        if passive.all() or w[~passive].max() <= tol * (1.0 + np.abs(d).max()):
+            break
+        passive[np.argmax(np.where(passive, -np.inf, w))] = True
+        while True:
+            trial = np.zeros(k)
+            trial[passive] = np.linalg.lstsq(M[:, passive], d, rcond=None)[0]
+            if (trial[passive] > 0.0).all():
+                z = trial
+                break
+            shrink = passive & (trial <= 0.0)
+            alpha = np.min(z[shrink] / (z[shrink] - trial[shrink]))
+            z = z + alpha * (trial - z)
+            passive &= z > 0.0
+    return z, float(np.linalg.norm(M @ z - d))
+
+
+def kkt_residual(P: Array, q: Array, A: Array, b: Array, G: Array | None, h: Array | None,
+                 lb: Array, ub: Array, x: Array,
+                 relaxed: float | None = None) -> float:  # fmt: skip
+    """How far ``x`` is from optimal for ``min ½ xᵀPx + qᵀx`` s.t. ``A x = b`` (or, if
+    ``relaxed`` = ρ, with ``+ ½ ρ ‖A x − b‖²`` in the cost instead), ``G x ≤ h``,
+    ``lb ≤ x ≤ ub``: the smallest ``‖∇f + Aᵀν + Σ λ_i a_i‖`` over free ν and ``λ ≥ 0`` on
+    the active inequalities ``a_i`` (ν projected out, λ by non-negative least squares),
+    relative to ``1 + ‖∇f‖``. A convex QP's feasible point with residual 0 is its minimiser."""
+    grad = P @ x + q
+    rows = active_rows(G, h, lb, ub, x).T  # (n, a)
+    if relaxed is None:  # the part of a vector that no Aᵀν cancels
+        project = lambda v: v - A.T @ np.linalg.lstsq(A.T, v, rcond=None)[0]  # noqa: E731
+        target, columns = project(grad), np.column_stack([project(c) for c in rows.T] or
+                                                         [np.zeros(x.shape[0])])  # fmt: skip
+    else:
+        grad = grad + relaxed * A.T @ (A @ x - b)
+        target, columns = grad, rows if rows.shape[1] else np.zeros((x.shape[0], 1))
+    _, residual = nnls(columns, -target)
+    return residual / (1.0 + float(np.linalg.norm(grad)))
