@@ -32,60 +32,19 @@ from dvqp.limits import Bounds, Constraint, Distances, Limit, VelocityDamper
 from dvqp.motion import JogSegment, ToolPath, Trajectory, jog_commands, simulate
 from dvqp.objective import Objective, ObjectiveTerm, Term
 from dvqp.planning import check_run, plan
-from dvqp.resolution import (
-    PseudoinverseResolver,
-    QPResolver,
-    Resolver,
-    Step,
-    StepSpec,
-    make_resolver,
-)
+from dvqp.resolution import PseudoinverseResolver, QPResolver, Resolver, StepSpec, make_resolver
+from dvqp.resolution.step import Step
 from dvqp.scenes import Scene, load_scene
 from dvqp.step import Stepper
 from dvqp.tasks import Task, TaskRows, ToolTask
 from dvqp.workspace import Kernel, StepPlan
 
 __all__ = [
-    "BackendError",
-    "Bounds",
-    "Constraint",
-    "Distances",
-    "DvqpError",
-    "JogSegment",
-    "Kernel",
-    "KinematicState",
-    "Limit",
-    "LimitViolationError",
-    "Objective",
-    "ObjectiveTerm",
-    "Obstacle",
-    "ObstacleSet",
-    "ParameterError",
-    "PseudoinverseResolver",
-    "QPResolver",
-    "Resolver",
-    "Robot",
-    "Scene",
-    "SceneError",
-    "ShapeError",
-    "SingularConfigurationError",
-    "Step",
-    "StepPlan",
-    "StepSpec",
-    "Stepper",
-    "Task",
-    "TaskRows",
-    "Term",
-    "ToolPath",
-    "ToolTask",
-    "Trajectory",
-    "UnreachableTargetError",
-    "VelocityDamper",
-    "__version__",
-    "check_run",
-    "jog_commands",
-    "load_scene",
-    "make_resolver",
-    "plan",
-    "simulate",
-]
+    "BackendError", "Bounds", "Constraint", "Distances", "DvqpError", "JogSegment", "Kernel",
+    "KinematicState", "Limit", "LimitViolationError", "Objective", "ObjectiveTerm", "Obstacle",
+    "ObstacleSet", "ParameterError", "PseudoinverseResolver", "QPResolver", "Resolver", "Robot",
+    "Scene", "SceneError", "ShapeError", "SingularConfigurationError", "Step", "StepPlan",
+    "StepSpec", "Stepper", "Task", "TaskRows", "Term", "ToolPath", "ToolTask", "Trajectory",
+    "UnreachableTargetError", "VelocityDamper", "__version__", "check_run", "jog_commands",
+    "load_scene", "make_resolver", "plan", "simulate",
+]  # fmt: skip

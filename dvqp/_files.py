@@ -46,14 +46,9 @@ def atomic_file(target: Path) -> Iterator[Path]:
     """Yield a temporary path beside ``target``; on success it replaces ``target``.
 
     The file appears complete or not at all: on any error (a full disk, Ctrl-C) the temporary
-    file is removed and an existing ``target`` is left as it was. The new file gets the usual
-    mode (``0o666 & ~umask``), not ``mkstemp``'s 0600.
-
-    Raises
-    ------
-    OutputError
-        ``output: <target>: cannot write: <reason>`` for an operating-system error while
-        creating, writing or renaming the file (e.g. ``No space left on device``).
+    file is removed and an existing ``target`` is left as it was; an operating-system error
+    raises :class:`~dvqp.errors.OutputError`. The new file gets the usual mode
+    (``0o666 & ~umask``), not ``mkstemp``'s 0600.
     """
     try:
         fd, tmp = tempfile.mkstemp(
@@ -74,11 +69,8 @@ def atomic_file(target: Path) -> Iterator[Path]:
 
 def _finish(tmp: Path, target: Path) -> None:
     """Flush ``tmp`` to the disk (a full disk may only show here), set its mode, rename it."""
-    fd = os.open(tmp, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
+    with open(tmp, "rb") as fh:
+        os.fsync(fh.fileno())
     umask = os.umask(0)
     os.umask(umask)
     os.chmod(tmp, 0o666 & ~umask)
@@ -91,14 +83,10 @@ def _output_error(target: Path, exc: OSError) -> OutputError:
 
 @contextlib.contextmanager
 def c_output_captured(lines: list[str]) -> Iterator[None]:
-    """Send what C/C++ code writes to the file descriptors 1 and 2 into ``lines``.
-
-    For libraries that print to the terminal themselves (Pinocchio's URDF parser): their
-    output is kept off the terminal, and the caller may quote it. The non-empty lines, with
-    runs of white space collapsed, are appended to ``lines`` when the block ends, also on an
-    error. Python's ``sys.stdout`` and ``sys.stderr`` are flushed first; a descriptor that is
-    not open is left alone.
-    """
+    """Keep what C/C++ code (Pinocchio's URDF parser) writes to the file descriptors 1 and 2
+    off the terminal: its non-empty lines, white space collapsed, are appended to ``lines``
+    when the block ends, also on an error. ``sys.stdout`` and ``sys.stderr`` are flushed
+    first; a descriptor that is not open is left alone."""
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(AttributeError, OSError, ValueError):
             stream.flush()

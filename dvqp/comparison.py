@@ -1,13 +1,14 @@
-"""Run scenes with several backends on the same commands and gather comparable figures.
+"""Run scenes with several backends on the same commands; their rows as a table or CSV.
 
-Each scene is loaded once per worker and run with every backend in turn, so the ratio of a
-backend's step time to ``pinv``'s compares runs made in the same process, one after the
-other. :func:`compare` runs scenes in parallel processes when ``jobs > 1`` (timings are then
-noisier: the processes share the machine).
+Each scene is loaded once per worker and run with every backend in turn, so ``ratio_to_pinv``
+compares runs made one after the other in the same process. :func:`compare` runs scenes in
+parallel processes when ``jobs > 1`` (noisier timings). The row helpers serve ``dvqp bench``.
 """
 
 from __future__ import annotations
 
+import csv
+import io
 import os
 import platform
 import signal
@@ -16,6 +17,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from dvqp import load_scene, plan
 from dvqp.errors import DvqpError
@@ -47,36 +49,28 @@ def _finite(value: float) -> float | None:
     return v if np.isfinite(v) else None
 
 
+def _least(values: NDArray[np.float64]) -> float | None:
+    """The smallest of ``values`` if there are any and it is finite, else None."""
+    return _finite(np.min(values)) if values.size else None
+
+
 def summarize(scene: Scene, traj: Trajectory) -> Row:
-    """The figures of one run.
+    """The figures of one run of ``scene`` (``traj`` from :func:`dvqp.plan`), as a dict:
 
-    Parameters
-    ----------
-    scene
-        The scene that was run.
-    traj
-        Its trajectory, from :func:`dvqp.plan`.
-
-    Returns
-    -------
-    dict
-        ``success``: the run can be sent to the arm — no step failed, every saved sample
-        keeps every limit to its tolerance, and a path's end was reached
-        (:func:`dvqp.planning.check_run`); ``error`` says why not. ``steps``; ``failures``
-        (steps not solved or that broke a limit even in substeps); ``relaxed`` (steps whose
-        task gave way to a limit) and ``braking`` (steps where the limits conflicted among
-        themselves and the arm slowed down toward rest); ``substepped`` (steps split to keep
-        a limit); median and 95th-percentile full step time (µs), the medians of the solver
-        call alone and of the rest of the step (µs) and of the solver's iterations; the largest
-        task error
-        ``‖J̄Q̇ − ẋ‖∞`` of the succeeded steps; the smallest clearance of any guarded part
-        (m) and the part and obstacle that have it (``closest``); the probe's own smallest
-        clearance (m); the smallest probe tilt from radial (rad); the smallest distance
-        between non-adjacent links (m) and that pair (``closest_pair``); the largest joint
-        acceleration (rad/s²); ``max_limit_excess`` of the worst limit (in its unit, see
-        ``worst_limit``); the largest joint-limit violation (rad) of ``q`` and
-        velocity-limit violation (rad/s) of ``Q̇``; the final tracking error (m) against the
-        commanded motion; ``final_tool`` ``[l, z, h, α]``. Undefined figures are None.
+    ``success``: the run can be sent to the arm (:func:`dvqp.planning.check_run`); ``error``
+    says why not. ``steps``; ``failures`` (steps not solved or that broke a limit even in
+    substeps); ``relaxed`` (the task gave way to a limit) and ``braking`` (the limits
+    conflicted and the arm slowed toward rest); ``substepped`` (steps split to keep a limit);
+    median and 95th-percentile full step time (µs), the medians of the solver call alone and
+    of the rest of the step (µs) and of the solver's iterations; the largest task error
+    ``‖J̄Q̇ − ẋ‖∞`` of the succeeded steps; the smallest clearance of any guarded part (m) and
+    the part and obstacle that have it (``closest``); the probe's own smallest clearance (m);
+    the smallest probe tilt from radial (rad); the smallest distance between non-adjacent
+    links (m) and that pair (``closest_pair``); the largest joint acceleration (rad/s²);
+    ``max_limit_excess`` of the worst limit (in its unit, see ``worst_limit``); the largest
+    joint-limit violation (rad) of ``q`` and velocity-limit violation (rad/s) of ``Q̇``; the
+    final tracking error (m) against the commanded motion; ``final_tool`` ``[l, z, h, α]``.
+    Undefined figures are None.
     """
     ok = traj.success
     steps_us = traj.step_time * 1e6
@@ -118,32 +112,25 @@ def _solver_figures(traj: Trajectory) -> Row:
 
 
 def _clearances(scene: Scene, traj: Trajectory) -> Row:
-    """``min_clearance``, ``closest``, ``min_probe_clearance`` and ``min_tilt``."""
-    closest = None
+    """Clearances (and their closest pairs), tilt and the largest joint acceleration."""
+    closest = pair = None
     if len(scene.obstacles) and np.isfinite(traj.min_clearance).any():
         k = int(np.argmin(traj.min_clearance))
         state = KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius)
         _, part, j = proximity(state, scene.obstacles).closest()
         closest = f"{part}/obstacle{j + 1}"
+    if traj.self_distance.size:
+        k = int(np.argmin(traj.self_distance))
+        _, pair = self_distance(KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius))
     return {
         "min_clearance": _finite(np.min(traj.min_clearance)),
         "closest": closest,
-        "min_probe_clearance": _finite(np.min(traj.probe_clearance))
-        if traj.probe_clearance.size
-        else None,
-        "min_tilt": _finite(np.min(traj.tilt)) if traj.tilt.size else None,
-        **_self_distance(scene, traj),
+        "min_probe_clearance": _least(traj.probe_clearance),
+        "min_tilt": _least(traj.tilt),
+        "min_self_distance": _least(traj.self_distance),
+        "closest_pair": pair or None,
         "max_joint_acceleration": _finite(np.abs(traj.qddot).max()) if traj.qddot.size else None,
     }
-
-
-def _self_distance(scene: Scene, traj: Trajectory) -> Row:
-    """``min_self_distance`` (m) and ``closest_pair`` (e.g. ``"link1/holder"``)."""
-    if not traj.self_distance.size:
-        return {"min_self_distance": None, "closest_pair": None}
-    k = int(np.argmin(traj.self_distance))
-    _, pair = self_distance(KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius))
-    return {"min_self_distance": _finite(traj.self_distance[k]), "closest_pair": pair or None}
 
 
 def _limit_figures(scene: Scene, traj: Trajectory) -> Row:
@@ -152,13 +139,10 @@ def _limit_figures(scene: Scene, traj: Trajectory) -> Row:
     q_out = np.maximum(robot.q_min - traj.q, traj.q - robot.q_max)
     qd_out = np.abs(traj.qdot) - robot.qd_max
     worst = worst_sample_excess(scene, traj)
-    if worst is not None and worst[1].value <= 0.0:  # kept, or a limit not in the scene
-        worst = None
+    excess = worst[1] if worst is not None and not worst[1].value <= 0.0 else None  # else kept
     return {
-        "max_limit_excess": float(worst[1].value) if worst is not None else 0.0,
-        "worst_limit": (
-            f"{worst[1].label} {worst[1].quantity} ({worst[1].unit})" if worst is not None else None
-        ),
+        "max_limit_excess": float(excess.value) if excess else 0.0,
+        "worst_limit": f"{excess.label} {excess.quantity} ({excess.unit})" if excess else None,
         "max_joint_limit_violation": float(max(0.0, np.max(q_out))),
         "max_velocity_limit_violation": float(max(0.0, np.max(qd_out, initial=0.0))),
     }
@@ -178,37 +162,35 @@ def run_scene(
 ) -> list[Row]:
     """Load a scene and run it with every backend; the rows in ``backends`` order.
 
-    A run that raises a :class:`~dvqp.errors.DvqpError` (a singular configuration, a solver
-    that gave up) gives a row with ``success`` False and the message in ``error``.
+    A run that raises a :class:`~dvqp.errors.DvqpError` gives an :func:`error_row`.
     ``progress(backend)`` is called after each run.
     """
     scene = load_scene(path)
     rows = []
     for backend in backends:
         try:
-            row = summarize(scene, plan(scene, backend))
+            rows.append(summarize(scene, plan(scene, backend)))
         except DvqpError as exc:
-            row = _error_row(scene, backend, exc)
-        rows.append(row)
+            rows.append(error_row(scene, backend, exc))
         if progress is not None:
             progress(backend)
-    _add_ratios(rows)
+    add_ratios(rows)
     return rows
 
 
-def _error_row(scene: Scene, backend: str, exc: DvqpError) -> Row:
-    """The row of a run that raised: every figure None, ``success`` False, ``error`` set."""
-    row: Row = {key: None for key in (*FIELDS, "final_tool")}
-    row.update(scene=scene.name, file=scene.source, backend=backend, success=False)
-    row["error"] = str(exc)
+def error_row(scene: Scene, backend: str, exc: Exception, extra: Sequence[str] = ()) -> Row:
+    """The row of a run that raised: ``success`` False, ``error`` the message of ``exc``, every
+    other figure (keys :data:`FIELDS`, then ``extra``, then ``final_tool``) None."""
+    row: Row = dict.fromkeys((*FIELDS, *extra, "final_tool"))
+    row.update(scene=scene.name, file=scene.source, backend=backend, success=False, error=str(exc))
     return row
 
 
-def _add_ratios(rows: Sequence[Row]) -> None:
-    """Set ``ratio_to_pinv``: median step time over ``pinv``'s among ``rows`` (one scene)."""
+def add_ratios(rows: Sequence[Row]) -> None:
+    """Set ``ratio_to_pinv`` of ``rows`` (one scene's): median step time over ``pinv``'s."""
     base = next((r["median_step_us"] for r in rows if r["backend"] == PINV), None)
     for row in rows:
-        if base and row["median_step_us"] is not None:
+        if base and row.get("median_step_us") is not None:
             row["ratio_to_pinv"] = row["median_step_us"] / base
 
 
@@ -220,17 +202,9 @@ def compare(
 ) -> list[Row]:
     """Run every scene with every backend; rows grouped by scene in ``paths`` order.
 
-    Parameters
-    ----------
-    paths
-        Scene files (already validated by the caller, or errors surface here).
-    backends
-        Resolver names (checked by the caller with
-        :func:`dvqp.resolution.registry.check_name`; an unknown one gives failed rows).
-    jobs
-        Worker processes (one scene per task); 1 runs in this process.
-    progress
-        Called as ``progress(done, total, label)``, counting runs (scene × backend).
+    The scene files and backend names are checked by the caller (else scene errors surface
+    here; an unknown backend gives failed rows). ``jobs`` worker processes run one scene each
+    (1: all in this process). ``progress(done, total, label)`` counts runs (scene × backend).
     """
     total, done = len(paths) * len(backends), 0
     results: dict[str, list[Row]] = {}
@@ -253,6 +227,43 @@ def compare(
     return [row for path in paths for row in results[path]]
 
 
+def cell(value: Any, fmt: str = "{}") -> str:
+    """A table cell: ``-`` for None, ``yes``/``NO`` for a flag, else ``fmt.format(value)``."""
+    if value is None:
+        return "-"
+    if isinstance(value, bool):
+        return "yes" if value else "NO"
+    return fmt.format(value)
+
+
+def aligned(table: Sequence[Sequence[str]], left: int = 1) -> str:
+    """Rows of cells as text columns two spaces apart, a rule of ``-`` under the first row;
+    the first ``left`` columns left-justified, the others right-justified."""
+    widths = [max(len(line[i]) for line in table) for i in range(len(table[0]))]
+    just = [str.ljust] * left + [str.rjust] * (len(widths) - left)
+    lines = [
+        "  ".join(j(c, w) for j, c, w in zip(just, line, widths, strict=True)) for line in table
+    ]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def csv_cell(value: Any) -> str:
+    """A CSV cell: empty for None or a non-finite float, ``true``/``false`` for a flag."""
+    if value is None or (isinstance(value, float) and not np.isfinite(value)):
+        return ""
+    return str(value).lower() if isinstance(value, bool) else str(value)
+
+
+def rows_to_csv(rows: Sequence[Row], fields: Sequence[str] = FIELDS) -> str:
+    """The rows as CSV text: a header of ``fields``, then one line per row (:func:`csv_cell`)."""
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(fields)
+    writer.writerows([csv_cell(row.get(key)) for key in fields] for row in rows)
+    return buf.getvalue()
+
+
 def machine() -> dict[str, Any]:
     """Platform, processor, CPU count and Python version of this machine."""
     return {
@@ -266,8 +277,8 @@ def machine() -> dict[str, Any]:
 def quiet_worker() -> None:
     """Make Ctrl-C end this worker process at once, silently (exit code 130).
 
-    For ``ProcessPoolExecutor(initializer=quiet_worker)``: workers that are not forked from
-    inside :func:`interruptible` (the ``spawn`` and ``forkserver`` start methods) then stop as
-    forked ones do, instead of each printing a traceback.
+    For ``ProcessPoolExecutor(initializer=quiet_worker)``: workers not forked from inside
+    :func:`dvqp.cli.progress.interruptible` (``spawn``, ``forkserver``) then stop as forked
+    ones do, instead of each printing a traceback.
     """
     signal.signal(signal.SIGINT, lambda signum, frame: os._exit(130))

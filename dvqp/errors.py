@@ -12,11 +12,8 @@ from collections.abc import Sequence
 
 
 def one_line(text: str) -> str:
-    """``text`` with line breaks and other unprintable characters escaped (``\\n``).
-
-    Messages quote what the user wrote (keys, file names, parser output): this keeps each on
-    one line.
-    """
+    """``text`` with line breaks and other unprintable characters escaped (``\\n``), so that a
+    message quoting what the user wrote stays on one line."""
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
 
 
@@ -25,17 +22,8 @@ class DvqpError(Exception):
 
 
 class ShapeError(DvqpError, ValueError):
-    """An array has the wrong shape.
-
-    Parameters
-    ----------
-    name
-        Name of the argument or field.
-    expected
-        Expected shape; ``-1`` stands for "any length".
-    actual
-        Shape that was given.
-    """
+    """An array (argument or field ``name``) has the ``actual`` shape, not the ``expected``
+    one (``-1`` in it: any length)."""
 
     def __init__(self, name: str, expected: Sequence[int], actual: Sequence[int]) -> None:
         self.name = name
@@ -47,15 +35,8 @@ class ShapeError(DvqpError, ValueError):
 
 
 class ParameterError(DvqpError, ValueError):
-    """A parameter has an invalid value (negative radius, dt <= 0, NaN, ...).
-
-    Parameters
-    ----------
-    name
-        Name of the parameter or field.
-    reason
-        What is wrong with it, e.g. ``"must be > 0"``.
-    """
+    """A parameter or field ``name`` has an invalid value (negative radius, dt <= 0, NaN...);
+    ``reason`` says what is wrong, e.g. ``"must be > 0"``."""
 
     def __init__(self, name: str, reason: str) -> None:
         self.name = name
@@ -66,12 +47,8 @@ class ParameterError(DvqpError, ValueError):
 class SingularConfigurationError(DvqpError, ArithmeticError):
     """The developed view or the task Jacobian is singular at this configuration.
 
-    Parameters
-    ----------
-    what
-        Which quantity is singular (``"tool: rho = 0"``, ``"task Jacobian"``...).
-    q
-        The joint configuration, rad, shape (n,), if known.
+    ``what`` is singular (``"tool: rho = 0"``, ``"task Jacobian"``...) at the joint
+    configuration ``q`` (rad, shape (n,), or None if unknown).
     """
 
     def __init__(self, what: str, q: object = None) -> None:
@@ -97,17 +74,8 @@ class BackendError(DvqpError):
 
 
 class SceneError(DvqpError, ValueError):
-    """A scene file is malformed; the message is ``<file>: <field>: <reason>``.
-
-    Parameters
-    ----------
-    path
-        The scene file (or ``"<string>"``).
-    field
-        Dotted path of the field, e.g. ``"obstacles[1].radius"``.
-    reason
-        What is wrong.
-    """
+    """A scene file is malformed: ``<path>: <field>: <reason>``, ``path`` the file (or
+    ``"<string>"``), ``field`` the dotted path of the field (``"obstacles[1].radius"``)."""
 
     def __init__(self, path: str, field: str, reason: str) -> None:
         self.path = path
@@ -118,19 +86,11 @@ class SceneError(DvqpError, ValueError):
 
 
 class OutputError(DvqpError, OSError):
-    """An output file could not be written (a directory in the way, a full disk, ...).
+    """The output file ``path`` could not be written: ``reason`` (``"No space left on
+    device"``), with the operating system's ``errno`` if there was one.
 
     Nothing is left behind: the file is written to a temporary name and renamed only when
     complete. Also an :class:`OSError`, so code that catches those still does.
-
-    Parameters
-    ----------
-    path
-        The file that was to be written.
-    reason
-        Why it could not be, e.g. ``"No space left on device"``.
-    errno
-        The operating system's error number, if there was one.
     """
 
     def __init__(self, path: object, reason: str, errno: int | None = None) -> None:
@@ -148,17 +108,8 @@ class OutputError(DvqpError, OSError):
 
 class LimitViolationError(DvqpError):
     """A planned motion breaks a limit (the baseline holds none; a QP run that could not keep
-    one fails its step instead).
-
-    Parameters
-    ----------
-    message
-        One line naming the limit, the part and the amount.
-    sample
-        Index of the worst sample.
-    excess
-        How far past the limit, in its unit (m or rad).
-    """
+    one fails its step instead): ``message`` names the limit, the part and the amount,
+    ``sample`` is the worst sample's index, ``excess`` how far past the limit (m or rad)."""
 
     def __init__(self, message: str, sample: int, excess: float) -> None:
         self.sample = sample

@@ -1,9 +1,9 @@
 """Offline trajectory generation from a :class:`~dvqp.scenes.Scene`.
 
 :func:`plan` runs a scene's motion with a named resolver (``"pinv"``, the paper's baseline, or
-a QP backend; see :mod:`dvqp.resolution.registry`) on the scene's step, to which a user may
-add tasks and limits of their own. In JOG mode the tool gets the JOG velocities; in path mode
-it follows the waypoints with position feedback ``ẋ = ẋ_d + K(x_d − x)``.
+a QP backend) on the scene's step plus any tasks and limits of the caller's. In JOG mode the
+tool gets the JOG velocities; in path mode it follows the waypoints with position feedback
+``ẋ = ẋ_d + K(x_d − x)``.
 """
 
 from __future__ import annotations
@@ -69,9 +69,7 @@ def ramped(reference: NDArray[np.float64], ramp: float, dt: float) -> NDArray[np
     window = round(ramp / dt)
     if window <= 1:
         return reference
-    padded = np.vstack([np.repeat(reference[:1], window - 1, axis=0), reference,
-                        np.repeat(reference[-1:], window - 1, axis=0)])  # fmt: skip
-    return box_average(padded, window)
+    return box_average(np.pad(reference, ((window - 1, window - 1), (0, 0)), mode="edge"), window)
 
 
 def plan(
@@ -86,13 +84,10 @@ def plan(
     """Run a scene with a resolver and return its trajectory.
 
     The trajectory carries the scene text and ``tracking_error`` (``x_d − x`` per sample,
-    l and α wrapped). A run whose steps failed or whose path ends off target is returned as
-    well; :func:`check_run` says whether and why it failed.
+    l and α wrapped). A failed run is returned as well; :func:`check_run` says why it failed.
 
     Parameters
     ----------
-    scene
-        The scene.
     backend
         ``"pinv"`` or a QP backend name (:func:`dvqp.resolution.registry.available_resolvers`).
     tasks, limits
@@ -124,11 +119,9 @@ def plan(
 def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> None:
     """Raise if a planned run failed: steps that failed, a broken limit, a path's end missed.
 
-    The path's end counts as reached when the final position error is within
-    ``path.tolerance`` (m) and the heading error within ``path.heading_tolerance`` (rad).
-
-    ``limits`` are the limits given to :func:`plan` beyond the scene's own, so that a broken
-    one is named.
+    The path's end is reached when the final position error is within ``path.tolerance`` (m)
+    and the heading error within ``path.heading_tolerance`` (rad). ``limits``: those given to
+    :func:`plan` beyond the scene's own, so that a broken one is named.
 
     Raises
     ------
@@ -175,12 +168,8 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
 def worst_sample_excess(
     scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()
 ) -> tuple[int, Excess] | None:
-    """The sample whose limit excess is worst relative to its tolerance, and that excess.
-
-    None if the trajectory has no sample or records no excess (a file from before 0.2).
-    """
-    if traj.limit_excess.shape[0] == 0:
-        return None
+    """The sample whose limit excess is worst relative to its tolerance, and that excess; None
+    if no sample exceeds a limit (or the file, from before 0.2, records no excess)."""
     candidates = np.flatnonzero(traj.limit_excess > 0.0)
     if candidates.shape[0] == 0:
         return None

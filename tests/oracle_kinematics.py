@@ -16,6 +16,7 @@ so that the map is checked frame by frame).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 import pinocchio as pin
@@ -23,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from dvqp import Robot
 from dvqp.errors import SingularConfigurationError
+from dvqp.kinematics.dh import DHRow, fixed_part
 
 Array = NDArray[np.float64]
 
@@ -153,3 +155,41 @@ def on_surface(l: float, z: float, h: float, radius: float) -> Array:
     """The Cartesian point (m) at DV position ``(l, z, h)`` around a pipe of ``radius``."""
     phi = l / radius
     return np.array([(radius + h) * math.cos(phi), (radius + h) * math.sin(phi), z])
+
+
+def dh_transform(row: DHRow, theta: float) -> NDArray[np.float64]:
+    """Homogeneous transform ``T_i^{i-1}`` of one DH row at joint angle ``theta``, (4, 4)."""
+    th = theta + row.theta_offset
+    ct, st = np.cos(th), np.sin(th)
+    rz = np.array([[ct, -st, 0.0, 0.0], [st, ct, 0.0, 0.0], [0, 0, 1.0, 0], [0, 0, 0, 1.0]])
+    return rz @ fixed_part(row)
+
+
+def forward_dh(
+    table: Sequence[DHRow], q: ArrayLike, tool: NDArray[np.float64] | None = None
+) -> list[NDArray[np.float64]]:
+    """Plain DH product: the transforms ``T_1^0, …, T_n^0`` and, if given, ``T_e^0``.
+
+    Parameters
+    ----------
+    table
+        The n DH rows.
+    q
+        Joint angles, rad, shape (n,).
+    tool
+        ``T_e^n``, shape (4, 4), or None.
+
+    Returns
+    -------
+    list of ndarray
+        n transforms (n+1 with a tool), each (4, 4), in the base frame.
+    """
+    qv = np.asarray(q, dtype=float)
+    out = []
+    t = np.eye(4)
+    for row, th in zip(table, qv, strict=True):
+        t = t @ dh_transform(row, th)
+        out.append(t)
+    if tool is not None:
+        out.append(t @ tool)
+    return out

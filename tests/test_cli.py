@@ -430,6 +430,28 @@ def test_the_progress_bar_tells_the_time_left(monkeypatch: pytest.MonkeyPatch) -
     assert [duration(s) for s in (42, 210, 4680, 9000)] == ["42 s", "3.5 min", "78 min", "2.5 h"]
 
 
+def test_the_time_left_counts_from_the_first_step_not_from_compiling(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from dvqp.cli.progress import ProgressBar
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    clock = iter([0.0, 1.5, 20.0, 20.0, 30.0])
+    monkeypatch.setattr("dvqp.cli.progress.time.perf_counter", lambda: next(clock))
+    term = Terminal()
+    bar = ProgressBar(term)  # started at t = 0
+    bar.show(0, 1, "compiling")  # t = 1.5
+    bar.note("compiled in 20 s")  # a line of its own
+    bar.show(1, 11, "steps")  # t = 20: the steps' clock starts here, at step 1
+    bar.show(6, 11, "steps")  # t = 30: 10 s for 5 steps, 5 more: 10 s left (not 40)
+    text = term.getvalue()
+    assert "dvqp: compiled in 20 s\n" in text
+    assert text.split("\r")[-1].startswith("[################..............] 6/11 10 s left")
+
+
 def test_a_quiet_worker_ends_on_ctrl_c_without_a_word() -> None:
     code = (
         "import os, signal, time\n"

@@ -3,9 +3,10 @@ import pinocchio as pin
 import pytest
 
 from dvqp.errors import ParameterError, ShapeError
-from dvqp.kinematics.dh import DHRow, check_transform, dh_transform, forward_dh, ndt13_table
+from dvqp.kinematics.dh import DHRow, check_transform, ndt13_table
 from dvqp.kinematics.robot import NDT13_POINT_JOINTS, Robot
 from tests.common import LINK_LENGTHS, random_configurations
+from tests.oracle_kinematics import dh_transform, forward_dh
 
 
 def pinocchio_frames(robot: Robot, q: np.ndarray) -> list[np.ndarray]:

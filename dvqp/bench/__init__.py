@@ -1,16 +1,9 @@
 """``dvqp bench``: a seeded suite of random scenes run with every backend, here or on Dask.
 
-- :mod:`dvqp.bench.generate` draws the scenes (:func:`generate_scenes`), one seeded stream
-  each, with :mod:`~dvqp.bench.obstacles` and :mod:`~dvqp.bench.motion`, written as TOML by
-  :mod:`~dvqp.bench.toml_text`;
-- :mod:`dvqp.bench.runner` runs one scene with every backend (:func:`run_job`);
-- :mod:`dvqp.bench.execution` runs the jobs here or in a process pool,
-  :mod:`dvqp.bench.dask_run` on a Dask cluster (optional: ``pip install 'dvqp[dask]'``);
-- :mod:`dvqp.bench.summary` sums the runs up per backend (shifted geometric means);
-- :mod:`dvqp.bench.output` prints and writes them; :mod:`dvqp.bench.suite` ties it together
-  (:func:`run_suite`).
-
-See ``docs/bench.md``.
+:mod:`~dvqp.bench.generate` draws the scenes, :mod:`~dvqp.bench.runner` runs one with every
+backend, :mod:`~dvqp.bench.execution` (here) or :mod:`~dvqp.bench.dask_run` runs the suite,
+:mod:`~dvqp.bench.summary` sums it up, :mod:`~dvqp.bench.output` writes it and
+:func:`run_suite` ties it together. See ``docs/bench.md``.
 """
 
 from dvqp.bench.dask_run import DaskUnavailableError, import_distributed
@@ -27,24 +20,8 @@ from dvqp.bench.summary import (
 )
 
 __all__ = [
-    "SHIFT_US",
-    "BenchInterrupted",
-    "BenchScene",
-    "DaskUnavailableError",
-    "Job",
-    "Suite",
-    "bench_json",
-    "format_summary",
-    "generate_scene",
-    "generate_scenes",
-    "import_distributed",
-    "make_suite",
-    "outcome_differences",
-    "qp_disagreement",
-    "rows_to_csv",
-    "run_job",
-    "run_suite",
-    "save_scenes",
-    "shifted_geometric_mean",
-    "summarize_backends",
-]
+    "SHIFT_US", "BenchInterrupted", "BenchScene", "DaskUnavailableError", "Job", "Suite",
+    "bench_json", "format_summary", "generate_scene", "generate_scenes", "import_distributed",
+    "make_suite", "outcome_differences", "qp_disagreement", "rows_to_csv", "run_job", "run_suite",
+    "save_scenes", "shifted_geometric_mean", "summarize_backends",
+]  # fmt: skip

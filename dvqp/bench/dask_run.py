@@ -18,8 +18,6 @@ from dvqp.bench.execution import OnRows, Progress, Where
 from dvqp.bench.runner import Job, run_job
 from dvqp.errors import DvqpError, one_line
 
-DASK_HINT = "pip install 'dvqp[dask]'"
-"""What installs Dask for dvqp."""
 CONNECT_TIMEOUT = "10s"
 """How long to wait for an existing scheduler."""
 
@@ -28,7 +26,7 @@ class DaskUnavailableError(DvqpError, ImportError):
     """Dask's distributed scheduler is not installed."""
 
     def __init__(self) -> None:
-        super().__init__(f"needs Dask: {DASK_HINT}")
+        super().__init__("needs Dask: pip install 'dvqp[dask]'")
 
 
 def _load_distributed() -> ModuleType:
@@ -39,29 +37,11 @@ def _load_distributed() -> ModuleType:
 
 
 def import_distributed() -> ModuleType:
-    """The ``dask.distributed`` module.
-
-    Raises
-    ------
-    DaskUnavailableError
-        Dask (with ``distributed``) is not installed.
-    """
+    """The ``dask.distributed`` module; :class:`DaskUnavailableError` if it is not installed."""
     try:
         return _load_distributed()
     except ImportError as exc:
         raise DaskUnavailableError() from exc
-
-
-@contextlib.contextmanager
-def _quiet_logs() -> Iterator[None]:
-    """Keep Dask's informational log lines (cluster start and stop) off the terminal."""
-    logger = logging.getLogger("distributed")
-    level = logger.level
-    logger.setLevel(logging.ERROR)
-    try:
-        yield
-    finally:
-        logger.setLevel(level)
 
 
 @contextlib.contextmanager
@@ -73,8 +53,7 @@ def dask_client(scheduler: str, workers: int = 1) -> Iterator[tuple[Any, Where]]
     scheduler
         A scheduler's address (``tcp://host:8786``), or ``"local"`` to start a
         ``LocalCluster`` of ``workers`` single-threaded workers in this process (threads:
-        quick to start and stopped cleanly by Ctrl-C, but they share the interpreter; for
-        runs side by side use local processes, ``workers`` without a scheduler).
+        quick to start and stopped cleanly by Ctrl-C, but sharing the interpreter).
     workers
         Workers of a LocalCluster (ignored for an existing scheduler).
 
@@ -86,7 +65,10 @@ def dask_client(scheduler: str, workers: int = 1) -> Iterator[tuple[Any, Where]]
         ``scheduler <address>: cannot connect: <reason>``, or ``… no worker within 10s``.
     """
     dd = import_distributed()
-    with _quiet_logs(), contextlib.ExitStack() as stack:
+    logger = logging.getLogger("distributed")
+    with contextlib.ExitStack() as stack:
+        stack.callback(logger.setLevel, logger.level)
+        logger.setLevel(logging.ERROR)  # no info lines on the cluster's start and stop
         try:
             if scheduler == "local":
                 cluster = stack.enter_context(
@@ -112,13 +94,9 @@ def run_dask(
 ) -> None:
     """Run every job on the cluster of ``client``, handing each scene's rows to ``on_rows``.
 
-    Ctrl-C (KeyboardInterrupt) cancels what has not finished and propagates.
-
-    Raises
-    ------
-    DvqpError
-        A job failed on a worker for another reason than a failed run (e.g. dvqp missing
-        there): ``dask: <scene>: <error>``.
+    Ctrl-C (KeyboardInterrupt) cancels what has not finished and propagates. A job that fails
+    on a worker for another reason than a failed run (e.g. dvqp missing there) raises
+    ``DvqpError("dask: <scene>: <error>")``.
     """
     dd = import_distributed()
     total, done = sum(len(job.backends) for job in jobs), 0

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 from dvqp.bench.runner import Job, Row, run_job
 from dvqp.comparison import quiet_worker
@@ -22,17 +22,9 @@ OnRows = Callable[[list[Row]], None]
 
 @dataclass(frozen=True)
 class Where:
-    """Where the runs went.
-
-    Attributes
-    ----------
-    kind : str
-        ``"local"`` (this process or a local pool) or ``"dask"``.
-    workers : int
-        Runs that could go on at the same time (processes, or Dask worker threads).
-    scheduler : str or None
-        The Dask scheduler's address (``"local"`` for a LocalCluster).
-    """
+    """Where the runs went: ``kind`` ``"local"`` (this process or a local pool) or ``"dask"``,
+    ``workers`` runs that could go on at the same time (processes, or Dask worker threads), and
+    the Dask ``scheduler``'s address (``"local"`` for a LocalCluster, None for local runs)."""
 
     kind: str
     workers: int
@@ -45,11 +37,10 @@ class Where:
 
     def as_dict(self) -> dict[str, object]:
         """For the JSON document."""
-        return {"kind": self.kind, "workers": self.workers, "scheduler": self.scheduler,
-                "parallel": self.parallel}  # fmt: skip
+        return {**asdict(self), "parallel": self.parallel}
 
     def describe(self) -> str:
-        """``local, 1 process (runs one after the other)``, ``dask at tcp://…, 4 workers …``."""
+        """``local, 1 process (one run at a time)``, ``dask (tcp://…), 4 worker threads (…)``."""
         place = "local" if self.kind == "local" else f"dask ({self.scheduler})"
         unit = "process" if self.kind == "local" else "worker thread"
         plural = "" if self.workers == 1 else "es" if unit == "process" else "s"
@@ -70,8 +61,7 @@ def run_local(
     Ctrl-C (KeyboardInterrupt) stops the pool without waiting for it and propagates; the
     rows of the scenes finished before it have been handed to ``on_rows``.
     """
-    total = sum(len(job.backends) for job in jobs)
-    done = 0
+    total, done = sum(len(job.backends) for job in jobs), 0
 
     def tick(count: int, label: str) -> None:
         nonlocal done

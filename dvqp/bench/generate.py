@@ -2,10 +2,9 @@
 
 Scene ``i`` of seed ``s`` is drawn from ``np.random.default_rng([s, i])`` alone, so it is the
 same whatever the count, the workers or the machine. A draw is kept only if
-:func:`dvqp.scenes.loads` accepts its text, every guarded part of the arm starts clear of
-every obstacle by the margin, and the run has 10 to ``2 * MAX_STEPS`` steps (the motion is
-drawn to take at most :data:`~dvqp.bench.motion.MAX_STEPS`); otherwise the scene is drawn
-again from the same stream. The distribution is documented in ``docs/bench.md``.
+:func:`dvqp.scenes.loads` accepts its text, the arm starts clear of every obstacle by the
+margin and the run has 10 to ``2 * MAX_STEPS`` steps; else it is drawn again from the same
+stream. The distribution is documented in ``docs/bench.md``.
 """
 
 from __future__ import annotations
@@ -13,7 +12,6 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -21,7 +19,7 @@ from numpy.typing import NDArray
 from dvqp._files import atomic_file
 from dvqp.bench.motion import DT_CHOICES, MAX_STEPS, draw_jog, draw_path, tool_track
 from dvqp.bench.obstacles import SHAPE_ORDER, Start, draw_obstacles
-from dvqp.bench.toml_text import dumps
+from dvqp.bench.toml_text import Table, dumps
 from dvqp.errors import DvqpError, ParameterError
 from dvqp.geometry import min_clearance
 from dvqp.kinematics import KinematicState, Robot
@@ -41,25 +39,10 @@ ATTEMPTS = 100
 
 @dataclass(frozen=True)
 class BenchScene:
-    """A generated scene.
-
-    Attributes
-    ----------
-    seed, index : int
-        Where it comes from: ``default_rng([seed, index])``.
-    name : str
-        ``bench-s<seed>-<index:04d>``; its file is ``<name>.toml``.
-    text : str
-        The scene file (accepted by :func:`dvqp.scenes.loads`).
-    mode : str
-        ``"jog"`` or ``"path"``.
-    shapes : tuple of str
-        The obstacles' shapes, in file order.
-    dt : float
-        Step, s.
-    steps : int
-        Steps of one run.
-    """
+    """A generated scene: drawn from ``default_rng([seed, index])``, named
+    ``bench-s<seed>-<index:04d>``, its scene file's ``text``, its ``mode`` (``"jog"`` or
+    ``"path"``), its obstacles' ``shapes`` in file order, its step ``dt`` (s) and the
+    ``steps`` of one run."""
 
     seed: int
     index: int
@@ -87,13 +70,8 @@ def _robot() -> Robot:
 
 
 def generate_scene(seed: int, index: int) -> BenchScene:
-    """Scene ``index`` of ``seed`` (independent of any other scene).
-
-    Raises
-    ------
-    ParameterError
-        ``seed`` or ``index`` negative, or no acceptable scene in :data:`ATTEMPTS` draws.
-    """
+    """Scene ``index`` of ``seed`` (independent of any other scene); ParameterError if ``seed``
+    or ``index`` is negative, or no acceptable scene comes in :data:`ATTEMPTS` draws."""
     if seed < 0 or index < 0:
         raise ParameterError("seed", f"seed and index must be >= 0, got {seed}, {index}")
     rng = np.random.default_rng([seed, index])
@@ -130,7 +108,7 @@ def _accepted_steps(scene: Scene, margin: float) -> int | None:
     return steps if 10 <= steps <= 2 * MAX_STEPS else None
 
 
-def _draw(rng: np.random.Generator, seed: int, index: int) -> dict[str, Any] | None:
+def _draw(rng: np.random.Generator, seed: int, index: int) -> Table | None:
     """One draw of the whole scene as a TOML document (None: its start is unusable)."""
     q0 = _draw_q0(rng)
     try:

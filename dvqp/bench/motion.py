@@ -1,24 +1,30 @@
-"""Random motions: operator JOG sequences and paths along the weld, short by construction.
-
-Both are drawn as the ``[motion]`` table of a scene file. A run has at most
-:data:`MAX_STEPS` steps: JOG durations are scaled down to fit, a path's speed raised. The
-distribution is documented in ``docs/bench.md``.
+"""Random motions, drawn as a scene file's ``[motion]`` table: operator JOG sequences and paths
+along the weld, their durations scaled down or speed raised to fit in :data:`MAX_STEPS` steps.
+The distribution is documented in ``docs/bench.md``.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from dvqp.bench.toml_text import Table
+from dvqp.motion import ToolPath
 
 DT_CHOICES = (0.005, 0.01, 0.02)
 """Step sizes drawn from, s."""
 MAX_STEPS = 240
 """Most steps of a generated run."""
-
-Table = dict[str, Any]
+JOG_KINDS = (
+    ((0, 0.03, 0.08),),  # along the weld
+    ((1, 0.02, 0.05),),  # along the pipe
+    ((3, 0.2, 0.6),),  # a turn
+    ((2, 0.005, 0.015),),  # up or down
+    ((0, 0.02, 0.06), (1, 0.02, 0.04), (3, 0.0, 0.3)),  # a diagonal
+)
+"""Kinds of JOG segment: (axis of ``[l̇, ż, ḣ, α̇]``, low, high) of each speed (m/s, rad/s)."""
 
 
 def _r(value: float, digits: int = 4) -> float:
@@ -30,22 +36,10 @@ def _sign(rng: np.random.Generator) -> float:
 
 
 def _jog_velocity(rng: np.random.Generator) -> list[float]:
-    """``[l̇, ż, ḣ, α̇]`` of one segment: along the weld, along the pipe, a turn, up or down,
-    or a diagonal (m/s, rad/s)."""
-    kind = int(rng.integers(0, 5))
+    """``[l̇, ż, ḣ, α̇]`` of one segment of a random kind: each speed uniform, of either sign."""
     v = [0.0, 0.0, 0.0, 0.0]
-    if kind == 0:
-        v[0] = _sign(rng) * rng.uniform(0.03, 0.08)
-    elif kind == 1:
-        v[1] = _sign(rng) * rng.uniform(0.02, 0.05)
-    elif kind == 2:
-        v[3] = _sign(rng) * rng.uniform(0.2, 0.6)
-    elif kind == 3:
-        v[2] = _sign(rng) * rng.uniform(0.005, 0.015)
-    else:
-        v[0] = _sign(rng) * rng.uniform(0.02, 0.06)
-        v[1] = _sign(rng) * rng.uniform(0.02, 0.04)
-        v[3] = _sign(rng) * rng.uniform(0.0, 0.3)
+    for axis, low, high in JOG_KINDS[int(rng.integers(0, len(JOG_KINDS)))]:
+        v[axis] = _sign(rng) * rng.uniform(low, high)
     return [_r(x) for x in v]
 
 
@@ -59,16 +53,6 @@ def draw_jog(rng: np.random.Generator, dt: float) -> Table:
         for d in durations
     ]
     return {"dt": dt, "jog": segments}
-
-
-def path_length(points: NDArray[np.float64]) -> float:
-    """Length of a waypoint polyline as the planner times it, m.
-
-    Each segment counts its (l, z, h) length or 0.1 m per radian of heading change, whichever
-    is longer (``docs/scenes.md``).
-    """
-    d = np.diff(points, axis=0)
-    return float(np.maximum(np.linalg.norm(d[:, :3], axis=1), 0.1 * np.abs(d[:, 3])).sum())
 
 
 def draw_path(rng: np.random.Generator, tool: NDArray[np.float64], dt: float) -> Table:
@@ -90,7 +74,7 @@ def draw_path(rng: np.random.Generator, tool: NDArray[np.float64], dt: float) ->
         points.append([l + direction * rng.uniform(0.04, 0.12), z0 + dz,
                        h0 + rng.uniform(-0.005, 0.005), a + turn])  # fmt: skip
     waypoints = [[_r(x) for x in p] for p in points]
-    length = path_length(np.array([list(tool), *waypoints]))
+    length = float(ToolPath.segment_lengths(np.array([list(tool), *waypoints])).sum())
     speed = max(float(rng.uniform(0.05, 0.12)), length / (MAX_STEPS * dt))
     speed = math.ceil(speed * 1e4) / 1e4
     return {"dt": dt, "path": {"waypoints": waypoints, "speed": speed, "gain": 5.0}}

@@ -1,24 +1,25 @@
 """Random obstacles of every shape around the weld and the arm, never over the start.
 
-Each obstacle is drawn as the ``[[obstacles]]`` table a scene file holds, then built with the
-same shape class the scene loader uses and checked against the arm's start configuration:
-every guarded part (body points and links, the probe and its holder) must start at least
-``margin + START_GAP`` from it, else it is drawn again (at most :data:`TRIES` times, then left
-out). The distribution is documented in ``docs/bench.md``.
+Each obstacle is drawn as a scene file's ``[[obstacles]]`` table, read as the scene loader
+reads it, and kept only if every guarded part of the arm starts at least ``margin + START_GAP``
+from it; else it is drawn again (at most :data:`TRIES` times, then left out). The distribution
+is documented in ``docs/bench.md``.
 """
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp.bench.toml_text import Table
 from dvqp.errors import DvqpError
-from dvqp.geometry import ObstacleSet, min_clearance
-from dvqp.geometry.shapes import SHAPES
+from dvqp.geometry import min_clearance
 from dvqp.kinematics import KinematicState
+from dvqp.scenes.fields import Fields
+from dvqp.scenes.obstacles import obstacles as read_obstacles
 
 SHAPE_ORDER = ("circle", "inlet", "band", "polygon")
 """The shapes drawn; scene i's first obstacle is ``SHAPE_ORDER[i % 4]``."""
@@ -27,27 +28,13 @@ START_GAP = 0.003
 TRIES = 40
 """Draws of one obstacle before it is left out."""
 
-Table = dict[str, Any]
-
 
 @dataclass(frozen=True)
 class Start:
-    """Where the arm starts, what the obstacles are placed around.
-
-    Attributes
-    ----------
-    state : KinematicState
-        The arm at ``q0``.
-    weld : float
-        z of the weld, m (the tool's start z).
-    margin : float
-        The scene's obstacle margin, m.
-    beside_weld : bool
-        Keep circles, inlets and polygons off the weld line (a path follows it).
-    track : ndarray, shape (m, 2)
-        ``[l, z]`` of the tool's commanded motion, m: its start, then the end of each JOG
-        segment or each waypoint.
-    """
+    """What the obstacles are placed around: the arm's ``state`` at ``q0``, the ``weld``'s z
+    (m), the scene's obstacle ``margin`` (m), whether to keep circles, inlets and polygons off
+    the weld line (``beside_weld``: a path follows it) and the ``track``, ``[l, z]`` (m) of
+    the tool's commanded motion (:func:`dvqp.bench.motion.tool_track`)."""
 
     state: KinematicState
     weld: float
@@ -71,22 +58,13 @@ def draw_obstacles(rng: np.random.Generator, start: Start, first: str) -> list[T
 
 
 def start_clearance(table: Table, start: Start) -> float:
-    """Smallest start clearance (m) of the arm's guarded parts to one obstacle table.
-
-    The table is built as the scene loader builds it; one the shape refuses counts as
-    ``-inf`` (drawn again).
-    """
-    cls = SHAPES[table.get("shape", "circle")]
-    values = {}
-    for key, (kind, default) in cls.SCENE_FIELDS.items():
-        value = table.get(key, default)
-        array = kind in ("point", "interval", "points")
-        values[key] = np.asarray(value, dtype=float) if array else value
+    """Smallest start clearance (m) of the arm's guarded parts to one obstacle table, read by
+    the scene loader; a table it refuses counts as ``-inf`` (drawn again)."""
     try:
-        shape = cls.from_scene(values, start.state.radius)
+        obstacle = read_obstacles(Fields("<bench>"), {"obstacles": [table]}, start.state.radius)
     except DvqpError:
         return -np.inf
-    return min_clearance(start.state, ObstacleSet([shape]))
+    return min_clearance(start.state, obstacle)
 
 
 def _mm(value: float) -> float:
@@ -128,19 +106,12 @@ def _anchor(rng: np.random.Generator, start: Start, size: float) -> tuple[float,
     return part[0] + gap * np.cos(angle), part[1] + gap * np.sin(angle)
 
 
-def _round_shape(rng: np.random.Generator, start: Start, kind: str) -> Table:
+def _round(rng: np.random.Generator, start: Start, kind: str) -> Table:
+    """A circle or an inlet."""
     radius = rng.uniform(0.025, 0.07)
     l, z = _anchor(rng, start, radius)
     return {"shape": kind, "center": [_mm(l), _mm(z)], "radius": _mm(radius),
             "weight": _weight(rng)}  # fmt: skip
-
-
-def _circle(rng: np.random.Generator, start: Start) -> Table:
-    return _round_shape(rng, start, "circle")
-
-
-def _inlet(rng: np.random.Generator, start: Start) -> Table:
-    return _round_shape(rng, start, "inlet")
 
 
 def _band(rng: np.random.Generator, start: Start) -> Table:
@@ -167,5 +138,10 @@ def _polygon(rng: np.random.Generator, start: Start) -> Table:
     return {"shape": "polygon", "vertices": vertices, "weight": _weight(rng)}
 
 
-DRAW = {"circle": _circle, "inlet": _inlet, "band": _band, "polygon": _polygon}
+DRAW = {
+    "circle": functools.partial(_round, kind="circle"),
+    "inlet": functools.partial(_round, kind="inlet"),
+    "band": _band,
+    "polygon": _polygon,
+}
 """One drawing function per shape of :data:`SHAPE_ORDER`."""

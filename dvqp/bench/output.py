@@ -6,17 +6,15 @@ cells; flags are ``true``/``false`` in the CSV.
 
 from __future__ import annotations
 
-import csv
-import io
 import json
-import math
 from dataclasses import dataclass
 from typing import Any
 
 from dvqp._versions import versions
 from dvqp.bench.execution import Where
 from dvqp.bench.runner import EXTRA_FIELDS, Row
-from dvqp.comparison import FIELDS, machine
+from dvqp.comparison import FIELDS, aligned, cell, machine
+from dvqp.comparison import rows_to_csv as csv_text
 
 COLUMNS = (  # (summary key, header, format of a defined value)
     ("runs", "runs", "{}"), ("succeeded", "ok", "{}"), ("success_rate", "success", "{:.1%}"),
@@ -29,36 +27,18 @@ COLUMNS = (  # (summary key, header, format of a defined value)
 )  # fmt: skip
 """Columns of :func:`format_summary` after the backend's name."""
 
-CSV_FIELDS = (
-    "index", *(f for f in FIELDS if f != "index"), *(f for f in EXTRA_FIELDS if f != "index"),
-    "final_l", "final_z", "final_h", "final_alpha", "parallel",
-)  # fmt: skip
+TOOL = ("final_l", "final_z", "final_h", "final_alpha")
+CSV_FIELDS = ("index", *FIELDS, *EXTRA_FIELDS, *TOOL, "parallel")
 """Columns of :func:`rows_to_csv`."""
 
 
 @dataclass(frozen=True)
 class Suite:
-    """A finished (or interrupted) bench: what the outputs are made of.
-
-    Attributes
-    ----------
-    seed, count : int
-        The suite asked for.
-    backends : tuple of str
-        In the order they ran.
-    where : Where
-        Where the runs went.
-    rows : list of dict
-        One per finished scene and backend, by scene index then backend.
-    summary : dict
-        :func:`dvqp.bench.summary.summarize_backends`.
-    disagreement : dict
-        :func:`dvqp.bench.summary.qp_disagreement`.
-    shift_us : float
-        Shift of the shifted geometric means, µs.
-    interrupted : bool
-        Ctrl-C stopped it; ``rows`` holds the scenes finished before.
-    """
+    """A finished (or ``interrupted`` by Ctrl-C) bench, what the outputs are made of: the
+    ``seed`` and ``count`` asked for, the ``backends`` in the order they ran, ``where`` they ran,
+    the ``rows`` of the finished scenes (by scene index, then backend), their ``summary``
+    (:func:`~dvqp.bench.summary.summarize_backends`) and ``disagreement``
+    (:func:`~dvqp.bench.summary.qp_disagreement`), and the sgm shift ``shift_us`` (µs)."""
 
     seed: int
     count: int
@@ -71,28 +51,15 @@ class Suite:
     interrupted: bool = False
 
 
-def _cell(value: Any, fmt: str) -> str:
-    return "-" if value is None else fmt.format(value)
-
-
 def format_summary(suite: Suite) -> str:
     """The per-backend table and the notes under it (shift, timing, agreement)."""
-    head = [["backend", *(h for _, h, _ in COLUMNS)]]
-    body = [[b, *(_cell(suite.summary[b][k], f) for k, _, f in COLUMNS)] for b in suite.backends]
-    table = head + body
-    widths = [max(len(line[i]) for line in table) for i in range(len(head[0]))]
-    lines = [
-        "  ".join(
-            c.ljust(w) if i == 0 else c.rjust(w)
-            for i, (c, w) in enumerate(zip(line, widths, strict=True))
-        )
-        for line in table
-    ]
-    lines.insert(1, "  ".join("-" * w for w in widths))
+    table = [["backend", *(h for _, h, _ in COLUMNS)]]
+    table += [[b, *(cell(suite.summary[b][k], f) for k, _, f in COLUMNS)] for b in suite.backends]
     scenes = len({r["scene"] for r in suite.rows})
     timed = suite.summary[suite.backends[0]]["timed_scenes"] if suite.backends else 0
     d = suite.disagreement
-    lines += [
+    lines = [
+        aligned(table),
         "",
         f"scenes          {scenes} of {suite.count} (seed {suite.seed}), {len(suite.rows)} runs"
         + (" (interrupted)" if suite.interrupted else ""),
@@ -111,17 +78,6 @@ def format_summary(suite: Suite) -> str:
     return "\n".join(lines)
 
 
-def _clean(value: Any) -> Any:
-    """``value`` with every non-finite float replaced by None (JSON has no NaN)."""
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {k: _clean(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_clean(v) for v in value]
-    return value
-
-
 def _marked(suite: Suite) -> list[Row]:
     """The rows, each marked ``parallel`` when its timing came from workers side by side."""
     return [{**row, "parallel": suite.where.parallel} for row in suite.rows]
@@ -135,25 +91,13 @@ def bench_json(suite: Suite) -> str:
         "shift_us": suite.shift_us, "results": _marked(suite), "summary": suite.summary,
         "qp_disagreement": suite.disagreement, "machine": machine(), "versions": versions(),
     }  # fmt: skip
-    return json.dumps(_clean(doc), indent=2, allow_nan=False) + "\n"
+    clean = json.loads(json.dumps(doc), parse_constant=lambda _: None)  # NaN, ±inf: null
+    return json.dumps(clean, indent=2, allow_nan=False) + "\n"
 
 
 def rows_to_csv(suite: Suite) -> str:
-    """One CSV line per scene and backend (:data:`CSV_FIELDS`), a header first."""
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(CSV_FIELDS)
-    for row in _marked(suite):
-        tool = row.get("final_tool") or [None] * 4
-        names = ("final_l", "final_z", "final_h", "final_alpha")
-        flat = {**row, **dict(zip(names, tool, strict=True))}
-        writer.writerow([_csv_cell(flat.get(key)) for key in CSV_FIELDS])
-    return buf.getvalue()
-
-
-def _csv_cell(value: Any) -> str:
-    if value is None or (isinstance(value, float) and not math.isfinite(value)):
-        return ""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    return str(value)
+    """One CSV line per scene and backend (:data:`CSV_FIELDS`, ``final_tool`` spread over
+    :data:`TOOL`), a header first."""
+    flat = [{**r, **dict(zip(TOOL, r.get("final_tool") or [None] * 4, strict=True))}
+            for r in _marked(suite)]  # fmt: skip
+    return csv_text(flat, CSV_FIELDS)

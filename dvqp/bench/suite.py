@@ -1,9 +1,5 @@
-"""Run a suite of generated scenes with every backend, here or on Dask, and sum it up.
-
-:func:`run_suite` is what ``dvqp bench`` calls after its checks. Ctrl-C raises
-:class:`BenchInterrupted`, a ``KeyboardInterrupt`` that carries the suite of the scenes
-finished before it, so they can still be written.
-"""
+"""Run a suite of generated scenes with every backend, here or on Dask, and sum it up:
+:func:`run_suite`, what ``dvqp bench`` calls after its checks."""
 
 from __future__ import annotations
 
@@ -18,7 +14,8 @@ from dvqp.bench.summary import SHIFT_US, qp_disagreement, summarize_backends
 
 
 class BenchInterrupted(KeyboardInterrupt):
-    """Ctrl-C during a suite; ``suite`` holds the scenes finished before it."""
+    """Ctrl-C during a suite (a ``KeyboardInterrupt``); ``suite`` holds the scenes finished
+    before it, so they can still be written."""
 
     def __init__(self, suite: Suite) -> None:
         super().__init__()
@@ -38,24 +35,12 @@ def run_suite(
 ) -> Suite:
     """Run every scene with every backend and sum the runs up per backend.
 
-    Parameters
-    ----------
-    scenes
-        The generated scenes (:func:`dvqp.bench.generate.generate_scenes`).
-    backends
-        Resolver names, checked by the caller.
-    seed
-        The seed the scenes came from (reported).
-    workers
-        Local processes, or the workers of a Dask LocalCluster.
-    scheduler
-        None to run locally; a Dask scheduler's address, or ``"local"`` for a LocalCluster.
-    progress
-        ``progress(done, total, label)`` counting runs.
-    ready
-        Called once where the runs go is ready (a scheduler reached), before the first run.
-    shift
-        Shift of the shifted geometric means, µs.
+    ``scenes`` come from :func:`~dvqp.bench.generate.generate_scenes` with ``seed`` (reported),
+    ``backends`` are resolver names checked by the caller. ``scheduler`` None runs them in
+    ``workers`` local processes, else on a Dask scheduler at that address, or on a LocalCluster
+    of ``workers`` for ``"local"``. ``progress(done, total, label)`` counts runs; ``ready(where)``
+    is called once where the runs go is ready (a scheduler reached), before the first run.
+    ``shift``: of the shifted geometric means, µs.
 
     Raises
     ------

@@ -1,10 +1,9 @@
 """The bench's figures per backend: success, steps, shifted geometric means, agreement.
 
-The shifted geometric mean of times ``t_1 … t_n`` (µs) with shift ``s`` is
-``exp(mean(log(t_i + s))) − s``, as in qpbenchmark: a geometric mean (a ratio of two is the
-typical ratio of their times) that the shift keeps from being ruled by the shortest times.
-Each backend's mean is over the same scenes (those every backend ran to the end) and is also
-given relative to the best backend's (1.0 = the fastest). See ``docs/bench.md``.
+Times are compared by their shifted geometric mean, as in qpbenchmark: a ratio of two is the
+typical ratio of the times, and the shift keeps the shortest times from ruling it. Every
+backend's is over the same scenes (those every backend ran) and relative to the fastest
+backend's. See ``docs/bench.md``.
 """
 
 from __future__ import annotations
@@ -26,13 +25,8 @@ OUTCOME_KEYS = ("success", "steps", "failures", "relaxed", "substepped", "error"
 
 
 def shifted_geometric_mean(values: Sequence[float], shift: float = SHIFT_US) -> float:
-    """``exp(mean(log(v + shift))) − shift`` of non-negative ``values`` (same unit as shift).
-
-    Raises
-    ------
-    ParameterError
-        No value, a negative or non-finite value, or a shift <= 0.
-    """
+    """``exp(mean(log(v + shift))) − shift`` of non-negative ``values`` (same unit as shift);
+    ParameterError for no value, a negative or non-finite value, or a shift <= 0."""
     v = np.asarray(values, dtype=float)
     if v.size == 0 or not np.all(np.isfinite(v)) or np.any(v < 0) or not shift > 0:
         raise ParameterError("values", "need finite values >= 0 and a shift > 0")
@@ -40,8 +34,7 @@ def shifted_geometric_mean(values: Sequence[float], shift: float = SHIFT_US) -> 
 
 
 def _max(values: Sequence[float | None]) -> float | None:
-    defined = [v for v in values if v is not None]
-    return max(defined) if defined else None
+    return max((v for v in values if v is not None), default=None)
 
 
 def summarize_backends(
@@ -56,14 +49,13 @@ def summarize_backends(
     to the best backend; ``timed_scenes``; ``worst_limit_excess`` (m or rad);
     ``worst_task_error``; ``max_distance_to_qp_median_m`` (final tool position, m).
     """
-    mine = {b: [r for r in rows if r["backend"] == b] for b in backends}
     timed = _timed_scenes(rows, backends)
     step = _sgm_column(rows, backends, timed, "mean_step_us", shift)
     solve = _sgm_column(rows, backends, timed, "mean_solve_us", shift)
     distance = _distance_to_qp_median(rows)
     out = {}
     for b in backends:
-        runs = mine[b]
+        runs = [r for r in rows if r["backend"] == b]
         ok = sum(1 for r in runs if r["success"])
         out[b] = {
             "runs": len(runs),
@@ -121,15 +113,10 @@ def _final_positions(rows: Sequence[Row]) -> dict[str, dict[str, np.ndarray]]:
 
 
 def qp_disagreement(rows: Sequence[Row]) -> dict[str, Any]:
-    """The largest spread of the final tool position among QP backends that succeeded.
-
-    Returns
-    -------
-    dict
-        ``max_spread_m`` (largest distance between two QP backends' final tool positions
-        ``[l, z, h]`` on one scene, m; None if no scene had two successful QP runs),
-        ``scene`` and ``backends`` (the pair), ``scenes_compared``.
-    """
+    """The largest spread of the final tool position among QP backends that succeeded:
+    ``max_spread_m`` (largest distance between two QP backends' final ``[l, z, h]`` on one
+    scene, m; None if no scene had two successful QP runs), that ``scene`` and ``backends``
+    pair, and ``scenes_compared``."""
     worst: dict[str, Any] = {"max_spread_m": None, "scene": None, "backends": None}
     compared = 0
     for scene, finals in _final_positions(rows).items():
@@ -159,11 +146,8 @@ def _distance_to_qp_median(rows: Sequence[Row]) -> dict[str, float]:
 
 
 def outcome_differences(a: Sequence[Row], b: Sequence[Row], tol: float = 1e-9) -> list[str]:
-    """How two runs of the same suite differ in outcome (timings aside); empty if they agree.
-
-    Compares :data:`OUTCOME_KEYS` exactly and ``final_tool`` to ``tol`` (m, rad), per scene
-    and backend.
-    """
+    """How two runs of the same suite differ in outcome, per scene and backend: in
+    :data:`OUTCOME_KEYS` or in ``final_tool`` by more than ``tol`` (m, rad); empty if they agree."""
     index_a = {(r["scene"], r["backend"]): r for r in a}
     index_b = {(r["scene"], r["backend"]): r for r in b}
     found = [f"{s} / {k}: only in one" for s, k in sorted(set(index_a) ^ set(index_b))]

@@ -1,8 +1,6 @@
-"""Write a generated scene, a nested dict, as TOML text (the subset scene files use).
-
-Only what :mod:`dvqp.bench.generate` builds is supported: strings, booleans, integers,
-floats and arrays of them (nested), tables and arrays of flat tables. Floats are written with
-``repr``, so reading the text back gives exactly the same numbers.
+"""Write a generated scene, a nested dict, as TOML text: strings, booleans, integers, floats
+and (nested) arrays of them, tables and arrays of flat tables, the subset scene files use.
+Floats are written with ``repr``, so reading the text back gives exactly the same numbers.
 """
 
 from __future__ import annotations
@@ -19,13 +17,8 @@ Table = dict[str, Any]
 
 
 def dumps(doc: Table, comment: str = "") -> str:
-    """``doc`` as TOML text, an optional ``# comment`` block first.
-
-    Raises
-    ------
-    ParameterError
-        A value TOML (or this writer) cannot hold: NaN, infinity, an unknown type.
-    """
+    """``doc`` as TOML text, an optional ``# comment`` block first; ParameterError for a value
+    TOML (or this writer) cannot hold: NaN, infinity, an unknown type."""
     lines = [f"# {line}" if line else "#" for line in comment.splitlines()]
     _table(lines, (), doc)
     return "\n".join(lines).strip("\n") + "\n"

@@ -9,6 +9,7 @@ then the command ends as an interrupted one (exit 130). See ``docs/bench.md``.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 import tempfile
 from dataclasses import dataclass
@@ -37,21 +38,9 @@ from dvqp.resolution.registry import check_name, default_resolvers
 
 @dataclass(frozen=True)
 class Options:
-    """The checked options of one ``dvqp bench``.
-
-    Attributes
-    ----------
-    count, seed, workers : int
-        Scenes, their seed, local processes (or LocalCluster workers).
-    backends : tuple of str
-        Known resolver names, without repeats.
-    scheduler : str or None
-        A Dask scheduler's address, ``"local"``, or None to run locally.
-    json, csv : Path or None
-        Output files (checked writable).
-    scenes_dir : Path or None
-        Where to save the scene files (an existing folder, or one to create).
-    """
+    """The checked options of one ``dvqp bench``: ``backends`` known and without repeats,
+    ``scheduler`` an address, ``"local"`` or None (run here), the files checked writable,
+    ``scenes_dir`` an existing folder or one to create."""
 
     count: int
     seed: int
@@ -77,28 +66,17 @@ def register(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument("--json", help="write results, summary, machine and versions as JSON")
     p.add_argument("--csv", help="write one row per scene and backend as CSV")
     p.add_argument("--save-scenes", metavar="DIR", help="write the scene files into DIR")
-    p.add_argument(
-        "--workers", default="1", help="local processes, or LocalCluster workers (default: 1)"
-    )
-    p.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help="run on a Dask scheduler (tcp://host:8786), or 'local' for a LocalCluster",
-    )
+    p.add_argument("--workers", default="1",
+                   help="local processes, or LocalCluster workers (default: 1)")  # fmt: skip
+    p.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask scheduler "
+                   "(tcp://host:8786), or 'local' for a LocalCluster")  # fmt: skip
     p.set_defaults(run=run)
     return p
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``dvqp bench``; return the exit code (0: the suite ran; bad input raises).
-
-    Raises
-    ------
-    DvqpError
-        Bad input (checked before any run): the one-line message of exit code 2.
-    KeyboardInterrupt
-        Ctrl-C, after the finished scenes were summed up and written.
-    """
+    """Run ``dvqp bench``; return 0. Bad input raises a DvqpError before any run (exit 2);
+    Ctrl-C a KeyboardInterrupt, after the finished scenes were summed up and written."""
     options = check_options(args)
     scenes = generate_scenes(options.seed, options.count)
 
@@ -107,15 +85,12 @@ def run(args: argparse.Namespace) -> int:
             options.scenes_dir.mkdir(exist_ok=True)
             save_scenes(scenes, options.scenes_dir)
 
-    bar = ProgressBar(sys.stderr)
     try:
-        try:
+        with contextlib.closing(ProgressBar(sys.stderr)) as bar:
             suite = run_suite(
                 scenes, options.backends, seed=options.seed, workers=options.workers,
                 scheduler=options.scheduler, progress=bar.show, ready=ready,
             )  # fmt: skip
-        finally:
-            bar.close()
     except BenchInterrupted as exc:
         _report(exc.suite, options)  # what finished is still written
         raise
@@ -136,14 +111,9 @@ def _report(suite: Suite, options: Options) -> None:
 
 
 def check_options(args: argparse.Namespace) -> Options:
-    """Every option checked, nothing run or written yet.
-
-    Raises
-    ------
-    DvqpError
-        ``--count: must be an integer >= 1, got '0'``, an unknown backend, an output file
-        that cannot be written, ``--scheduler needs Dask: pip install 'dvqp[dask]'``.
-    """
+    """Every option checked, nothing run or written yet; else a DvqpError such as ``--count:
+    must be an integer >= 1, got '0'``, an unknown backend, an output file that cannot be
+    written, ``--scheduler needs Dask: pip install 'dvqp[dask]'``."""
     count = _integer("--count", args.count, 1)
     seed = _integer("--seed", args.seed, 0)
     workers = _integer("--workers", args.workers, 1)
@@ -183,8 +153,7 @@ def _scenes_dir(text: str) -> Path:
     if not where.is_dir():
         raise ParameterError("--save-scenes", f"{where}: no such directory")
     try:
-        with tempfile.TemporaryFile(dir=where):
-            pass
+        tempfile.TemporaryFile(dir=where).close()
     except OSError as exc:
         raise ParameterError(
             "--save-scenes", f"{where}: cannot write here ({exc.strerror})"

@@ -1,10 +1,8 @@
 """``dvqp console SCENE``: drive the arm live from the browser (see ``docs/console.md``).
 
-:func:`register` adds the subcommand to the ``dvqp`` parser; :func:`run` loads the scene,
-starts the server on 127.0.0.1 (unless ``--host`` says otherwise) and prints one line, the URL
-with a fresh random token. It serves until Ctrl-C. Without the extra ``dvqp[console]`` it
-fails at once with ``dvqp: the console needs aiohttp: pip install 'dvqp[console]'``
-(exit 2), like every bad input.
+:func:`run` serves on 127.0.0.1 (unless ``--host`` says otherwise) until Ctrl-C and prints
+one line, the URL with a fresh random token. Without the extra ``dvqp[console]`` it fails at
+once (exit 2, ``dvqp: the console needs aiohttp: pip install 'dvqp[console]'``).
 """
 
 from __future__ import annotations
@@ -42,11 +40,8 @@ def _port(text: str) -> int:
 def run(args: argparse.Namespace) -> int:
     """Serve the console of ``args.scene`` until interrupted; 0 when the server ends.
 
-    Raises
-    ------
-    DvqpError
-        The extra is missing, the scene is invalid, the backend unknown, or the port cannot
-        be listened on (exit code 2 in :func:`dvqp.cli.main`).
+    Raises a DvqpError (exit code 2) if the extra is missing, the scene is invalid, the
+    backend unknown, or the port cannot be listened on.
     """
     from dvqp.console import server
 
@@ -59,11 +54,8 @@ def run(args: argparse.Namespace) -> int:
     console = server.Console(ConsoleSession(scene, backend), server.security.new_token(), args.host)
     gc.freeze()  # the scene, the arm and the libraries: never scanned again, no 60 ms GC pauses
 
-    def announce(url: str) -> None:
-        print(url, flush=True)
-
     try:
-        asyncio.run(server.serve(console, args.port, announce))
+        asyncio.run(server.serve(console, args.port, lambda url: print(url, flush=True)))
     finally:
         console.clock.close()
     return 0

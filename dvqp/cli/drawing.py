@@ -30,23 +30,9 @@ SHIFTS = (-1, 0, 1)
 
 
 class View(NamedTuple):
-    """A trajectory with what is drawn around it, checked by :func:`make_view`.
-
-    Attributes
-    ----------
-    traj
-        The trajectory.
-    radius
-        Pipe radius ``R``, m.
-    obstacles
-        Obstacle shapes (l, z).
-    h_star
-        Orbital level ``h*``, m, or None.
-    weld
-        Axial position of the weld, m, or None.
-    limits
-        ``(l_min, l_max, z_min, z_max)`` of the developed-view axes, m.
-    """
+    """A trajectory with what is drawn around it, checked by :func:`make_view`: the pipe
+    ``radius``, orbital level ``h_star`` and ``weld`` z (None: not drawn), and the
+    developed-view axes' ``limits`` ``(l_min, l_max, z_min, z_max)``, all in m."""
 
     traj: Trajectory
     radius: float
@@ -85,19 +71,11 @@ def make_view(
             raise ParameterError(name, f"must be a finite number, got {value!r}")
     h = None if orbital_level is None else float(orbital_level)
     weld = None if weld_z is None else float(weld_z)
-    limits = _limits(traj, radius, obstacles, weld)
-    return View(traj, radius, tuple(obstacles), h, weld, limits)
-
-
-def _limits(
-    traj: Trajectory, radius: float, obstacles: Sequence[Shape], weld: float | None
-) -> tuple[float, float, float, float]:
-    """Developed-view limits: l a little beyond the seams, z around everything drawn, m."""
-    z = [traj.points[..., 1].ravel(), traj.tool[:, 1]]
-    z += [np.array(o.z_range) for o in obstacles]
+    z = [traj.points[..., 1].ravel(), traj.tool[:, 1], *(np.array(o.z_range) for o in obstacles)]
     zs = np.concatenate([*z, [] if weld is None else [weld]])
-    pad, edge = 0.08 * float(np.ptp(zs)) + 0.03, 1.12 * np.pi * radius
-    return (-edge, edge, float(zs.min()) - pad, float(zs.max()) + pad)
+    pad, edge = 0.08 * float(np.ptp(zs)) + 0.03, 1.12 * np.pi * radius  # l: beyond the seams
+    limits = (-edge, edge, float(zs.min()) - pad, float(zs.max()) + pad)
+    return View(traj, radius, tuple(obstacles), h, weld, limits)
 
 
 def wrap_arc(l: NDArray[np.float64] | float, radius: float) -> NDArray[np.float64]:
@@ -106,10 +84,8 @@ def wrap_arc(l: NDArray[np.float64] | float, radius: float) -> NDArray[np.float6
 
 
 def body_at(traj: Trajectory, i: int) -> NDArray[np.float64]:
-    """Body points then the tool at sample i, shape (k+1, 3), ``[l, z, h]`` (m).
-
-    l is continuous along the body and starts in ``(−πR, πR]``.
-    """
+    """Body points then the tool at sample i, shape (k+1, 3), ``[l, z, h]`` (m); l is
+    continuous along the body and starts in ``(−πR, πR]``."""
     body = np.vstack([traj.points[i], traj.tool[i, :3]])
     body[:, 0] = unwrap(body[:, 0], 2.0 * np.pi * traj.pipe_radius)
     body[:, 0] += wrap_arc(body[0, 0], traj.pipe_radius) - body[0, 0]
@@ -146,8 +122,7 @@ def _draw_obstacles(ax: Axes, view: View) -> None:
     for j, o in enumerate(view.obstacles):
         ring = o.outline()
         if np.isnan(ring[:, 0]).all():  # a band: every l
-            label = "obstacle" if j == 0 else None
-            ax.axhspan(ring[0, 1], ring[1, 1], **style, label=label)
+            ax.axhspan(ring[0, 1], ring[1, 1], **style, label="obstacle" if j == 0 else None)
             continue
         ref = float(np.mean(ring[:, 0]))
         shift = float(wrap_arc(ref, view.radius)) - ref
@@ -171,25 +146,11 @@ def _draw_tool_path(ax: Axes, view: View) -> None:
 def draw_body(
     ax: Axes, body: NDArray[np.float64], radius: float, color: Any, legend: bool = True
 ) -> list[Any]:
-    """The body polyline (points, then tool ▲) and its copies.
+    """The body polyline (points, then tool ▲) and its copies, in ``color``; the middle copy
+    labelled for the legend if ``legend``.
 
-    Parameters
-    ----------
-    ax
-        Developed-view axes.
-    body
-        ``[l, z, h]`` of the points then the tool, shape (k+1, 3), m (see :func:`body_at`).
-    radius
-        Pipe radius, m.
-    color
-        A matplotlib colour.
-    legend
-        Label the middle copy for the legend.
-
-    Returns
-    -------
-    list
-        ``[line, tool marker]`` per copy, in :data:`SHIFTS` order.
+    ``body`` is :func:`body_at`'s, ``radius`` the pipe's (m). Returns ``[line, tool marker]``
+    per copy, in :data:`SHIFTS` order.
     """
     artists = []
     for s, (lb, zb) in zip(SHIFTS, body_copies(body, radius), strict=True):
@@ -200,10 +161,8 @@ def draw_body(
 
 
 def draw_section(ax: Axes, view: View, instants: Sequence[tuple[int, Any]]) -> None:
-    """Pipe cross-section (x, y): wall, orbital circle, obstacle extents, the body at instants.
-
-    ``instants`` holds ``(sample index, colour)`` pairs.
-    """
+    """Pipe cross-section (x, y): wall, orbital circle, obstacle extents, and the body at the
+    ``(sample index, colour)`` pairs of ``instants``."""
     radius, h_star = view.radius, view.h_star
     th = np.linspace(0.0, 2.0 * np.pi, 361)
     circle = np.array([np.cos(th), np.sin(th)])
@@ -221,19 +180,13 @@ def draw_section(ax: Axes, view: View, instants: Sequence[tuple[int, Any]]) -> N
         label = "obstacle (l extent)" if j == 0 else None
         xy = radius * np.cos(arc), radius * np.sin(arc)
         ax.plot(*xy, color="tab:red", lw=5, alpha=0.5, solid_capstyle="butt", label=label)
-    for i, c in instants:
-        _draw_section_body(ax, view, i, c)
+    for i, color in instants:  # the body at sample i, tool ▲ at its end
+        body = np.vstack([view.traj.points[i], view.traj.tool[i, :3]])
+        rho, angle = radius + body[:, 2], body[:, 0] / radius
+        x, y = rho * np.cos(angle), rho * np.sin(angle)
+        ax.plot(x, y, "-o", color=color, lw=1.5, ms=3)
+        ax.plot(x[-1], y[-1], "^", color=color, ms=6)
     _finish_section(ax, view)
-
-
-def _draw_section_body(ax: Axes, view: View, i: int, color: Any) -> None:
-    """The body at sample i in the cross-section, tool ▲ at its end."""
-    traj, radius = view.traj, view.radius
-    body = np.vstack([traj.points[i], traj.tool[i, :3]])
-    rho, angle = radius + body[:, 2], body[:, 0] / radius
-    x, y = rho * np.cos(angle), rho * np.sin(angle)
-    ax.plot(x, y, "-o", color=color, lw=1.5, ms=3)
-    ax.plot(x[-1], y[-1], "^", color=color, ms=6)
 
 
 def _finish_section(ax: Axes, view: View) -> None:

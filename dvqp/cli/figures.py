@@ -1,9 +1,8 @@
 """What every figure of the command line shares: a pyplot-free figure and atomic saving.
 
 matplotlib is imported only when :func:`new_figure` is called (``pip install 'dvqp[plot]'``).
-The figure is drawn on a :class:`matplotlib.figure.Figure` with the Agg canvas, never through
-``pyplot``: no display and no backend setting are needed. Files are written atomically: a
-temporary file in the same folder, renamed once complete.
+Figures are drawn on the Agg canvas, never through ``pyplot``: no display and no backend
+setting are needed.
 """
 
 from __future__ import annotations
@@ -23,12 +22,7 @@ FIGURE_FORMATS = (".png", ".svg", ".pdf")
 
 
 def new_figure(size: tuple[float, float]) -> Figure:
-    """A constrained-layout figure on the Agg canvas (no pyplot, no display).
-
-    Parameters
-    ----------
-    size
-        ``(width, height)``, inches.
+    """A constrained-layout figure of ``size`` (width, height; inches) on the Agg canvas.
 
     Raises
     ------
@@ -46,36 +40,15 @@ def new_figure(size: tuple[float, float]) -> Figure:
 
 
 def write_atomic(target: Path, write: Callable[[str], None]) -> Path:
-    """Call ``write(tmp)`` on a temporary file beside ``target``, then rename it to ``target``.
-
-    On any error the temporary file is removed and an existing ``target`` is left as it was.
-
-    Returns
-    -------
-    Path
-        ``target``.
-    """
+    """Call ``write(tmp)`` on a temporary file beside ``target``, then rename it to ``target``
+    (returned); on any error ``tmp`` is removed and an existing ``target`` left as it was."""
     with atomic_file(target) as tmp:
         write(str(tmp))
     return target
 
 
 def save_figure(fig: Figure, target: Path, dpi: int) -> Path:
-    """Save ``fig`` atomically in the format of ``target``'s suffix (one of FIGURE_FORMATS).
-
-    Parameters
-    ----------
-    fig
-        The figure.
-    target
-        Output file, already checked (``dvqp._files.output_path``).
-    dpi
-        Resolution of raster formats, dots per inch.
-
-    Returns
-    -------
-    Path
-        ``target``.
-    """
+    """Save ``fig`` atomically to ``target`` (returned; already checked, a suffix of
+    :data:`FIGURE_FORMATS`), raster formats at ``dpi`` dots per inch."""
     fmt = target.suffix.lower()[1:]
     return write_atomic(target, lambda tmp: fig.savefig(tmp, format=fmt, dpi=dpi))

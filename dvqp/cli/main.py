@@ -16,7 +16,7 @@ import json
 import os
 import sys
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -29,23 +29,9 @@ from dvqp.cli import console as console_cli
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
 from dvqp.cli.report import format_summary, format_table, rows_to_csv, write_text
-from dvqp.errors import (
-    DvqpError,
-    LimitViolationError,
-    SingularConfigurationError,
-    UnreachableTargetError,
-)
-from dvqp.planning import check_run
-from dvqp.resolution.registry import (
-    ResolverInfo,
-    check_name,
-    default_resolvers,
-    describe_resolvers,
-)
+from dvqp.errors import DvqpError, SingularConfigurationError
+from dvqp.resolution.registry import check_name, default_resolvers, describe_resolvers
 from dvqp.scenes import environment
-
-if TYPE_CHECKING:
-    from dvqp import Scene
 
 __all__ = ["format_table", "main"]
 
@@ -82,9 +68,6 @@ def _run(args: argparse.Namespace) -> int:
         return 2
 
 
-# -- arguments --------------------------------------------------------------------------------
-
-
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="dvqp",
@@ -94,25 +77,11 @@ def _parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"dvqp {__version__}")
     sub = parser.add_subparsers(title="commands", metavar="COMMAND")
-    _add_plan(sub)
-    _add_compare(sub)
-    _add_plot(sub)
-    console_cli.register(sub)
-    bench_cmd.register(sub)
-    b = sub.add_parser("backends", help="list the installed backends and their versions")
-    b.set_defaults(run=_backends)
-    return parser
-
-
-def _add_plan(sub: Any) -> None:
     p = sub.add_parser("plan", help="run a scene and save its trajectory")
     p.add_argument("scene", help="scene file (.toml)")
     p.add_argument("--backend", default="daqp", help="pinv or a QP backend (default: daqp)")
     p.add_argument("-o", "--output", help="trajectory file to write (.npz or .csv)")
     p.set_defaults(run=_plan)
-
-
-def _add_compare(sub: Any) -> None:
     c = sub.add_parser("compare", help="run scenes with several backends, print one table")
     c.add_argument("scenes", nargs="+", metavar="SCENE", help="scene files (.toml)")
     c.add_argument("--backends", help="comma-separated names (default: pinv + installed)")
@@ -121,14 +90,16 @@ def _add_compare(sub: Any) -> None:
     c.add_argument("--plot", help="write a figure of the comparison (.png/.svg/.pdf)")
     c.add_argument("--jobs", type=_positive_int, default=1, help="worker processes (scenes)")
     c.set_defaults(run=_compare)
-
-
-def _add_plot(sub: Any) -> None:
     g = sub.add_parser("plot", help="draw a saved trajectory")
     g.add_argument("trajectory", help="trajectory file (.npz) written by 'dvqp plan'")
     g.add_argument("-o", "--output", required=True, help="figure (.png/.svg/.pdf, or .gif)")
     g.add_argument("--gif", action="store_true", help="write an animation (.gif)")
     g.set_defaults(run=_plot)
+    console_cli.register(sub)
+    bench_cmd.register(sub)
+    b = sub.add_parser("backends", help="list the installed backends and their versions")
+    b.set_defaults(run=_backends)
+    return parser
 
 
 def _positive_int(text: str) -> int:
@@ -141,7 +112,12 @@ def _positive_int(text: str) -> int:
     return value
 
 
-# -- plan -------------------------------------------------------------------------------------
+def _notice(bar: ProgressBar, text: str) -> None:
+    """While compiling, the bar says so; once done, a line says how long it took."""
+    if text.startswith("compiled"):
+        bar.note(text)
+    else:
+        bar.show(0, 1, text)
 
 
 def _plan(args: argparse.Namespace) -> int:
@@ -149,33 +125,21 @@ def _plan(args: argparse.Namespace) -> int:
     output = output_path(args.output, (".npz", ".csv")) if args.output else None
     check_name(args.backend)  # unknown backend: exit 2 before any work
     check_size([scene], 1)
-    try:
-        traj = _run_with_bar(scene, args.backend)
+    try:  # a progress bar on stderr, erased when done
+        with contextlib.closing(ProgressBar(sys.stderr)) as bar:
+            traj = plan(scene, args.backend, progress=lambda k, n: bar.show(k, n, "steps"),
+                        notice=lambda text: _notice(bar, text))  # fmt: skip
     except SingularConfigurationError as exc:
         print(f"dvqp: {scene.source}: {args.backend}: {exc}", file=sys.stderr)
         return 1
     if output is not None:
         traj.save(output)  # written even for a failed run, to look at it
-    print(format_summary(scene, traj, cmp.summarize(scene, traj), output))
-    try:
-        check_run(scene, traj)
-    except (UnreachableTargetError, LimitViolationError) as exc:
-        print(f"dvqp: {exc}", file=sys.stderr)
+    row = cmp.summarize(scene, traj)
+    print(format_summary(scene, traj, row, output))
+    if row["error"]:  # why check_run failed the run
+        print(f"dvqp: {row['error']}", file=sys.stderr)
         return 1
     return 0
-
-
-def _run_with_bar(scene: Scene, backend: str) -> Trajectory:
-    """Plan ``scene`` with ``backend``, a progress bar on stderr (erased when done)."""
-    bar = ProgressBar(sys.stderr)
-    try:
-        return plan(scene, backend, progress=lambda k, n: bar.show(k, n, "steps"),
-                    notice=lambda text: bar.show(0, 1, text))  # fmt: skip
-    finally:
-        bar.close()
-
-
-# -- compare ----------------------------------------------------------------------------------
 
 
 def _compare(args: argparse.Namespace) -> int:
@@ -186,17 +150,16 @@ def _compare(args: argparse.Namespace) -> int:
     json_out = output_path(args.json, (".json",)) if args.json else None
     csv_out = output_path(args.csv, (".csv",)) if args.csv else None
     plot_out = output_path(args.plot, FIGURE_FORMATS) if args.plot else None
-    bar = ProgressBar(sys.stderr)
-    try:
+    with contextlib.closing(ProgressBar(sys.stderr)) as bar:
         rows = cmp.compare(args.scenes, backends, args.jobs, progress=bar.show)
-    finally:
-        bar.close()
     print(format_table(rows))
     for row in rows:
         if row["error"]:
             print(f"  {row['scene']} / {row['backend']}: {row['error']}")
-    if json_out is not None:
-        write_text(json_out, _comparison_json(args.scenes, backends, rows))
+    if json_out is not None:  # no NaN in it: an undefined figure is null
+        doc = {"backends": backends, "scenes": list(args.scenes), "results": rows,
+               "machine": cmp.machine(), "versions": versions()}  # fmt: skip
+        write_text(json_out, json.dumps(doc, indent=2, allow_nan=False) + "\n")
     if csv_out is not None:
         write_text(csv_out, rows_to_csv(rows))
     if plot_out is not None:
@@ -206,39 +169,23 @@ def _compare(args: argparse.Namespace) -> int:
     return 0 if all(row["success"] for row in rows) else 1
 
 
-def _comparison_json(
-    scenes: Sequence[str], backends: Sequence[str], rows: Sequence[cmp.Row]
-) -> str:
-    """The ``--json`` document: names, rows, machine and versions (no NaN: undefined is null)."""
-    doc = {"backends": list(backends), "scenes": list(scenes), "results": list(rows),
-           "machine": cmp.machine(), "versions": versions()}  # fmt: skip
-    return json.dumps(doc, indent=2, allow_nan=False) + "\n"
-
-
-# -- plot and backends ------------------------------------------------------------------------
-
-
 def _plot(args: argparse.Namespace) -> int:
     traj = _load_trajectory(args.trajectory)
-    drawn_with = _stored_environment(traj, args.trajectory)
-    try:
-        from dvqp.cli import plot
-    except ImportError as exc:  # pragma: no cover - dvqp.cli.plot ships with dvqp
-        raise DvqpError(f"plotting is not available: {exc}") from exc
+    drawn_with: dict[str, Any] = {}
+    if traj.scene_text:  # draw the stored scene's obstacles, orbital level and weld
+        env = environment(traj.scene_text, f"{args.trajectory} (stored scene)")
+        drawn_with = {"obstacles": env.obstacles, "orbital_level": env.orbital_level,
+                      "weld_z": env.weld}  # fmt: skip
+    from dvqp.cli import plot
+
     draw = plot.animate_trajectory if args.gif else plot.plot_trajectory
-    written = draw(traj, args.output, **drawn_with)
-    print(f"wrote {written}")
+    print(f"wrote {draw(traj, args.output, **drawn_with)}")
     return 0
 
 
 def _load_trajectory(path: str) -> Trajectory:
-    """A trajectory file, checked enough to be drawn.
-
-    Raises
-    ------
-    DvqpError
-        ``<path>: cannot read: <reason>`` or ``<path>: not a dvqp trajectory (<reason>)``.
-    """
+    """A trajectory file, checked enough to be drawn; else a DvqpError
+    ``<path>: cannot read: <reason>`` or ``<path>: not a dvqp trajectory (<reason>)``."""
     try:
         with open(path, "rb") as fh:
             zipped = fh.read(4) == b"PK\x03\x04"
@@ -269,25 +216,10 @@ def _drawable(traj: Trajectory) -> bool:
     )  # fmt: skip
 
 
-def _stored_environment(traj: Trajectory, source: str) -> dict[str, Any]:
-    """Obstacles, orbital level and weld of the scene stored in ``traj`` (none stored: {})."""
-    if not traj.scene_text:
-        return {}
-    env = environment(traj.scene_text, f"{source} (stored scene)")
-    return {"obstacles": env.obstacles, "orbital_level": env.orbital_level, "weld_z": env.weld}
-
-
 def _backends(args: argparse.Namespace) -> int:
+    """Name, distribution, version and note of each resolver; the note of dvqp's own (a
+    description) in parentheses, that of a QP backend (e.g. ``via qpsolvers 4.13.0``) as is."""
     for info in describe_resolvers():
-        print(_backend_line(info))
+        note = f"({info.note})" if info.note and info.distribution == "dvqp" else info.note
+        print(f"{info.name:<22} {info.distribution} {info.version}" + (f" {note}" if note else ""))
     return 0
-
-
-def _backend_line(info: ResolverInfo) -> str:
-    """One line of ``dvqp backends``: name, distribution, version and the note.
-
-    The note of dvqp's own resolvers (a description) is shown in parentheses, that of a QP
-    backend (how it is reached, e.g. ``via qpsolvers 4.13.0``) as it is.
-    """
-    note = f"({info.note})" if info.note and info.distribution == "dvqp" else info.note
-    return f"{info.name:<22} {info.distribution} {info.version}" + (f" {note}" if note else "")

@@ -1,10 +1,7 @@
 """Figures of a planned trajectory: developed view, heights and pipe cross-section.
 
-Needs matplotlib (``pip install 'dvqp[plot]'``), imported only when a function is called. The
-figures are drawn on a :class:`matplotlib.figure.Figure` with the Agg canvas, never through
-``pyplot``: no display and no backend setting are needed. Files are written atomically.
-The building blocks are public: :mod:`dvqp.cli.figures` (figure, saving) and
-:mod:`dvqp.cli.drawing` (developed view, body, cross-section, seam handling).
+Drawn and written atomically as :mod:`dvqp.cli.figures` does (matplotlib imported only when
+called, no pyplot), from the building blocks of :mod:`dvqp.cli.drawing`.
 """
 
 from __future__ import annotations
@@ -13,7 +10,7 @@ import math
 from collections.abc import Callable, Sequence
 from numbers import Real
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -63,20 +60,14 @@ def plot_trajectory(
     traj
         The trajectory (``pipe_radius`` must be set).
     path
-        Output file, ``.png``, ``.svg`` or ``.pdf``; its folder must exist.
+        Output file, ``.png``, ``.svg`` or ``.pdf``; its folder must exist. Returned.
     obstacles
         Obstacle shapes (l, z) to draw.
-    orbital_level
-        ``h*`` (m), drawn as a dashed line and circle if given.
-    weld_z
-        Axial position (m) of a circumferential weld, drawn dashed if given.
+    orbital_level, weld_z
+        ``h*`` (m, a dashed line and circle) and the axial position of a circumferential weld
+        (m, dashed), drawn if given.
     instants
         Number of times at which the body is drawn, >= 1.
-
-    Returns
-    -------
-    Path
-        The written file.
 
     Raises
     ------
@@ -97,7 +88,7 @@ def plot_trajectory(
     times = _time_scale(traj)
     _draw_developed_panel(fig, ax_dv, view, idx, times)
     _draw_heights(ax_h, view)
-    draw_section(ax_x, view, [(i, _colour(times, traj.t[i])) for i in idx])
+    draw_section(ax_x, view, [(i, times.to_rgba(traj.t[i])) for i in idx])
     failed = "" if traj.ok else f", {int(np.sum(~traj.success))} failed steps"
     fig.suptitle(
         f"dvqp trajectory ({traj.backend or 'unknown resolver'}): {traj.n_steps} steps, "
@@ -118,28 +109,10 @@ def animate_trajectory(
 ) -> Path:
     """Save a GIF of the developed view with the body moving along the trajectory.
 
-    Parameters
-    ----------
-    traj, obstacles, weld_z
-        As in :func:`plot_trajectory`.
-    path
-        Output ``.gif``; its folder must exist.
-    orbital_level
-        ``h*`` (m), shown in the title if given.
-    fps
-        Frames per second, > 0.
-    max_frames
-        At most this many frames (samples are taken evenly, first and last included), >= 2.
-
-    Returns
-    -------
-    Path
-        The written file.
-
-    Raises
-    ------
-    ParameterError, DvqpError
-        As in :func:`plot_trajectory`.
+    ``path`` (``.gif``, in an existing folder) is returned; ``orbital_level`` is shown in the
+    title. ``fps`` (> 0) frames a second, at most ``max_frames`` (>= 2) of them, the samples
+    taken evenly, first and last included. The other arguments and the errors are as in
+    :func:`plot_trajectory`.
     """
     target = output_path(path, (".gif",))
     view = make_view(traj, obstacles, orbital_level, weld_z)
@@ -154,9 +127,6 @@ def animate_trajectory(
     return write_atomic(target, lambda tmp: _write_gif(fig, tmp, fps, frames, show))
 
 
-# -- plot_trajectory's panels -------------------------------------------------------------------
-
-
 def _time_scale(traj: Trajectory) -> ScalarMappable:
     """Colours by time: viridis over ``[t0, t_end]`` (s)."""
     from matplotlib import colormaps
@@ -167,18 +137,13 @@ def _time_scale(traj: Trajectory) -> ScalarMappable:
     return ScalarMappable(norm=Normalize(t0, max(t1, t0 + 1e-9)), cmap=colormaps["viridis"])
 
 
-def _colour(times: ScalarMappable, t: float) -> Any:
-    """The colour of time t (s)."""
-    return times.cmap(times.norm(t))
-
-
 def _draw_developed_panel(
     fig: Figure, ax: Axes, view: View, idx: NDArray[np.intp], times: ScalarMappable
 ) -> None:
     """The developed view with the body at samples ``idx``, its legend and the time bar."""
     draw_developed_view(ax, view)
     for n, i in enumerate(idx):
-        colour = _colour(times, view.traj.t[i])
+        colour = times.to_rgba(view.traj.t[i])
         draw_body(ax, body_at(view.traj, i), view.radius, colour, legend=n == 0)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     cax = ax.inset_axes((1.03, 0.06, 0.24, 0.07))
@@ -197,9 +162,6 @@ def _draw_heights(ax: Axes, view: View) -> None:
     ax.set(xlabel="t (s)", ylabel="h (m)", title="heights above the pipe surface")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small", ncol=2)
-
-
-# -- animate_trajectory's frames ----------------------------------------------------------------
 
 
 def _animation_axes(fig: Figure, view: View) -> Callable[[int], None]:
@@ -234,13 +196,9 @@ def _write_gif(
             writer.grab_frame()
 
 
-# -- checks -------------------------------------------------------------------------------------
-
-
 def _evenly(traj: Trajectory, count: int) -> NDArray[np.intp]:
     """Indices of ``count`` samples evenly spread over the trajectory, first and last included."""
-    last = traj.t.shape[0] - 1
-    return np.unique(np.linspace(0, last, count).round().astype(int))
+    return np.unique(np.linspace(0, traj.t.shape[0] - 1, count).round().astype(int))
 
 
 def _check_count(name: str, value: object, least: int) -> None:

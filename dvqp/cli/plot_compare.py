@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -13,26 +13,15 @@ from dvqp._files import output_path
 from dvqp.cli.figures import FIGURE_FORMATS, new_figure, save_figure
 
 if TYPE_CHECKING:
-    from matplotlib.axes import Axes
-
-Row = dict[str, Any]
+    from dvqp.comparison import Row
 
 
 def plot_comparison(rows: Sequence[Row], path: str | Path) -> Path:
     """Median step time and minimum clearance per scene and backend, as grouped bars.
 
-    Parameters
-    ----------
-    rows
-        Result rows with at least ``scene``, ``backend``, ``median_step_us``,
-        ``p95_step_us`` and ``min_clearance`` (m; None without obstacles).
-    path
-        ``.png``, ``.svg`` or ``.pdf``; written atomically.
-
-    Returns
-    -------
-    Path
-        The written file.
+    ``rows`` have at least ``scene``, ``backend``, ``median_step_us``, ``p95_step_us`` and
+    ``min_clearance`` (m; None without obstacles). ``path`` (``.png``, ``.svg`` or ``.pdf``)
+    is written atomically and returned.
     """
     target = output_path(path, FIGURE_FORMATS)
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
@@ -45,7 +34,10 @@ def plot_comparison(rows: Sequence[Row], path: str | Path) -> Path:
     for k, backend in enumerate(backends):
         got = [by_key.get((s, backend), {}) for s in scenes]
         offset = x + (k - (len(backends) - 1) / 2) * width
-        _bars(time_ax, clear_ax, offset, width, backend, got)
+        med, p95 = _column(got, "median_step_us"), _column(got, "p95_step_us")
+        errors = [np.zeros_like(med), p95 - med]  # a bar from the median up to p95
+        time_ax.bar(offset, med, width, label=backend, yerr=errors, capsize=2)
+        clear_ax.bar(offset, 1000.0 * _column(got, "min_clearance"), width, label=backend)
     time_ax.set_yscale("log")
     time_ax.set_ylabel("full step time, µs (median, bar to p95)")
     time_ax.legend(ncol=min(len(backends), 5), fontsize="small")
@@ -54,22 +46,6 @@ def plot_comparison(rows: Sequence[Row], path: str | Path) -> Path:
     clear_ax.set_ylabel("min clearance to obstacles, mm")
     clear_ax.set_xticks(x, scenes, rotation=15)
     return save_figure(fig, target, dpi=120)
-
-
-def _bars(
-    time_ax: Axes,
-    clear_ax: Axes,
-    offset: NDArray[np.float64],
-    width: float,
-    backend: str,
-    rows: Sequence[Row],
-) -> None:
-    """One backend's bars: median step time (µs, error bar to p95) and min clearance (mm)."""
-    med, p95 = _column(rows, "median_step_us"), _column(rows, "p95_step_us")
-    clear = _column(rows, "min_clearance")
-    errors = [np.zeros_like(med), p95 - med]
-    time_ax.bar(offset, med, width, label=backend, yerr=errors, capsize=2)
-    clear_ax.bar(offset, 1000.0 * clear, width, label=backend)
 
 
 def _column(rows: Sequence[Row], key: str) -> NDArray[np.float64]:

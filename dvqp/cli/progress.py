@@ -1,9 +1,6 @@
-"""Long runs: their size estimated before they start, a progress bar, Ctrl-C and warnings.
-
-What the command line wraps around a run: :func:`check_size` refuses a run whose arrays would
-not fit in memory and announces a long one; :class:`ProgressBar` shows how far it is and how
-long it still takes; :func:`interruptible` makes Ctrl-C a clean stop; :func:`warnings_summed_up`
-keeps warnings of the numerical code off the terminal but for one line.
+"""What the command line wraps around a run: :func:`check_size` (refuse a run too big for the
+memory, announce a long one), :class:`ProgressBar`, :func:`interruptible` (Ctrl-C a clean
+stop) and :func:`warnings_summed_up` (the numerical code's warnings in one line).
 """
 
 from __future__ import annotations
@@ -37,17 +34,9 @@ MEMORY_SHARE = 0.8
 
 @dataclass(frozen=True)
 class RunEstimate:
-    """How big a planned run will be, from its scene alone (before any step).
-
-    Attributes
-    ----------
-    steps : int
-        Steps N of one run (a path's approach to its first waypoint not counted).
-    seconds : float
-        Rough duration of one run at :data:`STEP_SECONDS` a step, s.
-    nbytes : int
-        Memory of its trajectory's arrays, bytes.
-    """
+    """How big one planned run will be, from its scene alone: ``steps`` (a path's approach to
+    its first waypoint not counted), ``seconds`` at :data:`STEP_SECONDS` a step, and
+    ``nbytes`` of its trajectory's arrays."""
 
     steps: int
     seconds: float
@@ -77,10 +66,9 @@ class RunEstimate:
 def interruptible() -> Iterator[None]:
     """Ctrl-C raises KeyboardInterrupt here, and ends forked worker processes quietly.
 
-    Workers of ``compare --jobs`` are forked with this handler: in them it exits at once
-    (code 130) instead of printing a traceback each. An interrupt sent to this process alone
-    (``kill -INT``) is passed on to them, so none is left running. Only in the main thread
-    (signals are delivered there); elsewhere nothing changes.
+    Forked workers (``compare --jobs``) inherit the handler and exit at once (code 130); an
+    interrupt sent to this process alone (``kill -INT``) is passed on to them. Outside the
+    main thread (where signals are delivered) nothing changes.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
@@ -123,8 +111,8 @@ def warnings_summed_up() -> Iterator[list[int]]:
 def check_size(scenes: Sequence[Scene], runs: int) -> None:
     """Refuse runs whose arrays would not fit in memory; announce those that take long.
 
-    ``runs`` is how many times each scene is run (backends). The announcement is one line on
-    stderr, ``dvqp: note: <file>: about 8e+06 steps: roughly 1.3 h and 4.4 GB``.
+    ``runs``: how many times each scene is run. The announcement is one line on stderr,
+    ``dvqp: note: <file>: about 8e+06 steps: roughly 1.3 h and 4.4 GB``.
 
     Raises
     ------
@@ -161,40 +149,44 @@ def duration(seconds: float) -> str:
 
 
 class ProgressBar:
-    """A one-line progress bar on a terminal (silent when the stream is not a TTY).
-
-    After a second it also shows the time left, from the rate so far.
-
-    Parameters
-    ----------
-    stream
-        Where to draw, usually ``sys.stderr``.
-    width
-        Characters of the bar itself.
-    """
+    """A one-line progress bar of ``width`` characters on ``stream`` (silent when it is not a
+    TTY); after a second it also shows the time left, from the rate so far (of this ``total``:
+    a new total, e.g. the steps after compiling, starts its own clock)."""
 
     def __init__(self, stream: TextIO, width: int = 30) -> None:
         self.stream, self.width = stream, width
         self.enabled = bool(getattr(stream, "isatty", lambda: False)())
-        self._last = -1
-        self._started = time.perf_counter()
+        self._last, self._total = -1, 0
+        self._started, self._first = time.perf_counter(), 0
 
     def show(self, done: int, total: int, label: str = "") -> None:
         """Draw ``done`` of ``total`` with a label (redrawn at most every 1 %)."""
         if not self.enabled or total <= 0:
             return
+        if total != self._total:  # the steps after compiling: a clock of their own
+            if self._total:
+                self._started, self._first = time.perf_counter(), done
+            self._total, self._last = total, -1
         percent = 100 * done // total
         if percent == self._last and done != total:
             return
         self._last = percent
         filled = self.width * done // total
         bar = "#" * filled + "." * (self.width - filled)
-        elapsed = time.perf_counter() - self._started
+        elapsed, counted = time.perf_counter() - self._started, done - self._first
         left = ""
-        if 0 < done < total and elapsed > 1.0:
-            left = f" {duration(elapsed * (total - done) / done)} left"
+        if counted > 0 and done < total and elapsed > 1.0:
+            left = f" {duration(elapsed * (total - done) / counted)} left"
         self.stream.write(f"\r[{bar}] {done}/{total}{left} {label[:40]:<40}")
         self.stream.flush()
+
+    def note(self, text: str) -> None:
+        """``text`` on a line of its own above the bar (nothing when silent)."""
+        if self.enabled:
+            self.close()
+            self.stream.write(f"dvqp: {text}\n")
+            self.stream.flush()
+            self._last = -1
 
     def close(self) -> None:
         """Erase the bar (if one was drawn)."""

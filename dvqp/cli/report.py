@@ -1,19 +1,18 @@
 """What the command line prints and writes: the comparison table, a run's summary, CSV.
 
-The rows are those of :func:`dvqp.comparison.summarize` (keys :data:`dvqp.comparison.FIELDS`);
-an undefined figure (None) is shown as ``-`` in the table and as an empty CSV cell.
+The rows are those of :func:`dvqp.comparison.summarize`; an undefined figure (None) is shown
+as ``-`` in the table and as an empty CSV cell (:func:`dvqp.comparison.rows_to_csv`).
 """
 
 from __future__ import annotations
 
-import csv
-import io
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
-from dvqp._files import atomic_file
-from dvqp.comparison import FIELDS, Row
+from dvqp.cli.figures import write_atomic
+from dvqp.comparison import Row, aligned, cell
+from dvqp.comparison import rows_to_csv as rows_to_csv  # part of this module's API (docs)
 
 if TYPE_CHECKING:
     from dvqp import Scene, Trajectory
@@ -36,60 +35,33 @@ TABLE = (  # (row key, header, format)
 
 def format_table(rows: Sequence[Row]) -> str:
     """The comparison as an aligned text table, a header and a rule first (``-``: undefined)."""
-    table = [[h for _, h, _ in TABLE]] + [[_cell(r, k, f) for k, _, f in TABLE] for r in rows]
-    widths = [max(len(line[i]) for line in table) for i in range(len(TABLE))]
-    just = [str.ljust, str.ljust] + [str.rjust] * (len(TABLE) - 2)
-    lines = [
-        "  ".join(j(c, w) for j, c, w in zip(just, line, widths, strict=True)) for line in table
-    ]
-    lines.insert(1, "  ".join("-" * w for w in widths))
-    return "\n".join(lines)
-
-
-def _cell(row: Row, key: str, fmt: str) -> str:
-    """One table cell: ``-`` for None, ``yes``/``NO`` for a flag, else ``fmt``."""
-    value = row.get(key)
-    if value is None:
-        return "-"
-    if isinstance(value, bool):
-        return "yes" if value else "NO"
-    return fmt.format(value)
+    table = [[h for _, h, _ in TABLE]] + [[cell(r.get(k), f) for k, _, f in TABLE] for r in rows]
+    return aligned(table, left=2)
 
 
 def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None) -> str:
-    """What ``dvqp plan`` prints about a run.
-
-    Parameters
-    ----------
-    scene
-        The scene that was run.
-    traj
-        Its trajectory.
-    row
-        Its figures, from :func:`dvqp.comparison.summarize`.
-    output
-        The file the trajectory was saved to, or None.
-    """
+    """What ``dvqp plan`` prints about a run: ``row`` from :func:`dvqp.comparison.summarize`,
+    ``output`` the file the trajectory was saved to (or None)."""
     tool = traj.tool[-1]
     lines = [
         f"scene           {scene.name} ({scene.source}), {scene.mode} mode",
         f"backend         {traj.backend}",
         f"steps           {_steps(row)}",
         f"result          {_result(row)}",
-        f"max task error  {_num(row['max_task_error'], '{:.2e}')}",
-        f"min clearance   {_num(row['min_clearance'], '{:+.4f} m')}"
+        f"max task error  {cell(row['max_task_error'], '{:.2e}')}",
+        f"min clearance   {cell(row['min_clearance'], '{:+.4f} m')}"
         + (f" ({row['closest']})" if row["closest"] else ""),
-        f"probe           clearance {_num(row['min_probe_clearance'], '{:+.4f} m')}, "
-        f"tilt from radial >= {_num(row['min_tilt'], '{:.3f} rad')}",
-        f"self distance   {_num(row['min_self_distance'], '{:.4f} m')}"
+        f"probe           clearance {cell(row['min_probe_clearance'], '{:+.4f} m')}, "
+        f"tilt from radial >= {cell(row['min_tilt'], '{:.3f} rad')}",
+        f"self distance   {cell(row['min_self_distance'], '{:.4f} m')}"
         + (f" ({row['closest_pair']})" if row["closest_pair"] else ""),
-        f"acceleration    max |qdd| {_num(row['max_joint_acceleration'], '{:.3g} rad/s^2')}",
+        f"acceleration    max |qdd| {cell(row['max_joint_acceleration'], '{:.3g} rad/s^2')}",
         f"limits          {_worst(row, bool(traj.limits_kept.all()))}",
-        f"step time       median {_num(row['median_step_us'], '{:.0f}')} us, "
-        f"p95 {_num(row['p95_step_us'], '{:.0f}')} us",
-        f"solver          {_num(row['median_solver_us'], '{:.1f}')} us a step in the solver's "
-        f"calls, {_num(row['median_rest_us'], '{:.1f}')} us the rest, "
-        f"{_num(row['median_iterations'], '{:.0f}')} iterations (medians)",
+        f"step time       median {cell(row['median_step_us'], '{:.0f}')} us, "
+        f"p95 {cell(row['p95_step_us'], '{:.0f}')} us",
+        f"solver          {cell(row['median_solver_us'], '{:.1f}')} us a step in the solver's "
+        f"calls, {cell(row['median_rest_us'], '{:.1f}')} us the rest, "
+        f"{cell(row['median_iterations'], '{:.0f}')} iterations (medians)",
         f"final tool DV   l = {tool[0]:.4f} m, z = {tool[1]:.4f} m, h = {tool[2]:.4f} m, "
         f"alpha = {tool[3]:.4f} rad",
     ]
@@ -128,30 +100,6 @@ def _worst(row: Row, kept: bool) -> str:
     return f"every limit kept to its tolerance (deepest: {worst})" if kept else f"BROKEN: {worst}"
 
 
-def _num(value: float | None, fmt: str) -> str:
-    return "-" if value is None else fmt.format(value)
-
-
-def rows_to_csv(rows: Sequence[Row]) -> str:
-    """The rows as CSV text: a header of :data:`~dvqp.comparison.FIELDS`, then one line each.
-
-    Flags are written ``true``/``false``, undefined figures as empty cells.
-    """
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(FIELDS)
-    for row in rows:
-        writer.writerow([_csv_cell(row.get(key)) for key in FIELDS])
-    return buf.getvalue()
-
-
-def _csv_cell(value: Any) -> Any:
-    if value is None:
-        return ""
-    return str(value).lower() if isinstance(value, bool) else value
-
-
 def write_text(path: Path, text: str) -> None:
     """Write ``text`` (UTF-8) atomically: a temporary file in the same folder, then renamed."""
-    with atomic_file(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
+    write_atomic(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))

@@ -1,11 +1,5 @@
-"""Real-time stepping: a thread that advances a session every ``dt`` of wall time.
-
-The clock runs while a client is connected (:meth:`RealTimeClock.resume`) and holds the arm
-still otherwise (:meth:`RealTimeClock.pause`: no step is made). It keeps a deadline per step;
-a late step is made at once to catch up, and a lag of more than :data:`MAX_LAG` is given up
-(counted in :attr:`RateStats.dropped`) rather than run in a burst. It measures the achieved
-rate: simulated seconds per wall second while running, and the wall time of each step.
-"""
+"""Real-time stepping: a thread that advances a session every ``dt`` of wall time while a
+client is connected, and measures the rate it achieves."""
 
 from __future__ import annotations
 
@@ -25,21 +19,9 @@ MAX_LAG = 0.1
 
 @dataclass
 class RateStats:
-    """What the clock achieved while running.
-
-    Attributes
-    ----------
-    steps : int
-        Steps made.
-    wall : float
-        Wall time spent running, s.
-    dropped : float
-        Simulated time given up to stay in real time, s.
-    step_times : deque of float
-        Wall time of the last steps, s.
-    stamps : deque of float
-        When the last steps ended (``time.perf_counter``), s.
-    """
+    """What the clock achieved while running: the ``steps`` made, the ``wall`` time spent (s),
+    the simulated time ``dropped`` to stay in real time (s), and of the last steps their wall
+    time (``step_times``, s) and when they ended (``stamps``, ``time.perf_counter``, s)."""
 
     steps: int = 0
     wall: float = 0.0
@@ -69,13 +51,8 @@ class RateStats:
 
 
 class RealTimeClock:
-    """Steps ``session`` at its scene's ``dt`` in a daemon thread.
-
-    Parameters
-    ----------
-    session
-        What to step.
-    """
+    """Steps ``session`` at its scene's ``dt`` in a daemon thread, from :meth:`resume` to
+    :meth:`pause`: a late step is made at once, a lag of more than :data:`MAX_LAG` dropped."""
 
     def __init__(self, session: ConsoleSession) -> None:
         self.session, self.dt = session, session.scene.dt
@@ -111,9 +88,8 @@ class RealTimeClock:
 
     def _loop(self) -> None:
         while not self._closing.is_set():
-            if not self._running.wait(timeout=0.1):
-                continue
-            self._run()
+            if self._running.wait(timeout=0.1):
+                self._run()
 
     def _run(self) -> None:
         """Step until paused or closed, each step due ``dt`` after the previous one."""

@@ -1,9 +1,4 @@
-"""What the server shares between requests: the session, its clock, the token, the clients.
-
-:class:`Console` applies client messages, decides who holds the JOG, stops the arm when its
-connection goes and pauses the clock when no client is left. It knows nothing of the web
-framework: a connection is any hashable object.
-"""
+"""What the server shares between requests: the session, its clock, the token, the clients."""
 
 from __future__ import annotations
 
@@ -17,7 +12,8 @@ from dvqp.console.session import ConsoleSession
 
 
 class Console:
-    """What the server shares between requests: session, clock, token, connections."""
+    """Applies client messages, decides who holds the JOG, stops the arm when its connection
+    goes and pauses the clock when no client is left. A connection is any hashable object."""
 
     def __init__(self, session: ConsoleSession, token: str, host: str = "127.0.0.1") -> None:
         self.session, self.token, self.host = session, token, host
@@ -51,13 +47,11 @@ class Console:
             return protocol.error(str(exc))
         if message.kind == "jog":
             self.session.jog(message.velocity)
-            self.owner = ws
         elif message.kind == "stop":
             self.session.stop()
-            self.owner = None
         else:
             self.session.reset()
-            self.owner = None
+        self.owner = ws if message.kind == "jog" else None
         for wake in self.wakers:
             wake.set()
         return None

@@ -1,9 +1,5 @@
-"""The ``scene`` message a client gets once at connect: what to draw around the arm.
-
-It carries the pipe, the weld, the orbital level, the height and clearance limits, the JOG
-speed limits and every obstacle's outline in (l, z) (a band: its two edges' z), so a client
-can draw the developed view and the cross-section without reading the scene file.
-"""
+"""The ``scene`` message a client gets once at connect: all it needs to draw around the arm
+(the developed view, the cross-section) without reading the scene file."""
 
 from __future__ import annotations
 

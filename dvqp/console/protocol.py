@@ -1,16 +1,10 @@
-"""The console's WebSocket protocol: what a client may send, checked, and the JSON sent back.
+"""The console's WebSocket protocol (``docs/console.md``): client messages checked and
+clamped, and the JSON sent back. Nothing here imports the web framework.
 
-A client sends one JSON object per text frame (see ``docs/console.md``):
-
-- ``{"type": "jog", "velocity": [l̇, ż, ḣ, α̇]}`` (m/s, m/s, m/s, rad/s), held until the next
-  message; speeds beyond :data:`MAX_LINEAR_SPEED` / :data:`MAX_ANGULAR_SPEED` are clamped;
-- ``{"type": "stop"}``;
-- ``{"type": "reset"}``.
-
-Anything else — not text, more than :data:`MAX_MESSAGE_BYTES`, not JSON, not an object, an
-unknown type or key, a velocity that is not four finite numbers — raises
-:class:`ProtocolError`, whose one-line message the server sends back as
-``{"type": "error", "message": ...}``; nothing changes. Nothing here imports the web framework.
+A client sends one JSON object per text frame: ``jog`` (a velocity ``[l̇, ż, ḣ, α̇]`` held
+until the next message, clamped to :data:`SPEED_LIMITS`), ``stop`` or ``reset``. Anything else
+raises :class:`ProtocolError`, whose one-line message the server sends back as an ``error``
+message; nothing changes.
 """
 
 from __future__ import annotations
@@ -25,13 +19,10 @@ from numpy.typing import NDArray
 
 MAX_MESSAGE_BYTES = 4096
 """Largest client message answered, bytes (UTF-8); a longer one gets an ``error`` reply."""
-
 MAX_LINEAR_SPEED = 0.1
 """Largest JOG speed of l, z and h, m/s; a faster command is clamped to it."""
-
 MAX_ANGULAR_SPEED = 1.0
 """Largest JOG speed of the heading α, rad/s; a faster command is clamped to it."""
-
 SPEED_LIMITS = np.array([MAX_LINEAR_SPEED] * 3 + [MAX_ANGULAR_SPEED])
 AXES = ("l", "z", "h", "alpha")
 UNITS = ("m/s", "m/s", "m/s", "rad/s")
@@ -44,15 +35,8 @@ class ProtocolError(ValueError):
 
 @dataclass(frozen=True)
 class Message:
-    """A checked client message.
-
-    Attributes
-    ----------
-    kind : str
-        ``"jog"``, ``"stop"`` or ``"reset"``.
-    velocity : ndarray, shape (4,)
-        The JOG velocity as sent (zeros for ``stop`` and ``reset``).
-    """
+    """A checked client message: its ``kind`` (``"jog"``, ``"stop"`` or ``"reset"``) and the
+    JOG ``velocity`` as sent, shape (4,) (zeros for ``stop`` and ``reset``)."""
 
     kind: str
     velocity: NDArray[np.float64]
@@ -63,13 +47,8 @@ def _no_constant(name: str) -> float:
 
 
 def parse(data: str | bytes) -> Message:
-    """Check one client message.
-
-    Raises
-    ------
-    ProtocolError
-        Too long, not JSON, not a known message, or a velocity that is not 4 finite numbers.
-    """
+    """Check one client message: :class:`ProtocolError` if it is too long, not JSON, not a
+    known message, or has a velocity that is not 4 finite numbers."""
     if not isinstance(data, str):
         raise ProtocolError("binary frames are not accepted: send JSON text")
     size = len(data.encode("utf-8", "surrogatepass"))
@@ -89,9 +68,7 @@ def parse(data: str | bytes) -> Message:
     extra = sorted(set(doc) - KEYS[kind])
     if extra:
         raise ProtocolError(f"{kind}: unknown key {_show(extra[0])}")
-    if kind != "jog":
-        return Message(kind, np.zeros(4))
-    return Message(kind, _velocity(doc.get("velocity")))
+    return Message(kind, _velocity(doc.get("velocity")) if kind == "jog" else np.zeros(4))
 
 
 def _velocity(value: Any) -> NDArray[np.float64]:

@@ -1,14 +1,8 @@
-"""Who may talk to the console: the token, the Host header and the WebSocket Origin.
+"""Who may talk to the console (pure functions on strings, used by :mod:`dvqp.console.server`).
 
-Pure functions on strings (no web framework), used by :mod:`dvqp.console.server`:
-
-- every request carries ``?token=<token>``, compared in constant time (else 401);
-- a console bound to a loopback address answers only requests whose ``Host`` names a loopback
-  address (``127.x.x.x``, ``localhost``, ``[::1]``), against DNS rebinding (else 403);
-- a WebSocket request with an ``Origin`` header is accepted only from the console's own
-  origin (the ``Host`` it was asked under), so another site open in the same browser cannot
-  drive the arm (else 403); one without ``Origin`` (a pendant, a ROS bridge) needs the token
-  only.
+Every request carries the token (else 401). A console bound to a loopback address answers only
+a loopback ``Host`` (against DNS rebinding), and a WebSocket ``Origin``, if sent, must be the
+console's own, so another site open in the same browser cannot drive the arm (else 403).
 """
 
 from __future__ import annotations
@@ -47,17 +41,6 @@ def token_ok(given: str | None, token: str) -> bool:
     return hmac.compare_digest(given.encode("utf-8", "replace"), token.encode("utf-8"))
 
 
-def hostname(host: str | None) -> str | None:
-    """The host name of a ``Host`` header or bind address, lower case, no brackets or port."""
-    if not host:
-        return None
-    try:
-        name = urlsplit("//" + host).hostname
-    except ValueError:
-        return None
-    return name.lower() if name else None
-
-
 def is_loopback(name: str | None) -> bool:
     """A host name or address (no port; IPv6 with or without brackets) is the loopback."""
     if not name:
@@ -75,7 +58,10 @@ def host_ok(host_header: str | None, bound: str) -> bool:
     """A request's ``Host`` may reach a console bound to ``bound``."""
     if not is_loopback(bound):
         return True
-    return is_loopback(hostname(host_header))
+    try:
+        return is_loopback(urlsplit("//" + (host_header or "")).hostname)
+    except ValueError:  # not a host name
+        return False
 
 
 def origin_ok(origin: str | None, host_header: str | None) -> bool:

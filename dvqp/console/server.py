@@ -1,17 +1,8 @@
-"""The console's web server (aiohttp): the page, the WebSocket, the trajectory download.
-
-Routes (every one needs ``?token=<token>``, see :mod:`dvqp.console.security`):
-
-- ``GET /`` the page; ``GET /console.js``, ``/draw.js``, ``/panels.js``, ``/console.css``
-  its files;
-- ``GET /ws`` the WebSocket of :mod:`dvqp.console.protocol`: a ``scene`` message at connect,
-  then ``state`` messages at :data:`STATE_HZ`, an ``error`` reply to a refused message;
-- ``GET /trajectory.npz`` what was driven since the last reset, as ``dvqp plan -o`` writes it;
-- ``GET /stats.json`` the clock's achieved rate and step times.
-
-The arm steps while a WebSocket is open; the JOG belongs to the connection that sent it, and
-the arm stops when that connection closes (the clock pauses when none is left). aiohttp is the
-optional extra ``dvqp[console]``; this module imports without it (:data:`AVAILABLE`).
+"""The console's web server (aiohttp, the optional extra ``dvqp[console]``; this module imports
+without it, :data:`AVAILABLE`): the page and its files, the WebSocket of
+:mod:`dvqp.console.protocol`, ``/trajectory.npz`` (what was driven since the last reset) and
+``/stats.json`` (the clock's rate), each behind the checks of :mod:`dvqp.console.security`.
+The arm steps while a WebSocket is open; see ``docs/console.md``.
 """
 
 from __future__ import annotations
@@ -19,7 +10,7 @@ from __future__ import annotations
 import asyncio
 import re
 import tempfile
-from collections.abc import Callable
+from collections.abc import AsyncIterator, Callable
 from pathlib import Path
 from typing import Any
 
@@ -38,12 +29,8 @@ else:
 MISSING = "the console needs aiohttp: pip install 'dvqp[console]'"
 """The one-line error of ``dvqp console`` without the extra."""
 STATIC = Path(__file__).with_name("static")
-FILES = {
-    "console.js": "text/javascript",
-    "draw.js": "text/javascript",
-    "panels.js": "text/javascript",
-    "console.css": "text/css",
-}
+FILES = {"console.js": "text/javascript", "draw.js": "text/javascript",
+         "panels.js": "text/javascript", "console.css": "text/css"}  # fmt: skip
 STATE_HZ = 50.0
 """State messages per second to each client."""
 MAX_FRAME_BYTES = 1 << 20
@@ -66,9 +53,8 @@ def create_app(console: Console) -> Any:
     app.router.add_get("/stats.json", _stats)
     app.router.add_get("/{name}", _file)
     app.on_response_prepare.append(_headers)
-    app.on_startup.append(_start)
+    app.cleanup_ctx.append(_clock)
     app.on_shutdown.append(_close_sockets)
-    app.on_cleanup.append(_stop)
     return app
 
 
@@ -90,17 +76,15 @@ async def _headers(request: Any, response: Any) -> None:
         response.headers.setdefault(name, value)
 
 
-async def _start(app: Any) -> None:
+async def _clock(app: Any) -> AsyncIterator[None]:
     app[KEY].clock.start()
+    yield
+    app[KEY].clock.close()
 
 
 async def _close_sockets(app: Any) -> None:
     for ws in list(app[KEY].sockets):
         await ws.close(code=1001, message=b"server shutdown")
-
-
-async def _stop(app: Any) -> None:
-    app[KEY].clock.close()
 
 
 async def _page(request: Any) -> Any:

@@ -1,10 +1,9 @@
 """The console's simulation: one scene, one resolver, a held JOG command, stepped on demand.
 
-:class:`ConsoleSession` is safe to share between the clock thread that calls :meth:`step`
-and the server that sets commands, resets and reads snapshots. A step is the same compiled,
-exactly verified step as ``dvqp plan`` makes (:func:`dvqp.step.advance`), from the scene's
-start and on its limits; it is computed outside the lock, so a command or a snapshot never
-waits for a solver. The stepper is touched by the stepping thread only.
+:class:`ConsoleSession` is shared by the clock thread, which alone calls :meth:`step` and
+touches the stepper, and the server, which sets commands, resets and reads snapshots. A step
+is the verified step of ``dvqp plan`` (:func:`dvqp.step.advance`), computed outside the lock:
+a command or a snapshot never waits for a solver.
 """
 
 from __future__ import annotations
@@ -28,15 +27,9 @@ from dvqp.step import Advance, Stepper, advance
 
 
 class Ramp:
-    """The JOG command spread over ``window`` steps, as ``plan`` ramps JOG segments: the mean
-    of the last ``window`` targets, so a change of velocity becomes a linear ramp and the
-    displacement is that of the targets.
-
-    Parameters
-    ----------
-    window
-        Steps, >= 1 (1: no ramp).
-    """
+    """The JOG command spread over ``window`` steps (1: no ramp), as ``plan`` ramps JOG
+    segments: the mean of the last ``window`` targets, so a change of velocity becomes a
+    linear ramp and the displacement is that of the targets."""
 
     def __init__(self, window: int) -> None:
         self._ring = np.zeros((max(1, window), 4))
@@ -144,7 +137,7 @@ class ConsoleSession:
             restart, self._restart = self._restart, ""
             command = self._ramp(self._command)
         started = time.perf_counter()
-        self._restarted(restart, before)
+        self._restarted(restart)
         moved = self._advance(command)
         after = Sample.of(self.stepper)
         took = time.perf_counter() - started
@@ -158,7 +151,7 @@ class ConsoleSession:
             self._seq += 1
             self._applied = version
 
-    def _restarted(self, restart: str, before: Sample) -> None:
+    def _restarted(self, restart: str) -> None:
         """Back at the start (``"start"``), or from rest where the arm is (``"rest"``): warm
         starts forgotten, and what limits that remember motion remember (as ``plan``)."""
         if restart == "start":
@@ -196,7 +189,7 @@ class ConsoleSession:
             "min_clearance": protocol.finite(sample.min_clearance),
             "task_error": protocol.finite(step.task_error, 9), "closest": sample.closest,
             "probe_clearance": protocol.finite(sample.probe_clearance),
-            "tilt": protocol.finite(sample.tilt), "limits_kept": sample.kept,
+            "tilt": protocol.finite(sample.tilt), "limits_kept": sample.limits_kept,
             "substeps": substeps, "command": protocol.rounded(command),
             "velocity": protocol.rounded(velocity),
             "clamped": clamped, "seq": seq, "recorded_steps": recorded,

@@ -10,11 +10,6 @@ from dvqp.geometry.proximity import (
 )
 
 __all__ = [
-    "Obstacle",
-    "ObstacleSet",
-    "Proximity",
-    "distances",
-    "min_clearance",
-    "proximity",
+    "Obstacle", "ObstacleSet", "Proximity", "distances", "min_clearance", "proximity",
     "segment_distances",
-]
+]  # fmt: skip

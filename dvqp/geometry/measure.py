@@ -1,11 +1,10 @@
 """Signed distances of the arm's guarded chain to every obstacle, compiled.
 
-The guarded chain is the k body points then the probe (the tool point); its links join
-consecutive points (the k−1 body links, then the probe holder). :class:`ShapeArrays` packs an
-obstacle sequence once; :func:`measure_chain` writes every built-in shape's distances and
-normals into :class:`~dvqp.workspace.ProximityBuffers` (the kernels of each shape's module,
-selected per row), :func:`user_rows` those of shapes of your own (their NumPy methods), and
-:func:`penalties` every row's objective penalty ``e = d (d + 2ρ)`` and ``∇e = 2 (d + ρ) ∇d``.
+:class:`ShapeArrays` packs an obstacle sequence once; :func:`measure_chain` writes every
+built-in shape's distances and normals into :class:`~dvqp.workspace.ProximityBuffers` (the
+kernels of each shape's module, selected per row), :func:`user_rows` those of shapes of your
+own (their NumPy methods), and :func:`penalties` every row's objective penalty
+``e = d (d + 2ρ)`` and ``∇e = 2 (d + ρ) ∇d``.
 """
 
 from __future__ import annotations
@@ -82,16 +81,9 @@ class ShapeArrays:
                 vertices.append(local)
                 at += local.shape[0]
         packed = np.concatenate(vertices) if vertices else np.zeros((0, 2))
-        return cls(
-            float(period),
-            code,
-            data,
-            start,
-            stop,
-            np.ascontiguousarray(packed[:, 0]),
-            np.ascontiguousarray(packed[:, 1]),
-            np.array([s.size for s in shapes], float),
-        )
+        vl, vz = np.ascontiguousarray(packed[:, 0]), np.ascontiguousarray(packed[:, 1])
+        return cls(float(period), code, data, start, stop, vl, vz,
+                   np.array([s.size for s in shapes], float))  # fmt: skip
 
 
 @njit(cache=True)
@@ -125,9 +117,10 @@ def _segment(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
 @njit(cache=True)
 def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
     """Distances and normals of the points ``chain`` (m, ≥ 2; columns l, z, ...) and of the
-    links between consecutive points to every compiled obstacle, into ``near`` (a packed
-    :class:`~dvqp.workspace.ProximityBuffers`); rows of :data:`OTHER` shapes are left alone."""
-    m = chain.shape[0]
+    links between consecutive points (as many as ``near`` has columns for) to every compiled
+    obstacle, into ``near`` (a packed :class:`~dvqp.workspace.ProximityBuffers`); rows of
+    :data:`OTHER` shapes are left alone."""
+    m, links = chain.shape[0], near.link_distance.shape[1]
     for j in range(shapes.code.shape[0]):
         if shapes.code[j] == OTHER:
             continue
@@ -135,7 +128,7 @@ def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
             d, nl, nz = _point(shapes, j, chain[i, 0], chain[i, 1])
             near.point_distance[j, i] = d
             near.point_normal[j, i, 0], near.point_normal[j, i, 1] = nl, nz
-        for i in range(m - 1):
+        for i in range(links):
             d, t, nl, nz = _segment(shapes, j, chain[i, 0], chain[i, 1], chain[i + 1, 0],
                                     chain[i + 1, 1])  # fmt: skip
             near.link_distance[j, i], near.link_t[j, i] = d, t
@@ -163,9 +156,10 @@ def user_rows(shapes: Sequence[Shape], code: NDArray[np.int64], chain: Array, pe
               near: ProximityBuffers) -> None:  # fmt: skip
     """Rows of the shapes of your own (code :data:`OTHER`): their NumPy ``point_distance`` and
     ``segment_distance`` of ``chain`` (m, ≥ 2), written into ``near``."""
-    lz = np.ascontiguousarray(chain[:, :2])
+    lz, links = np.ascontiguousarray(chain[:, :2]), near.link_distance.shape[1]
     for j in np.flatnonzero(code == OTHER):
         shape = shapes[j]
         near.point_distance[j], near.point_normal[j] = shape.point_distance(lz, period)
-        d, t, n = shape.segment_distance(lz[:-1], lz[1:], period)
-        near.link_distance[j], near.link_t[j], near.link_normal[j] = d, t, n
+        if links:
+            d, t, n = shape.segment_distance(lz[:links], lz[1 : links + 1], period)
+            near.link_distance[j], near.link_t[j], near.link_normal[j] = d, t, n

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -70,13 +70,9 @@ class Proximity:
     @classmethod
     def of(cls, near: ProximityBuffers) -> Proximity:
         """Views of proximity buffers."""
-        points = ShapeDistances(
-            near.point_distance,
-            near.point_normal,
-            near.point_penalty,
-            near.point_penalty_gradient,
-            np.zeros_like(near.point_distance),
-        )
+        points = ShapeDistances(near.point_distance, near.point_normal, near.point_penalty,
+                                near.point_penalty_gradient,
+                                np.zeros_like(near.point_distance))  # fmt: skip
         links = ShapeDistances(near.link_distance, near.link_normal, near.link_penalty,
                                near.link_penalty_gradient, near.link_t)  # fmt: skip
         return cls(points, links)
@@ -132,16 +128,23 @@ def link_label(i: int, k: int) -> str:
     return "holder" if i == k - 1 else f"link{i + 1}"
 
 
-def measure(shapes: Sequence[Shape], chain: Array, period: float) -> ProximityBuffers:
-    """Every distance of the points ``chain`` (m, ≥ 2) and the links between them to
-    ``shapes``, penalties included, in new buffers (J, m) and (J, m − 1)."""
+def measure(shapes: Sequence[Shape], chain: Array, period: float, links: bool = True
+            ) -> ProximityBuffers:  # fmt: skip
+    """Every distance of the points ``chain`` (m, ≥ 2) and (if ``links``) the links between
+    them to ``shapes``, penalties included, in new buffers (J, m) and (J, m − 1 or 0)."""
     packed = ShapeArrays.of(shapes, period)
     near = ProximityBuffers.allocate(len(shapes), chain.shape[0] - 1)
+    if not links:
+        near = replace(near, **{f: np.zeros((len(shapes), 0, *getattr(near, f).shape[2:]))
+                                for f in _LINK_FIELDS})  # fmt: skip
     points = np.ascontiguousarray(chain, dtype=np.float64)
     measure_chain(as_struct(packed), points, as_struct(near))
     user_rows(shapes, packed.code, points, period, near)
     penalties(packed.size, as_struct(near))
     return near
+
+
+_LINK_FIELDS = ("link_distance", "link_normal", "link_penalty", "link_penalty_gradient", "link_t")
 
 
 def proximity(state: KinematicState, obstacles: ObstacleSet | Sequence[Shape]) -> Proximity:
@@ -167,7 +170,7 @@ def distances(
     obstacle (l differences wrapped modulo ``period``, m)."""
     points = np.asarray(lz, dtype=np.float64).reshape(-1, 2)
     chain = np.vstack([points, points[-1:]])  # a chain needs two points: the last, twice
-    near = measure(tuple(obstacles), chain, period)
+    near = measure(tuple(obstacles), chain, period, links=False)
     m = points.shape[0]
     return near.point_distance[:, :m].copy(), near.point_normal[:, :m].copy()
 

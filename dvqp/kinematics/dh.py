@@ -1,12 +1,11 @@
-"""Denavit–Hartenberg tables and a plain-NumPy forward kinematics (the reference).
+"""Denavit–Hartenberg tables: the rows the arm is built from (:meth:`dvqp.Robot.from_dh`).
 
-Standard DH: ``T_i^{i-1} = Rz(θ_i) · Tz(d_i) · Tx(a_i) · Rx(α_i)``. The NumPy product here is
-independent of Pinocchio and is what the tests compare the Pinocchio model against.
+Standard DH: ``T_i^{i-1} = Rz(θ_i) · Tz(d_i) · Tx(a_i) · Rx(α_i)``; the joint's rotation
+``Rz(θ_i)`` is Pinocchio's revolute joint, the rest the fixed part of the row.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,8 +13,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
-
-HALF_PI = 0.5 * np.pi
 
 
 @dataclass(frozen=True)
@@ -48,44 +45,6 @@ def fixed_part(row: DHRow) -> NDArray[np.float64]:
     )
 
 
-def dh_transform(row: DHRow, theta: float) -> NDArray[np.float64]:
-    """Homogeneous transform ``T_i^{i-1}`` of one DH row at joint angle ``theta``, (4, 4)."""
-    th = theta + row.theta_offset
-    ct, st = np.cos(th), np.sin(th)
-    rz = np.array([[ct, -st, 0.0, 0.0], [st, ct, 0.0, 0.0], [0, 0, 1.0, 0], [0, 0, 0, 1.0]])
-    return rz @ fixed_part(row)
-
-
-def forward_dh(
-    table: Sequence[DHRow], q: ArrayLike, tool: NDArray[np.float64] | None = None
-) -> list[NDArray[np.float64]]:
-    """Plain DH product: the transforms ``T_1^0, …, T_n^0`` and, if given, ``T_e^0``.
-
-    Parameters
-    ----------
-    table
-        The n DH rows.
-    q
-        Joint angles, rad, shape (n,).
-    tool
-        ``T_e^n``, shape (4, 4), or None.
-
-    Returns
-    -------
-    list of ndarray
-        n transforms (n+1 with a tool), each (4, 4), in the base frame.
-    """
-    qv = _validate.vector("q", q, len(table))
-    out = []
-    t = np.eye(4)
-    for row, th in zip(table, qv, strict=True):
-        t = t @ dh_transform(row, th)
-        out.append(t)
-    if tool is not None:
-        out.append(t @ tool)
-    return out
-
-
 def ndt13_table(link_lengths: ArrayLike) -> tuple[list[DHRow], NDArray[np.float64]]:
     """DH table and tool transform of the paper's 13-DOF NDT manipulator (Table I, eq. 2).
 
@@ -106,7 +65,7 @@ def ndt13_table(link_lengths: ArrayLike) -> tuple[list[DHRow], NDArray[np.float6
     if np.any(lengths < 0):
         raise ParameterError("link_lengths", "must be >= 0")
     l1, l2, l3, l4, l5, l6, l7 = lengths
-    p, m = HALF_PI, -HALF_PI
+    p, m = 0.5 * np.pi, -0.5 * np.pi
     table = [
         DHRow(0.0, 0.0, p),
         DHRow(l1, 0.0, m),

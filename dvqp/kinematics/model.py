@@ -87,17 +87,13 @@ class ModelArrays:
                 support[f, j] = True
                 j = model.parents[j]
         return cls(
-            parents=np.array(model.parents, dtype=np.int64),
-            kinds=kinds,
+            parents=np.array(model.parents, dtype=np.int64), kinds=kinds,
             index=np.array([max(model.joints[j].idx_q, 0) for j in range(count)], np.int64),
-            placements=np.array([p.homogeneous for p in model.jointPlacements]),
-            axes=axes,
+            placements=np.array([p.homogeneous for p in model.jointPlacements]), axes=axes,
             frame_joint=np.array([f.parentJoint for f in frames], dtype=np.int64),
-            frame_placement=np.array([f.placement.homogeneous for f in frames]),
-            support=support,
-            work=np.zeros((count + 2, 4, 4)),
-            world=np.zeros((count, 3)),
-        )
+            frame_placement=np.array([f.placement.homogeneous for f in frames]), support=support,
+            work=np.zeros((count + 2, 4, 4)), world=np.zeros((count, 3)),
+        )  # fmt: skip
 
 
 def _motion_of(joint: pin.JointModel, name: str) -> tuple[int, Array]:

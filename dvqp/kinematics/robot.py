@@ -62,21 +62,15 @@ class Robot:
     ) -> None:
         if model.nq != model.nv:
             raise ParameterError("model", "only joints with nq == nv (revolute, prismatic)")
-        self.model = model
-        self.name = name
-        n = model.nq
+        self.model, self.name, n = model, name, model.nq
         if len(point_frames) < 2:
             raise ParameterError("points", "need at least two body-point frames")
-        names = [*point_frames, tool_frame]
-        ids = []
-        for fname in names:
+        self.point_frames, self.tool_frame = tuple(point_frames), tool_frame
+        for fname in self.frame_names:
             if not model.existFrame(fname):
                 known = ", ".join(f.name for f in model.frames)
                 raise ParameterError("frames", f"no frame named {fname!r} (model has: {known})")
-            ids.append(model.getFrameId(fname))
-        self.point_frames = tuple(point_frames)
-        self.tool_frame = tool_frame
-        self.frame_ids: tuple[int, ...] = tuple(ids)
+        self.frame_ids: tuple[int, ...] = tuple(map(model.getFrameId, self.frame_names))
         lo = model.lowerPositionLimit if q_min is None else q_min
         hi = model.upperPositionLimit if q_max is None else q_max
         self.q_min = _validate.readonly(_validate.limit("q_min", lo, n))
@@ -161,16 +155,8 @@ class Robot:
             if row.theta_offset != 0.0:
                 rz = pin.SE3(pin.rpy.rpyToMatrix(0.0, 0.0, row.theta_offset), np.zeros(3))
                 placement = placement * rz
-            parent = model.addJoint(
-                parent,
-                pin.JointModelRZ(),
-                placement,
-                f"joint{i + 1}",
-                inf,
-                inf,
-                lo[i : i + 1],
-                hi[i : i + 1],
-            )
+            parent = model.addJoint(parent, pin.JointModelRZ(), placement, f"joint{i + 1}", inf,
+                                    inf, lo[i : i + 1], hi[i : i + 1])  # fmt: skip
             model.addJointFrame(parent, -1)
             placement = pin.SE3(fixed_part(row))
             for k, j in enumerate(point_joints):

@@ -9,6 +9,7 @@ compiled kinematics (:func:`dvqp.kinematics.model.kinematics`), into arrays of i
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,47 +23,28 @@ from dvqp.workspace import StateBuffers, as_struct
 
 
 @dataclass(frozen=True)
-class KinematicState:
-    """Kinematics of one configuration in Cartesian and developed-view coordinates.
+class KinematicState(StateBuffers):
+    """Kinematics of one configuration in Cartesian and developed-view coordinates: the fields
+    of :class:`~dvqp.workspace.StateBuffers` (``q``, ``origins``, ``axes``,
+    ``frame_jacobians``, ``guarded``, ``guarded_jacobians``, ``tool``, ``tool_jacobian``) and
+    the pipe's ``radius`` (m).
 
-    Attributes
-    ----------
-    q : ndarray, shape (n,)
-        Joint configuration, rad.
-    radius : float
-        Pipe radius, m.
-    origins : ndarray, shape (k+1, 3)
-        Frame origins of the k body points then the tool, m, base frame.
-    axes : ndarray, shape (k+1, 3)
-        Unit z axes of the same frames (the last one is the probe's axis).
-    frame_jacobians : ndarray, shape (k+1, 6, n)
-        ``[J_v; J_ω]`` of the same frames in the base orientation (Pinocchio's
-        LOCAL_WORLD_ALIGNED): ``ȯ = J_v Q̇``, ``ω = J_ω Q̇``.
-    guarded : ndarray, shape (k+1, 3)
-        DV positions ``[l, z, h]`` (m) of every guarded point: the k body points, then the
-        probe (the tool point). Consecutive points bound the guarded links: the k−1 body links,
-        then the probe holder (last body point to the tool).
-    guarded_jacobians : ndarray, shape (k+1, 3, n)
-        ``∂[l, z, h]/∂Q`` of the same points, m/rad.
-    points, point_jacobians : ndarray, shapes (k, 3), (k, 3, n)
-        The body points alone: ``guarded[:-1]``, ``guarded_jacobians[:-1]``.
-    tool : ndarray, shape (4,)
-        Tool DV coordinates ``[l, z, h, α]`` (m, m, m, rad).
-    tool_jacobian : ndarray, shape (4, n)
-        The DV task Jacobian ``J̄(Q)``.
+    The guarded points are the k body points then the probe (the tool point); consecutive
+    points bound the guarded links: the k−1 body links, then the probe holder. With
+    ``frame_jacobians = [J_v; J_ω]`` (base orientation): ``ȯ = J_v Q̇``, ``ω = J_ω Q̇``.
     """
 
-    q: NDArray[np.float64]
-    radius: float
-    origins: NDArray[np.float64]
-    axes: NDArray[np.float64]
-    frame_jacobians: NDArray[np.float64]
-    guarded: NDArray[np.float64]
-    guarded_jacobians: NDArray[np.float64]
-    points: NDArray[np.float64]
-    point_jacobians: NDArray[np.float64]
-    tool: NDArray[np.float64]
-    tool_jacobian: NDArray[np.float64]
+    radius: float = 0.0
+
+    @property
+    def points(self) -> NDArray[np.float64]:
+        """Body points ``[l, z, h]`` (m), shape (k, 3): ``guarded[:-1]``."""
+        return self.guarded[:-1]
+
+    @property
+    def point_jacobians(self) -> NDArray[np.float64]:
+        """Their ``∂[l, z, h]/∂Q``, shape (k, 3, n): ``guarded_jacobians[:-1]``."""
+        return self.guarded_jacobians[:-1]
 
     @property
     def n(self) -> int:
@@ -72,18 +54,15 @@ class KinematicState:
     @property
     def k(self) -> int:
         """Number of body points."""
-        return int(self.points.shape[0])
+        return int(self.guarded.shape[0]) - 1
 
     @classmethod
     def view(cls, buffers: StateBuffers, radius: float) -> KinematicState:
         """Read-only views of ``buffers``: they show whatever state the buffers hold now."""
-        views = {}
-        for name in ("q", "origins", "axes", "frame_jacobians", "guarded", "guarded_jacobians",
-                     "tool", "tool_jacobian"):  # fmt: skip
-            views[name] = getattr(buffers, name).view()
-            views[name].flags.writeable = False
-        g, gj = views["guarded"], views["guarded_jacobians"]
-        return cls(radius=float(radius), points=g[:-1], point_jacobians=gj[:-1], **views)
+        views = {f.name: getattr(buffers, f.name).view() for f in dataclasses.fields(StateBuffers)}
+        for view in views.values():
+            view.flags.writeable = False
+        return cls(radius=float(radius), **views)
 
     @classmethod
     def compute(cls, robot: Robot, q: ArrayLike, radius: float) -> KinematicState:
@@ -110,7 +89,5 @@ def singular_frame(
 ) -> SingularConfigurationError:
     """The error of guarded frame ``frame`` found on the pipe axis (at ``origin``, m)."""
     rho = float(np.hypot(origin[0], origin[1]))
-    name = robot.frame_names[frame]
-    return SingularConfigurationError(
-        f"frame {name!r} lies on the pipe axis (rho = {rho:.3g} m)", q
-    )
+    where = f"frame {robot.frame_names[frame]!r} lies on the pipe axis (rho = {rho:.3g} m)"
+    return SingularConfigurationError(where, q)

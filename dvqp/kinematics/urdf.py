@@ -13,18 +13,7 @@ from dvqp.errors import DvqpError, ParameterError
 
 def urdf_model(path: str | Path) -> pin.Model:
     """The Pinocchio model of the URDF file ``path``, each continuous joint (nq = 2) a revolute
-    one (nq = 1) without limits.
-
-    What the C++ URDF parser prints is kept off the terminal; its first complaint is part of
-    the error.
-
-    Raises
-    ------
-    DvqpError
-        ``<path>: cannot load URDF: <reason>`` for a file that is not a valid URDF.
-    ParameterError
-        ``urdf``: a joint of another type than revolute, continuous or prismatic.
-    """
+    one (nq = 1) without limits (errors: see :meth:`dvqp.Robot.from_urdf`)."""
     noise: list[str] = []
     try:
         with c_output_captured(noise):
@@ -42,11 +31,8 @@ nq = 1 twins (any other axis: ``JointModelRevoluteUnboundedUnaligned``, see :fun
 
 
 def _bounded_revolute(model: pin.Model) -> pin.Model:
-    """``model`` with each continuous joint (nq = 2) as a revolute one without limits (nq = 1).
-
-    The joints, bodies and frames keep their names, placements, inertias and order; any other
-    joint with ``nq != nv`` is refused (``ParameterError`` named ``urdf``).
-    """
+    """``model`` with each continuous joint as a revolute one, joints, bodies and frames keeping
+    their names, placements, inertias and order; any other joint with ``nq != nv`` is refused."""
     twins = [_twin(model.joints[i]) for i in range(1, model.njoints)]
     for name, joint, twin in zip(model.names[1:], model.joints[1:], twins, strict=True):
         if joint.nq != joint.nv and twin is None:

@@ -8,33 +8,16 @@ and the exact verification of its distances.
 from dvqp.limits.acceleration import DEFAULT_QDD_MAX, AccelerationLimit
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, damper_value
 from dvqp.limits.excess import NO_EXCESS, Excess
-from dvqp.limits.joint_position import JointPositionLimit
-from dvqp.limits.joint_velocity import JointVelocityLimit
+from dvqp.limits.height import ProbeHeight, SurfaceHeight
+from dvqp.limits.joints import JointPositionLimit, JointVelocityLimit
 from dvqp.limits.limit import Bounds, Constraint, Limit
 from dvqp.limits.obstacle_damper import ObstacleDamper
-from dvqp.limits.probe_height import ProbeHeight
 from dvqp.limits.self_collision import SelfCollision, self_distance
-from dvqp.limits.surface_height import SurfaceHeight
 from dvqp.limits.tilt import TiltLimit
 
 __all__ = [
-    "DEFAULT_DECELERATION",
-    "DEFAULT_QDD_MAX",
-    "NO_EXCESS",
-    "AccelerationLimit",
-    "Bounds",
-    "Constraint",
-    "Distances",
-    "Excess",
-    "JointPositionLimit",
-    "JointVelocityLimit",
-    "Limit",
-    "ObstacleDamper",
-    "ProbeHeight",
-    "SelfCollision",
-    "SurfaceHeight",
-    "TiltLimit",
-    "VelocityDamper",
-    "damper_value",
-    "self_distance",
-]
+    "DEFAULT_DECELERATION", "DEFAULT_QDD_MAX", "NO_EXCESS", "AccelerationLimit", "Bounds",
+    "Constraint", "Distances", "Excess", "JointPositionLimit", "JointVelocityLimit", "Limit",
+    "ObstacleDamper", "ProbeHeight", "SelfCollision", "SurfaceHeight", "TiltLimit",
+    "VelocityDamper", "damper_value", "self_distance",
+]  # fmt: skip

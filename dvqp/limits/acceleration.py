@@ -7,10 +7,8 @@ still stops in time: moving ``Q̇ dt`` this step, then braking at ``q̈_max`` ov
 ``Q̇²/(2 q̈_max)``, must end within the limit, ``Q̇ dt + Q̇²/(2a) ≤ D`` with ``D`` the distance
 left, i.e. ``Q̇ ≤ −a dt + sqrt(a² dt² + 2 a D)`` (and the mirror bound toward ``q_min``).
 
-The limit remembers the velocity of the last step it was told about: the resolution loop
-calls :meth:`AccelerationLimit.observe` after each accepted (sub)step and
-:meth:`AccelerationLimit.reset` at the start of a run (at rest). Both write into the same
-array for the limit's whole life, which the compiled step reads.
+The limit remembers the velocity of each accepted (sub)step (:meth:`AccelerationLimit.observe`;
+at rest after :meth:`AccelerationLimit.reset`) in one array, which the compiled step reads.
 """
 
 from __future__ import annotations
@@ -28,7 +26,6 @@ from dvqp.limits.limit import Limit
 
 DEFAULT_QDD_MAX = 10.0
 """rad/s²: the default joint acceleration limit of the NDT arm's drives."""
-
 
 Array = NDArray[np.float64]
 

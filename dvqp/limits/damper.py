@@ -85,6 +85,8 @@ class VelocityDamper(Limit):
         How far below ``min(d_safe, d at the start)`` an integrated step may end (its unit).
     reach : float
         A row applies only while its distance is below this (``inf``: always).
+    SCENE_KEYS : dict
+        dvqp's dampers: keys of the scene file's ``[constraints]`` table -> their arguments.
     """
 
     name = "damper"

@@ -5,9 +5,8 @@ go past them (second-order terms, large steps). After each step every verified l
 quantities (clearances, heights, tilt, joint room, ...) are evaluated at the configuration
 reached, without linearisation, and the worst :class:`Excess` is kept.
 
-A quantity is kept if it stays at or above ``min(safe, value at the start of the run)``: a
-part that starts closer than its margin may stay there but may not get worse, and small
-excesses cannot add up from step to step.
+A quantity is kept while at or above ``min(safe, value at the run's start)``: a part that
+starts inside its margin may stay there but not get worse, and excesses cannot add up.
 """
 
 from __future__ import annotations

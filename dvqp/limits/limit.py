@@ -9,7 +9,7 @@ parts, on the same state, and writes its rows into the same QP.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -48,19 +48,6 @@ class Constraint:
     def rows(self) -> int:
         """Number of rows p."""
         return int(self.h.shape[0])
-
-    @staticmethod
-    def stack(parts: Sequence[Constraint], n: int) -> Constraint:
-        """All rows of ``parts`` in order (no row if there are none)."""
-        parts = [p for p in parts if p.rows]
-        if not parts:
-            return Constraint(np.zeros((0, n)), np.zeros(0))
-
-        def describe() -> tuple[str, ...]:
-            return tuple(label for p in parts for label in p.labels)
-
-        return Constraint(np.vstack([p.G for p in parts]), np.concatenate([p.h for p in parts]),
-                          describe)  # fmt: skip
 
 
 @dataclass(frozen=True)

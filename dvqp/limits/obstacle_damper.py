@@ -1,10 +1,9 @@
 """Velocity dampers that keep every guarded part out of the obstacles.
 
-The guarded parts are the body points and the probe (the tool point), the body links and the
-probe holder (last body point to the tool). For a pair (part, obstacle j) with signed
-clearance ``d`` (m; a circle: ``‖S_j − p‖ − R_j``) below the influence distance ``d_i``, one
-damper row (see :mod:`dvqp.limits.damper`) keeps ``d ≥ d_safe``. A link row applies only where
-its closest point is interior; at an end the point's own row holds.
+For a pair (guarded point or link, obstacle j) with signed clearance ``d`` (m; a circle:
+``‖S_j − p‖ − R_j``) below the influence distance ``d_i``, one damper row (see
+:mod:`dvqp.limits.damper`) keeps ``d ≥ d_safe``. A link row applies only where its closest
+point is interior; at an end the point's own row holds.
 """
 
 from __future__ import annotations
@@ -42,12 +41,9 @@ class ObstacleDamper(VelocityDamper):
     name = "obstacles"
     quantity = "clearance"
     SCENE_KEYS: ClassVar[dict[str, str]] = {
-        "damper_deceleration": "deceleration",
-        "margin": "margin",
-        "influence": "influence",
+        "damper_deceleration": "deceleration", "margin": "margin", "influence": "influence",
         "damper_gain": "gain",
-    }
-    """Keys of the scene file's ``[constraints]`` table -> constructor arguments."""
+    }  # fmt: skip
 
     def __init__(
         self, obstacles: ObstacleSet, margin: float = 0.01, influence: float = 0.06,

@@ -1,8 +1,7 @@
 """Self-collision: non-adjacent links of the snake body kept apart, in 3-D.
 
-The guarded links are the segments between consecutive guarded points in the base frame: the
-k − 1 body links and the probe holder (last body point to the tool). Every pair of
-non-adjacent links ``(i, j)``, ``j ≥ i + 2``, keeps the distance between its segments
+The guarded links (the body links and the probe holder) are segments in the base frame. Every
+pair of non-adjacent links ``(i, j)``, ``j ≥ i + 2``, keeps the distance between its segments
 ``d = ‖c_i − c_j‖`` at least ``margin`` (``c_i = a_i + s (b_i − a_i)``, ``c_j`` likewise, the
 closest points; exact). With ``n = (c_i − c_j)/d`` and the frames' linear Jacobians ``J``::
 
@@ -21,7 +20,6 @@ import numpy as np
 from numba import njit
 
 from dvqp import _validate
-from dvqp.errors import ParameterError
 from dvqp.geometry.proximity import link_label
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
@@ -48,11 +46,8 @@ class SelfCollision(VelocityDamper):
     name = "self"
     quantity = "self distance"
     SCENE_KEYS: ClassVar[dict[str, str]] = {
-        "damper_deceleration": "deceleration",
-        "self_margin": "margin",
-        "damper_gain": "gain",
-    }
-    """Keys of the scene file's ``[constraints]`` table -> constructor arguments."""
+        "damper_deceleration": "deceleration", "self_margin": "margin", "damper_gain": "gain"
+    }  # fmt: skip
 
     def __init__(
         self, margin: float = 0.02, influence: float = 0.05, gain: float = 0.5,
@@ -61,8 +56,6 @@ class SelfCollision(VelocityDamper):
         super().__init__(gain, deceleration)
         self.margin = _validate.positive("margin", margin, strict=False)
         self.influence = _validate.positive("influence", influence)
-        if not np.isfinite(self.margin):
-            raise ParameterError("margin", "must be finite")
 
     @property
     def safe(self) -> float:

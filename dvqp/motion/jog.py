@@ -13,22 +13,14 @@ from dvqp.errors import ParameterError
 
 MAX_STEPS = 10_000_000
 """Most steps a planned motion may take."""
-
 DEFAULT_RAMP = 0.2
 """s: a JOG's velocity changes (its start, its end, between segments) are spread over this."""
 
 
 @dataclass(frozen=True)
 class JogSegment:
-    """A constant DV velocity held for a duration.
-
-    Parameters
-    ----------
-    duration
-        s, > 0.
-    velocity
-        ``[l̇, ż, ḣ, α̇]`` (m/s, m/s, m/s, rad/s), shape (4,).
-    """
+    """A constant DV velocity ``[l̇, ż, ḣ, α̇]`` (m/s, m/s, m/s, rad/s; shape (4,)) held for
+    ``duration`` s (> 0)."""
 
     duration: float
     velocity: NDArray[np.float64]
@@ -59,8 +51,7 @@ def jog_commands(
     counts = [max(1, round(s.duration / dt)) for s in segments]
     if sum(counts) > MAX_STEPS:
         raise ParameterError("dt", f"{sum(counts)} steps is too many (at most {MAX_STEPS})")
-    rows = [np.tile(s.velocity, (c, 1)) for s, c in zip(segments, counts, strict=True)]
-    commands = np.vstack(rows) if rows else np.zeros((0, 4))
+    commands = np.repeat(np.reshape([s.velocity for s in segments], (-1, 4)), counts, axis=0)
     window = round(_validate.positive("ramp", ramp, strict=False) / dt)
     if window <= 1 or commands.shape[0] == 0:
         return commands

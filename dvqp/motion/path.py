@@ -29,10 +29,8 @@ class ToolPath:
         Speed along the (l, z, h) polyline, m/s.
     gain : float
         Feedback gain ``K``, 1/s.
-    tolerance : float
-        Largest final position error (l, z, h) counted as reached, m.
-    heading_tolerance : float
-        Largest final heading error counted as reached, rad.
+    tolerance, heading_tolerance : float
+        Largest final position error (l, z, h; m) and heading error (rad) counted as reached.
     """
 
     waypoints: NDArray[np.float64]
@@ -58,25 +56,13 @@ class ToolPath:
     def reference(
         self, start: NDArray[np.float64], dt: float, radius: float
     ) -> NDArray[np.float64]:
-        """``x_d(t_k)``: constant speed along the (l, z, h) polyline from ``start``.
+        """``x_d(t_k)``, shape (N+1, 4): constant speed along the (l, z, h) polyline from the
+        tool's DV position ``start`` (shape (4,)), every ``dt`` s, on a pipe of ``radius`` m.
 
         The waypoints are shifted by whole turns (2πR in l, 2π in α) so the first lies nearest
         the tool's start; the tool first moves from ``start`` to it, then along the waypoints.
-        α is interpolated linearly along the arc length.
-
-        Parameters
-        ----------
-        start
-            The tool's DV position at the start, shape (4,).
-        dt
-            Step, s.
-        radius
-            Pipe radius, m.
-
-        Returns
-        -------
-        ndarray, shape (N+1, 4)
-            ``N = ⌈length / (speed·dt)⌉``; the last row is the last waypoint.
+        α is interpolated linearly along the arc length. ``N = ⌈length / (speed·dt)⌉``; the
+        last row is the last waypoint.
         """
         wp = np.array(self.waypoints, dtype=float)
         wp[:, 0] += start[0] + wrap(wp[0, 0] - start[0], radius) - wp[0, 0]

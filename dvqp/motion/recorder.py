@@ -17,17 +17,8 @@ PER_STEP = ("solve_time", "solver_time", "step_time", "task_error")
 
 
 class TrajectoryRecorder:
-    """Storage for ``N + 1`` samples and the ``N`` steps between them.
-
-    Parameters
-    ----------
-    n_steps
-        N.
-    n_joints
-        n.
-    n_points
-        Number of body points k.
-    """
+    """Storage for ``N + 1`` samples and the ``N = n_steps`` steps between them, of an arm of
+    ``n_joints`` joints and ``n_points`` body points."""
 
     def __init__(self, n_steps: int, n_joints: int, n_points: int) -> None:
         self.arrays: dict[str, np.ndarray] = {

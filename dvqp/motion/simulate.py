@@ -27,16 +27,16 @@ from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.step import Resolver
 from dvqp.step import MAX_HALVINGS, Stepper, advance
 
+Array = NDArray[np.float64]
+
 COMPILE_NOTICE_SECONDS = 1.0
 """s: compiling the step for longer than this is announced through ``notice``."""
-COMPILE_NOTICE = "compiling the step: the first run only, about half a minute (cached after)"
+COMPILE_NOTICE = "compiling: first run only, ~30 s"
 
 __all__ = ["COMPILE_NOTICE", "dv_error", "simulate"]
 
 
-def dv_error(
-    reference: NDArray[np.float64], actual: NDArray[np.float64], radius: float
-) -> NDArray[np.float64]:
+def dv_error(reference: Array, actual: Array, radius: float) -> Array:
     """``x_d − x`` of DV coordinates (…, 4) with l wrapped modulo 2πR and α modulo 2π."""
     e = np.asarray(reference, dtype=float) - np.asarray(actual, dtype=float)
     e[..., 0] = wrap(e[..., 0], radius)
@@ -60,12 +60,10 @@ def _noticed(notice: Callable[[str], None] | None) -> Iterator[None]:
     finally:
         timer.cancel()
         if timer.finished.is_set() and time.perf_counter() - started > COMPILE_NOTICE_SECONDS:
-            notice(f"compiled the step in {time.perf_counter() - started:.0f} s")
+            notice(f"compiled in {time.perf_counter() - started:.0f} s, cached")
 
 
-def _check_commands(
-    commands: ArrayLike, reference: ArrayLike | None
-) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+def _check_commands(commands: ArrayLike, reference: ArrayLike | None) -> tuple[Array, Array | None]:
     cmd = np.asarray(commands, dtype=float)
     if cmd.ndim != 2 or cmd.shape[1] != 4:
         raise ShapeError("commands", (-1, 4), cmd.shape)

@@ -16,21 +16,8 @@ from dvqp._versions import versions
 from dvqp.errors import DvqpError
 from dvqp.kinematics.developed_view import unwrap
 
-ARRAYS = (
-    "t",
-    "q",
-    "qdot",
-    "tool",
-    "points",
-    "w",
-    "min_clearance",
-    "solve_time",
-    "step_time",
-    "task_error",
-    "iterations",
-    "success",
-    "status",
-)
+ARRAYS = ("t", "q", "qdot", "tool", "points", "w", "min_clearance", "solve_time", "step_time",
+          "task_error", "iterations", "success", "status")  # fmt: skip
 """The arrays every trajectory file holds."""
 
 DIAGNOSTICS = ("probe_clearance", "tilt", "self_distance", "limit_excess", "limits_kept",
@@ -67,13 +54,13 @@ class Trajectory:
         Body points ``[l, z, h]`` (m), l unwrapped per point.
     w : ndarray, shape (N+1,)
         Objective value.
-    min_clearance : ndarray, shape (N+1,)
-        Smallest clearance of any guarded part (body points and links, the probe and its
-        holder) to the obstacles, m (inf: no obstacle).
-    solve_time : ndarray, shape (N,)
-        Resolver time per step (QP assembly + solve + check, or the pseudoinverse), s.
-    step_time : ndarray, shape (N,)
-        Full step time: kinematics + objective + resolver, s.
+    min_clearance, probe_clearance : ndarray, shape (N+1,)
+        Smallest clearance to the obstacles of any guarded part (body points and links, probe
+        and holder), and of the probe and its holder, m (inf: no obstacle).
+    solve_time, solver_time, step_time : ndarray, shape (N,)
+        Per step, s: the resolver's time (QP assembly + solve + check, or the pseudoinverse),
+        of it the time in the QP backend's calls (the baseline: its linear algebra), and the
+        full step's (kinematics + objective + resolver).
     task_error : ndarray, shape (N,)
         ``‖J̄Q̇ − ẋ‖∞`` per step.
     iterations : ndarray of int, shape (N,)
@@ -82,24 +69,16 @@ class Trajectory:
         The step was solved and checked.
     status : ndarray of str, shape (N,)
         Resolver status per step.
-    backend : str
-        Name of the resolver.
-    pipe_radius : float
-        m.
-    scene_text : str
-        The scene file's text, if the run came from one.
+    backend, pipe_radius, scene_text : str, float, str
+        The resolver's name, the pipe radius (m) and the scene file's text (if any).
     tracking_error : ndarray, shape (N+1, 4) or (0, 4)
         ``x_d − x`` of the tool per sample (m, m, m, rad; l and α wrapped) against the planned
         reference (a path, or the integrated JOG commands); empty if there was none.
-    probe_clearance : ndarray, shape (N+1,)
-        Smallest clearance of the probe and its holder, m (inf: no obstacle).
     tilt : ndarray, shape (N+1,)
         Angle of the probe axis from the pipe's radial direction, rad, in [0, π].
     limit_excess : ndarray, shape (N+1,)
-        Exact excess of the worst limit at each sample, in that limit's unit (m for
-        clearances and heights, rad for tilt and joint positions), against
-        ``min(bound, value at the start)``; 0 where every limit is kept. "Worst" is the
-        largest excess relative to the limit's tolerance.
+        Exact excess (m or rad) of the worst limit (relative to its tolerance) at each sample,
+        against ``min(bound, value at the start)``; 0 where every limit is kept.
     limits_kept : ndarray of bool, shape (N+1,)
         Every limit is kept at the sample to within its tolerance (0.1 mm, 1 mrad, 1 µrad).
     substeps : ndarray of int, shape (N,)
@@ -107,9 +86,6 @@ class Trajectory:
     self_distance : ndarray, shape (N+1,)
         Smallest 3-D distance between two non-adjacent links of the arm (the probe holder
         included), m.
-    solver_time : ndarray, shape (N,)
-        Of ``solve_time``, the time spent in the QP backend's calls (the baseline: its linear
-        algebra), s.
     qddot : ndarray, shape (N, n)
         Joint acceleration at the start of each step, ``(qdot[k] − qdot[k−1]) / dt`` with the
         run starting at rest, rad/s².
@@ -195,10 +171,7 @@ class Trajectory:
         ``qdot`` on a row is the joint velocity applied from that sample to the next (0 on
         the last row: the motion has ended). The ``.npz`` also holds ``meta``, a JSON text
         with the versions of dvqp, numpy, Pinocchio and the solvers, and the file's
-        conventions (:data:`CONVENTIONS`).
-
-        The file appears complete or not at all: it is written to a temporary file in the
-        same folder and renamed.
+        conventions (:data:`CONVENTIONS`). The file appears complete or not at all.
         """
         target = output_path(path, (".npz", ".csv"))
         with atomic_file(target) as tmp, open(tmp, "wb") as fh:
@@ -238,15 +211,13 @@ class Trajectory:
                 arrays = {
                     name: data["dv" if name == "tool" and "dv" in data else name] for name in ARRAYS
                 }
-                arrays.update({name: data[name] for name in DIAGNOSTICS if name in data})
+                optional = (*DIAGNOSTICS, "tracking_error")
+                arrays.update({name: data[name] for name in optional if name in data})
                 return cls(
                     **arrays,
                     backend=str(data["backend"]),
                     pipe_radius=float(data["pipe_radius"]),
                     scene_text=str(data["scene"]),
-                    tracking_error=(
-                        data["tracking_error"] if "tracking_error" in data else np.zeros((0, 4))
-                    ),
                 )
         except OSError as exc:
             reason = exc.strerror or type(exc).__name__

@@ -68,11 +68,7 @@ def point_gains(name: str, value: ArrayLike) -> Array:
 
 def per_point(name: str, gains: Array, k: int) -> Array:
     """``gains`` for k body points, shape (k,) (a scalar is repeated)."""
-    if gains.ndim == 0:
-        return np.full(k, float(gains))
-    if gains.shape[0] != k:
-        raise ShapeError(name, (k,), gains.shape)
-    return np.array(gains)
+    return _validate.broadcast(name, gains, k)
 
 
 @njit(cache=True, inline="always")

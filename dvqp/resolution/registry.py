@@ -26,19 +26,10 @@ EXTRA_BACKENDS = ("proxqp", "quadprog", "piqp", "highs")
 
 @dataclass(frozen=True)
 class ResolverInfo:
-    """What ``dvqp backends`` prints about one name.
-
-    Attributes
-    ----------
-    name : str
-        The name to pass to :func:`make_resolver`.
-    distribution : str
-        The Python distribution that provides it.
-    version : str
-        Its installed version (``"?"`` if unknown).
-    note : str
-        How it is reached, e.g. ``"via qpsolvers 4.13.0"`` or ``"pseudoinverse baseline"``.
-    """
+    """What ``dvqp backends`` prints about one name: the ``name`` to pass to
+    :func:`make_resolver`, the Python ``distribution`` that provides it, its installed
+    ``version`` (``"?"`` if unknown) and a ``note`` on how it is reached, e.g.
+    ``"via qpsolvers 4.13.0"`` or ``"pseudoinverse baseline"``."""
 
     name: str
     distribution: str

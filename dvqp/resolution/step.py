@@ -5,13 +5,9 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from dvqp import _validate
 from dvqp.resolution.spec import StepSpec
-
-COMMAND_SIZE = 4
-"""Length of the operator's command ``[l̇, ż, ḣ, α̇]``."""
 
 
 class Step(NamedTuple):
@@ -43,17 +39,6 @@ class Step(NamedTuple):
     solve_time: float
     iterations: int | None = None
     solver_time: float = 0.0
-
-
-def check_command(command: ArrayLike) -> NDArray[np.float64]:
-    """The operator's command as a finite vector of shape (4,).
-
-    Raises
-    ------
-    ShapeError, ParameterError
-        Wrong size or not finite.
-    """
-    return _validate.vector("command", command, COMMAND_SIZE)
 
 
 class Resolver:

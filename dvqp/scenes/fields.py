@@ -1,18 +1,15 @@
 """Typed readers of parsed TOML tables for :mod:`dvqp.scenes.scene` (private).
 
-Every reader takes the table, the key and the dotted path of the table (``"robot"``,
-``"obstacles[1]"``) and raises :class:`~dvqp.errors.SceneError` naming the full field on a
-missing, mistyped, unknown or out-of-range entry. A number's sane range is a :class:`Bound`
-given where the field is read (:data:`ANY` if none is given); :meth:`Fields.guard` turns what
-still escapes the checks (an overflow, a NumPy floating-point error, a constructor's
-complaint) into the same one-line error.
+Every reader takes the table, the key and the dotted path of the table (``"obstacles[1]"``)
+and raises :class:`~dvqp.errors.SceneError` naming the full field on a missing, mistyped,
+unknown or out-of-range entry (a number's sane range: a :class:`Bound`, :data:`ANY` if none).
 """
 
 from __future__ import annotations
 
 import difflib
 import math
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from decimal import Decimal
@@ -29,17 +26,8 @@ REQUIRED: Any = object()
 
 @dataclass(frozen=True)
 class Bound:
-    """The sane range of a physical quantity: ``low <= x <= high`` (``low < x`` if strict).
-
-    Attributes
-    ----------
-    low, high : float
-        The range.
-    unit : str
-        Shown in messages after a non-zero bound (``"m"``, ``"rad/s"``).
-    strict : bool
-        ``low`` itself is excluded.
-    """
+    """The sane range of a physical quantity: ``low <= x <= high`` (``low < x`` if ``strict``);
+    ``unit`` (``"m"``, ``"rad/s"``) is shown in messages after a non-zero bound."""
 
     low: float
     high: float
@@ -73,19 +61,13 @@ def join(prefix: str, key: str | int) -> str:
     return f"{prefix}.{key}" if prefix else key
 
 
+KINDS = ((bool, "a boolean"), ((int, float), "a number"), (str, "a string"), (list, "an array"),
+         (dict, "a table"))  # fmt: skip
+
+
 def kind(value: object) -> str:
     """The TOML type of a parsed value, with an article (``"a string"``)."""
-    if isinstance(value, bool):
-        return "a boolean"
-    if isinstance(value, (int, float)):
-        return "a number"
-    if isinstance(value, str):
-        return "a string"
-    if isinstance(value, list):
-        return "an array"
-    if isinstance(value, dict):
-        return "a table"
-    return "a date/time"
+    return next((name for types, name in KINDS if isinstance(value, types)), "a date/time")
 
 
 def is_number(value: object) -> bool:
@@ -94,13 +76,8 @@ def is_number(value: object) -> bool:
 
 
 class Fields:
-    """Readers bound to one scene source (the file name used in every message).
-
-    Parameters
-    ----------
-    source
-        The file name, or ``"<string>"``.
-    """
+    """Readers bound to one scene ``source``: the file name (or ``"<string>"``) in every
+    message."""
 
     def __init__(self, source: str) -> None:
         self.source = source
@@ -138,13 +115,12 @@ class Fields:
         except (ArithmeticError, RecursionError, ValueError, MemoryError) as exc:
             self.fail(prefix, f"cannot be used ({type(exc).__name__}: {exc})")
 
-    def check_keys(self, table: dict[str, Any], prefix: str, allowed: Iterable[str]) -> None:
+    def check_keys(self, table: dict[str, Any], prefix: str, allowed: Sequence[str]) -> None:
         """Reject keys of ``table`` not in ``allowed`` (typos), suggesting the closest one."""
-        names = list(allowed)
         for key in table:
-            if key not in names:
-                close = difflib.get_close_matches(key, names, n=1)
-                hint = f"did you mean {close[0]!r}?" if close else "allowed: " + ", ".join(names)
+            if key not in allowed:
+                close = difflib.get_close_matches(key, allowed, n=1)
+                hint = f"did you mean {close[0]!r}?" if close else "allowed: " + ", ".join(allowed)
                 self.fail(join(prefix, key), f"unknown key ({hint})")
 
     def get(self, table: dict[str, Any], key: str, prefix: str, default: Any = REQUIRED) -> Any:
@@ -156,7 +132,7 @@ class Fields:
         return default
 
     def table(
-        self, parent: dict[str, Any], key: str, prefix: str, allowed: Iterable[str], *,
+        self, parent: dict[str, Any], key: str, prefix: str, allowed: Sequence[str], *,
         required: bool = True,
     ) -> dict[str, Any]:  # fmt: skip
         """A sub-table with only ``allowed`` keys (``{}`` if optional and absent)."""
@@ -167,16 +143,15 @@ class Fields:
         return value
 
     def tables(
-        self, parent: dict[str, Any], key: str, prefix: str, allowed: Iterable[str]
+        self, parent: dict[str, Any], key: str, prefix: str, allowed: Sequence[str]
     ) -> list[dict[str, Any]]:
         """An array of tables (``[[key]]``), each with only ``allowed`` keys; ``[]`` if absent."""
         value = self.get(parent, key, prefix, [])
         field = join(prefix, key)
         if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
             self.fail(field, f"expected an array of tables ([[{field}]]), got {kind(value)}")
-        names = list(allowed)
         for i, item in enumerate(value):
-            self.check_keys(item, join(field, i), names)
+            self.check_keys(item, join(field, i), allowed)
         return value
 
     def number(
@@ -184,8 +159,7 @@ class Fields:
         within: Bound = ANY,
     ) -> float:  # fmt: skip
         """A finite number (int or float) in ``within``, m / s / rad as documented per field."""
-        value = self.get(table, key, prefix, default)
-        return self._finite(join(prefix, key), value, within)
+        return self._finite(join(prefix, key), self.get(table, key, prefix, default), within)
 
     def string(self, table: dict[str, Any], key: str, prefix: str, default: Any = REQUIRED) -> str:
         """A string."""
@@ -206,15 +180,12 @@ class Fields:
         scalar: bool = False, default: Any = REQUIRED, infinite: bool = False,
         within: Bound | Sequence[Bound] = ANY,
     ) -> NDArray[np.float64]:  # fmt: skip
-        """``n`` numbers (or one number broadcast to ``n`` if ``scalar``), shape (n,).
-
-        Each lies in ``within`` (one bound, or one per element). They must be finite unless
-        ``infinite`` (then ``±inf`` pass as "no limit", ``nan`` does not).
-        """
+        """``n`` numbers (or one broadcast to ``n`` if ``scalar``), shape (n,), each in ``within``
+        (one bound, or one per element) and finite unless ``infinite`` (then ``±inf`` pass as
+        "no limit", ``nan`` does not)."""
         value = self.get(table, key, prefix, default)
-        return self.vector_value(
-            join(prefix, key), value, n, scalar=scalar, infinite=infinite, within=within
-        )
+        field = join(prefix, key)
+        return self.vector_value(field, value, n, scalar=scalar, infinite=infinite, within=within)
 
     def vector_value(
         self, field: str, value: Any, n: int, *, scalar: bool = False, infinite: bool = False,
@@ -229,12 +200,8 @@ class Fields:
             self.fail(field, f"expected {want}, got {kind(value)}")
         if len(value) != n:
             self.fail(field, f"expected {want}, got {len(value)} values")
-        return np.array(
-            [
-                self._finite(join(field, i), v, b, infinite)
-                for i, (v, b) in enumerate(zip(value, bounds, strict=True))
-            ]
-        )
+        items = enumerate(zip(value, bounds, strict=True))
+        return np.array([self._finite(join(field, i), v, b, infinite) for i, (v, b) in items])
 
     def _finite(self, field: str, value: Any, within: Bound, infinite: bool = False) -> float:
         """``value`` as a float: a number, not NaN, finite unless ``infinite``, in ``within``."""

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from dvqp.geometry.obstacle import ObstacleSet
-from dvqp.geometry.shapes import SHAPES, Shape
+from dvqp.geometry.shapes import SHAPES
 from dvqp.scenes.fields import Fields, join
 from dvqp.scenes.sections import POSITION, SIZE, WEIGHT
 
@@ -28,21 +28,15 @@ def obstacles(f: Fields, doc: dict[str, Any], pipe_radius: float) -> ObstacleSet
         if cls is None:
             f.fail(join(prefix, "shape"), f"unknown shape {kind!r} (known: {', '.join(SHAPES)})")
         f.check_keys(t, prefix, ("shape", *cls.SCENE_FIELDS))
-        out.append(_shape(f, t, prefix, cls, pipe_radius))
+        values = {key: _value(f, t, prefix, key, what, default)
+                  for key, (what, default) in cls.SCENE_FIELDS.items()}  # fmt: skip
+        with f.mapped(prefix):
+            out.append(cls.from_scene(values, pipe_radius))
     return ObstacleSet(out)
 
 
-def _shape(f: Fields, t: dict[str, Any], prefix: str, cls: type[Shape], radius: float) -> Shape:
-    values = {key: _value(f, t, prefix, key, kind, default)
-              for key, (kind, default) in cls.SCENE_FIELDS.items()}  # fmt: skip
-    with f.mapped(prefix):
-        return cls.from_scene(values, radius)
-
-
 def _value(f: Fields, t: dict[str, Any], prefix: str, key: str, kind: str, default: Any) -> Any:
-    if kind == "point":
-        return f.vector(t, key, prefix, 2, within=POSITION)
-    if kind == "interval":
+    if kind in ("point", "interval"):
         return f.vector(t, key, prefix, 2, within=POSITION)
     if kind == "length":
         return f.number(t, key, prefix, within=SIZE)

@@ -30,7 +30,9 @@ def robot(
     t = f.table(doc, "robot", "", ROBOT_KEYS)
     arm = _arm(f, t, base_dir)
     q0 = f.vector(t, "q0", "robot", arm.n, within=ANGLE)
-    _check_limits(f, arm, q0)
+    for i, (q, lo, hi) in enumerate(zip(q0, arm.q_min, arm.q_max, strict=True)):
+        if not lo - 1e-12 <= q <= hi + 1e-12:
+            f.fail(f"robot.q0[{i}]", f"{q:g} rad is outside [q_min, q_max] = [{lo:g}, {hi:g}] rad")
     weights = f.vector(t, "weights", "robot", arm.n, scalar=True, default=1.0, within=JOINT_WEIGHT)
     return arm, _validate.readonly(q0), _validate.readonly(weights)
 
@@ -89,9 +91,3 @@ def _frame_error(f: Fields, exc: ParameterError, tool: str) -> None:
         f.fail(join("robot", exc.name), exc.reason)
     key = "tool" if exc.reason.startswith(f"no frame named {tool!r}") else "points"
     f.fail(join("robot", key), exc.reason)
-
-
-def _check_limits(f: Fields, robot: Robot, q0: NDArray[np.float64]) -> None:
-    for i, (q, lo, hi) in enumerate(zip(q0, robot.q_min, robot.q_max, strict=True)):
-        if not lo - 1e-12 <= q <= hi + 1e-12:
-            f.fail(f"robot.q0[{i}]", f"{q:g} rad is outside [q_min, q_max] = [{lo:g}, {hi:g}] rad")

@@ -1,14 +1,10 @@
 """Scene files: a pipe, an arm, the objective, obstacles, limits and a motion, in TOML.
 
-:func:`load_scene` reads a ``.toml`` file with the standard library (``tomllib``, or ``tomli``
-on Python 3.10) and validates it into a :class:`Scene` of typed objects. Anything wrong — a
-missing or mistyped field, a wrong length, an unknown key, a value a constructor rejects, an
-obstacle over the tool's start point, a number out of its sane range, a start inside the
-pipe — raises :class:`~dvqp.errors.SceneError` with the one-line message
-``<file>: <field>: <reason>``; fields are dotted TOML paths with 0-based array indices
-(``obstacles[1].radius``). Whatever else escapes the checks (a parser's recursion limit, an
-overflow) is turned into the same error by :meth:`~dvqp.scenes.fields.Fields.guard`, one
-section at a time. The format is documented in ``docs/scenes.md``.
+:func:`load_scene` reads a ``.toml`` file (``tomllib``, or ``tomli`` on Python 3.10) into a
+:class:`Scene` of typed objects. Anything wrong, or anything else that escapes the checks (a
+parser's recursion limit, an overflow), raises :class:`~dvqp.errors.SceneError`:
+``<file>: <field>: <reason>``, the field a dotted TOML path with 0-based array indices
+(``obstacles[1].radius``). The format is documented in ``docs/scenes.md``.
 """
 
 from __future__ import annotations
@@ -55,36 +51,26 @@ class Scene:
     ----------
     name, description : str
         Labels (``name`` defaults to the file's stem).
-    source : str
-        The file it came from, or ``"<string>"``.
-    text : str
-        The TOML text (stored in planned trajectories).
-    pipe_radius : float
-        ``R``, m.
-    weld : float or None
-        z of the circumferential weld, m (for plots).
+    source, text : str
+        The file it came from (or ``"<string>"``) and its TOML text (stored in trajectories).
+    pipe_radius, weld : float, float or None
+        ``R`` and the z of the circumferential weld (for plots), m.
     robot : Robot
         The arm with its limits.
-    q0 : ndarray, shape (n,)
-        Start configuration, rad.
-    weights : ndarray, shape (n,)
-        Diagonal of ``W``.
+    q0, weights : ndarray, shape (n,)
+        Start configuration (rad) and the diagonal of ``W``.
     orbital_level : float
         ``h*``, m.
     obstacles : ObstacleSet
-        The obstacle circles (shared by the objective, the dampers and the diagnostics).
+        The obstacles (shared by the objective, the dampers and the diagnostics).
     objective : Objective
         ``w(Q)``: the paper's three terms.
     limits : tuple of Limit
-        Joint position and velocity limits, obstacle dampers, surface height.
-    dt : float
-        Step, s.
-    jog : tuple of JogSegment
-        JOG segments (empty in path mode).
-    path : ToolPath or None
-        The path to follow (None in JOG mode).
-    ramp : float
-        s: JOG velocity changes are spread linearly over this time (0: steps).
+        Joint position, velocity and acceleration limits, then those of ``[constraints]``.
+    jog, path : tuple of JogSegment, ToolPath or None
+        The JOG segments (empty in path mode) or the path to follow (None in JOG mode).
+    dt, ramp : float
+        The step, and the time JOG velocity changes are spread linearly over (0: steps), s.
     """
 
     name: str
@@ -132,18 +118,9 @@ def load_scene(path: str | Path) -> Scene:
 
 
 def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = None) -> Scene:
-    """Parse and validate scene TOML text.
-
-    Parameters
-    ----------
-    text
-        The TOML document.
-    source
-        Name used in error messages.
-    base_dir
-        Folder relative URDF paths resolve from. Default: ``source``'s folder if it names a
-        file, else the working directory.
-    """
+    """Parse and validate scene TOML ``text``; ``source`` names it in error messages, and
+    relative URDF paths resolve from ``base_dir`` (default: ``source``'s folder if it names a
+    file, else the working directory)."""
     f = Fields(source)
     doc = _parse(f, text)
     if base_dir is None:

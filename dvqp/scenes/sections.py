@@ -1,10 +1,8 @@
 """Readers of the sections of a scene file: pipe, objective, constraints, motion.
 
-Each reader takes the parsed TOML document and returns typed objects, raising
-:class:`~dvqp.errors.SceneError` through :class:`~dvqp.scenes.fields.Fields`. The keys of the
-``[constraints]`` table live on the limit classes that take them (``SCENE_KEYS``); the
-obstacles are read by :mod:`dvqp.scenes.obstacles`. The sane range of each number is a
-:class:`~dvqp.scenes.fields.Bound` declared here with its field (``docs/scenes.md``, Ranges).
+The keys of ``[constraints]`` live on the limit classes that take them (``SCENE_KEYS``); the
+sane range of each number is a :class:`~dvqp.scenes.fields.Bound` declared here
+(``docs/scenes.md``, Ranges).
 """
 
 from __future__ import annotations
@@ -142,23 +140,17 @@ def _motion(f: Fields, motion: dict[str, Any]) -> tuple[tuple[JogSegment, ...], 
                 segments.append(JogSegment(duration, velocity))
         return tuple(segments), None
     t = f.table(motion, "path", "motion", PATH_KEYS)
-    raw = f.get(t, "waypoints", "motion.path")
+    raw, wp = f.get(t, "waypoints", "motion.path"), "motion.path.waypoints"
     if not isinstance(raw, list) or len(raw) < 2:
-        f.fail("motion.path.waypoints", "expected an array of at least 2 waypoints [l, z, h, α]")
+        f.fail(wp, "expected an array of at least 2 waypoints [l, z, h, α]")
     bounds = (POSITION, POSITION, Bound(-1000.0, HEIGHT.high, "m"), HEADING)  # h < 0: below
-    points = np.array(
-        [
-            f.vector_value(join("motion.path.waypoints", i), w, 4, within=bounds)
-            for i, w in enumerate(raw)
-        ]
-    )
+    points = np.array([f.vector_value(join(wp, i), w, 4, within=bounds) for i, w in enumerate(raw)])
     for i, h in enumerate(points[:, 2]):
         if h < 0:
-            f.fail(f"motion.path.waypoints[{i}]", f"h = {h:g} m is inside the pipe (must be >= 0)")
+            f.fail(join(wp, i), f"h = {h:g} m is inside the pipe (must be >= 0)")
     if not np.any(np.diff(points, axis=0) != 0.0):
-        f.fail("motion.path.waypoints", "the waypoints are all the same: nothing to follow")
+        f.fail(wp, "the waypoints are all the same: nothing to follow")
     speed = f.number(t, "speed", "motion.path", within=Bound(0.0, SPEED.high, "m/s", True))
-    gain = f.number(t, "gain", "motion.path", 5.0, within=GAIN)
-    tol = f.number(t, "tolerance", "motion.path", 0.005, within=TOLERANCE)
-    heading_tol = f.number(t, "heading_tolerance", "motion.path", 0.05, within=HEADING_TOLERANCE)
-    return (), ToolPath(_validate.readonly(points), speed, gain, tol, heading_tol)
+    optional = {"gain": GAIN, "tolerance": TOLERANCE, "heading_tolerance": HEADING_TOLERANCE}
+    given = {k: f.number(t, k, "motion.path", within=b) for k, b in optional.items() if k in t}
+    return (), ToolPath(_validate.readonly(points), speed, **given)

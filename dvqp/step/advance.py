@@ -33,18 +33,10 @@ SINGULAR = Excess(math.inf, 1.0, "singular configuration", "a guarded frame on t
 
 
 class Advance(NamedTuple):
-    """What one step of ``dt`` did (the stepper then holds the state it ended in).
-
-    Attributes
-    ----------
-    step : Step
-        The combined step: ``qdot`` is the mean joint velocity over ``dt``, ``task_error`` the
-        largest of the substeps, ``solve_time`` and ``iterations`` their sums.
-    substeps : int
-        1 if the step was not split.
-    excess : Excess
-        What broke a failed step (:data:`~dvqp.limits.NO_EXCESS` otherwise).
-    """
+    """What one step of ``dt`` did (the stepper then holds the state it ended in): the combined
+    ``step`` (``qdot`` the mean joint velocity over ``dt``, ``task_error`` the largest of the
+    substeps', ``solve_time`` and ``iterations`` their sums), its ``substeps`` (1 if not split)
+    and the ``excess`` that broke a failed step (:data:`~dvqp.limits.NO_EXCESS` otherwise)."""
 
     step: Step
     substeps: int

@@ -17,14 +17,8 @@ from numpy.typing import NDArray
 from dvqp.geometry.measure import ShapeArrays
 from dvqp.kinematics.model import ModelArrays
 from dvqp.limits.damper import DamperArrays
-from dvqp.workspace import (
-    CheckBuffers,
-    DamperBuffers,
-    PairBuffers,
-    ProximityBuffers,
-    QPBuffers,
-    StateBuffers,
-)
+from dvqp.workspace.buffers import PairBuffers, ProximityBuffers, StateBuffers
+from dvqp.workspace.plan import CheckBuffers, DamperBuffers, QPBuffers
 
 Array = NDArray[np.float64]
 Index = NDArray[np.int64]
@@ -32,20 +26,11 @@ Index = NDArray[np.int64]
 
 @dataclass(frozen=True)
 class ObjectiveArrays:
-    """dvqp's objective terms of a run, and ``w``, ``∂w/∂Q`` of the current state.
-
-    Attributes
-    ----------
-    levels, k_height : (T,), (T, k)
-        Each :class:`~dvqp.objective.OrbitalLevel`'s ``h*`` (m) and ``k²`` (1/m²).
-    point_coef, link_coef : (J, k), (J, k − 1)
-        ``Σ w_j k¹_i`` of the obstacle-point and obstacle-link terms (0 where none sees j).
-    scratch : (k, 2)
-    value, gradient : (1,), (n,)
-        ``w`` and ``∂w/∂Q``.
-    gain : float
-        ``λ``.
-    """
+    """dvqp's objective terms of a run, and ``w``, ``∂w/∂Q`` of the current state: each
+    :class:`~dvqp.objective.OrbitalLevel`'s ``h*`` (``levels`` (T,), m) and ``k²``
+    (``k_height`` (T, k), 1/m²); ``Σ w_j k¹_i`` of the obstacle-point and obstacle-link terms
+    (``point_coef`` (J, k), ``link_coef`` (J, k − 1); 0 where none sees j); ``scratch`` (k, 2);
+    ``w`` and ``∂w/∂Q`` (``value`` (1,), ``gradient`` (n,)); ``gain`` λ."""
 
     levels: Array
     k_height: Array
@@ -75,19 +60,12 @@ class BoundArrays:
 
 @dataclass(frozen=True)
 class MeasureArrays:
-    """Which compiled dampers measure which damper rows.
-
-    Attributes
-    ----------
-    tool_rows : (T,) int64
-        First row of ``A`` of each :class:`~dvqp.tasks.ToolTask`.
-    obstacle_start, obstacle_offsets, obstacle_members : (O,), (O + 1,), (M,) int64
-        Each obstacle damper's first row and its obstacles ``members[offsets[o]:offsets[o+1]]``.
-    heights : (H, 3) int64
-        ``[first row, first guarded point, count]`` of each height damper.
-    tilts, selves : (T,), (S,) int64
-        First row of each tilt and self-collision damper.
-    """
+    """Which compiled dampers measure which damper rows (int64): the first row of ``A`` of each
+    :class:`~dvqp.tasks.ToolTask` (``tool_rows``); each obstacle damper's first row
+    (``obstacle_start`` (O,)) and obstacles ``members[offsets[o]:offsets[o+1]]``
+    (``obstacle_members`` (M,), ``obstacle_offsets`` (O + 1,)); ``[first row, first guarded
+    point, count]`` of each height damper (``heights`` (H, 3)); the first row of each tilt and
+    self-collision damper (``tilts``, ``selves``)."""
 
     tool_rows: Index
     obstacle_start: Index

@@ -22,18 +22,10 @@ from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.shapes import Shape
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits import (
-    AccelerationLimit,
-    JointPositionLimit,
-    JointVelocityLimit,
-    ObstacleDamper,
-    ProbeHeight,
-    SelfCollision,
-    SurfaceHeight,
-    TiltLimit,
-    VelocityDamper,
-)
-from dvqp.limits.damper import DamperArrays
+from dvqp.limits import AccelerationLimit, ObstacleDamper, SelfCollision, TiltLimit
+from dvqp.limits.damper import DamperArrays, VelocityDamper
+from dvqp.limits.height import ProbeHeight, SurfaceHeight
+from dvqp.limits.joints import JointPositionLimit, JointVelocityLimit
 from dvqp.objective import ObstacleLinks, ObstaclePoints, OrbitalLevel
 from dvqp.objective.term import per_point
 from dvqp.resolution.pinv import PseudoinverseResolver
@@ -52,9 +44,7 @@ from dvqp.tasks import ToolTask
 from dvqp.workspace import StepPlan
 
 DAMPERS = (ObstacleDamper, SurfaceHeight, ProbeHeight, TiltLimit, SelfCollision)
-"""dvqp's damper classes, measured by the pipeline."""
 BOUNDS = (JointPositionLimit, JointVelocityLimit, AccelerationLimit)
-"""dvqp's box limits."""
 
 
 @dataclass(frozen=True)
@@ -87,13 +77,8 @@ class _Union:
     """Shapes of several obstacle sets, each once; a set's rows in the union."""
 
     def __init__(self, sets: Sequence[ObstacleSet]) -> None:
-        self.rows: dict[int, int] = {}
-        self.shapes: list[Shape] = []
-        for shapes in sets:
-            for shape in shapes:
-                if id(shape) not in self.rows:
-                    self.rows[id(shape)] = len(self.shapes)
-                    self.shapes.append(shape)
+        self.shapes: list[Shape] = list({id(s): s for shapes in sets for s in shapes}.values())
+        self.rows = {id(shape): row for row, shape in enumerate(self.shapes)}
 
     def members(self, shapes: ObstacleSet) -> np.ndarray:
         return np.array([self.rows[id(s)] for s in shapes], dtype=np.int64)
@@ -112,16 +97,21 @@ def build(robot: Robot, radius: float, spec: StepSpec, recorded: ObstacleSet, q0
     plan = StepPlan(n, k, radius, len(union.shapes))
     state = KinematicState.compute(robot, q0, radius)
     hooks = Hooks(plan, state, dt)
-    tool_rows = [plan.task_rows(4)[0].start if type(t) is ToolTask else hooks.task(t)
-                 for t in spec.tasks]  # fmt: skip
+    table: dict[str, list] = {key: [] for key in MeasureArrays.__dataclass_fields__}
+    table["obstacle_offsets"].append(0)
+    for task in spec.tasks:
+        if type(task) is ToolTask:
+            table["tool_rows"].append(plan.task_rows(4)[0].start)
+        else:
+            hooks.task(task)
     objective = _objective(spec, union, n, k, hooks)
-    bounds = _bounds(limits, n)
-    measures, params, blocks = _dampers(limits, union, plan, hooks)
+    params, blocks = _dampers(limits, union, plan, hooks, table)
     for limit in limits:
         if type(limit) not in BOUNDS and not isinstance(limit, VelocityDamper):
             hooks.limit(limit)
-    layout = Layout(plan, tuple(union.shapes), objective, bounds,
-                    _with_tools(measures, [r for r in tool_rows if r is not None]), params,
+    measures = MeasureArrays(**{key: np.array(rows, dtype=np.int64) for key, rows in table.items()})
+    measures = replace(measures, heights=measures.heights.reshape(-1, 3))
+    layout = Layout(plan, tuple(union.shapes), objective, _bounds(limits, n), measures, params,
                     hooks)  # fmt: skip
     _verified(layout, limits, blocks, n)
     return layout, union.members(recorded)
@@ -169,12 +159,10 @@ def _bounds(limits: Sequence[object], n: int) -> BoundArrays:
                        np.array(accel.q_min), np.array(accel.q_max), accel.previous)  # fmt: skip
 
 
-def _dampers(limits: Sequence[object], union: _Union, plan: StepPlan,
-             hooks: Hooks) -> tuple[MeasureArrays, DamperArrays, list[tuple]]:  # fmt: skip
-    """Every damper's rows: dvqp's measured by the pipeline, a user's by a hook."""
-    k = plan.k
-    table: dict[str, list] = {"start": [], "offsets": [0], "members": [], "heights": [],
-                              "tilts": [], "selves": []}  # fmt: skip
+def _dampers(limits: Sequence[object], union: _Union, plan: StepPlan, hooks: Hooks,
+             table: dict[str, list]) -> tuple[DamperArrays, list[tuple]]:  # fmt: skip
+    """Every damper's rows: dvqp's measured by the pipeline (into ``table``, the fields of
+    :class:`~dvqp.step.arrays.MeasureArrays`), a user's by a hook."""
     params: list[tuple[float, ...]] = []
     blocks: list[tuple] = []
     for limit in limits:
@@ -183,59 +171,42 @@ def _dampers(limits: Sequence[object], union: _Union, plan: StepPlan,
             continue
         if type(limit) in DAMPERS:
             start, count = _measured(limit, union, plan, table)
-            safe, labels = limit.safe, limit.labels(k)
+            safe, labels = limit.safe, limit.labels(plan.k)
         else:
             start, count, safe, labels = hooks.damper(limit)
         if count == 0:
             continue
-        angle = float(type(limit) is TiltLimit)
-        for r in range(count):
-            row_safe = float(np.broadcast_to(np.asarray(safe, dtype=float), (count,))[r])
-            params.append((row_safe, limit.gain, limit.tolerance, limit.deceleration,
-                           float(limit.reach), angle))  # fmt: skip
+        row = (limit.gain, limit.tolerance, limit.deceleration, float(limit.reach),
+               float(type(limit) is TiltLimit))  # fmt: skip
+        params += [(float(s), *row) for s in np.broadcast_to(np.asarray(safe, float), (count,))]
         blocks.append((limit, start, count, labels))
     columns = np.array(params, dtype=float).reshape(-1, 6).T.copy()
-    measures = MeasureArrays(
-        np.zeros(0, np.int64), *(np.array(table[key], dtype=np.int64) for key in
-                                  ("start", "offsets", "members")),
-        np.array(table["heights"], dtype=np.int64).reshape(-1, 3),
-        np.array(table["tilts"], dtype=np.int64), np.array(table["selves"], dtype=np.int64),
-    )  # fmt: skip
-    arrays = DamperArrays(*(np.ascontiguousarray(c) for c in columns[:5]),
-                          columns[5] != 0.0)  # fmt: skip
-    return measures, arrays, blocks
+    arrays = DamperArrays(*(np.ascontiguousarray(c) for c in columns[:5]), columns[5] != 0.0)
+    return arrays, blocks
 
 
 def _measured(limit: object, union: _Union, plan: StepPlan,
               table: dict[str, list]) -> tuple[int, int]:  # fmt: skip
     """Rows of one of dvqp's dampers: ``(first row, count)``, its instance recorded."""
-    k = plan.k
-    if type(limit) is ObstacleDamper:
-        members = union.members(limit.obstacles)
-        count = members.shape[0] * (2 * k + 1)
+    k, kind = plan.k, type(limit)
+    if kind is ObstacleDamper:
+        members = union.members(limit.obstacles).tolist()
+        count = len(members) * (2 * k + 1)
     else:
         count = {SurfaceHeight: k, ProbeHeight: 1, TiltLimit: 1,
-                 SelfCollision: plan.pairs.i.shape[0]}[type(limit)]  # fmt: skip
+                 SelfCollision: plan.pairs.i.shape[0]}[kind]  # fmt: skip
     if count == 0:
         return 0, 0
     start = plan.damper_rows(count)[0].start
-    if type(limit) is ObstacleDamper:
-        table["start"].append(start)
-        table["members"].extend(members.tolist())
-        table["offsets"].append(len(table["members"]))
-    elif type(limit) is SurfaceHeight:
-        table["heights"].append((start, 0, k))
-    elif type(limit) is ProbeHeight:
-        table["heights"].append((start, k, 1))
-    elif type(limit) is TiltLimit:
-        table["tilts"].append(start)
+    if kind is ObstacleDamper:
+        table["obstacle_start"].append(start)
+        table["obstacle_members"].extend(members)
+        table["obstacle_offsets"].append(len(table["obstacle_members"]))
+    elif kind in (SurfaceHeight, ProbeHeight):
+        table["heights"].append((start, 0, k) if kind is SurfaceHeight else (start, k, 1))
     else:
-        table["selves"].append(start)
+        table["tilts" if kind is TiltLimit else "selves"].append(start)
     return start, count
-
-
-def _with_tools(measures: MeasureArrays, tool_rows: list[int]) -> MeasureArrays:
-    return replace(measures, tool_rows=np.array(tool_rows, dtype=np.int64))
 
 
 def _verified(layout: Layout, limits: Sequence[object], dampers: list[tuple], n: int) -> None:
@@ -273,14 +244,13 @@ def lay_out(robot: Robot, radius: float, resolver: Resolver, q0: ArrayLike, dt: 
     plan.qp.P[:] = np.diag(weights)
     baseline = isinstance(resolver, PseudoinverseResolver)
     damping = resolver.damping if isinstance(resolver, PseudoinverseResolver) else 0.0
-    if baseline and damping > 0.0 and layout.hooks.soft:
+    if damping > 0.0 and layout.hooks.soft:
         raise ParameterError("damping", "the damped inverse takes no soft tasks")
     shapes = ShapeArrays.of(layout.shapes, plan.period)
     layout.hooks.finalize(layout.shapes, shapes.code, layout.params, layout.damper_values)
-    index = np.full(1, -1, np.int64)
+    fields = [f for f in RecordArrays.__dataclass_fields__ if f != "index"]
     record = (RecordArrays.none(n, k) if samples is None else
-              RecordArrays(index, *(samples[f] for f in RecordArrays.__dataclass_fields__
-                                    if f != "index")))  # fmt: skip
+              RecordArrays(np.full(1, -1, np.int64), *(samples[f] for f in fields)))  # fmt: skip
     return layout, Pipeline(
         float(radius), plan.dt, plan.command, np.zeros(n), np.zeros(2), robot.model_arrays(),
         plan.state, shapes, plan.proximity, plan.pairs, layout.objective, layout.bounds,

@@ -11,7 +11,7 @@ the common step, split substeps and interior points of a large step
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from typing import NamedTuple
 
 import numpy as np
@@ -22,21 +22,13 @@ from dvqp.errors import ParameterError, ShapeError, SingularConfigurationError
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState, singular_frame
-from dvqp.limits import (
-    NO_EXCESS,
-    Bounds,
-    Constraint,
-    Excess,
-    JointPositionLimit,
-    Limit,
-    VelocityDamper,
-)
+from dvqp.limits import Bounds, Constraint, JointPositionLimit, Limit, VelocityDamper
+from dvqp.limits.excess import NO_EXCESS, Excess
 from dvqp.objective import Term
 from dvqp.resolution.qp import QPResolver, QPSolver
 from dvqp.resolution.step import Resolver
 from dvqp.step import stages
 from dvqp.step.build import lay_out
-from dvqp.step.hooks import Hooks
 from dvqp.workspace import as_struct
 
 Array = NDArray[np.float64]
@@ -197,19 +189,15 @@ class Stepper:
             raise ShapeError("command", (4,), np.shape(command))
         a.command[:] = command
         a.dt[0] = dt
-        status = self._prepared(s, hooks)
+        last = stages.ROWS if hooks.prepared else stages.CLOSE
+        status = int(stages.prepare(s, stages.ROWS, last))
         if status == stages.BAD_COMMAND:
             raise ParameterError("command", "must be finite (no NaN or inf)")
+        if hooks.prepared:
+            for hook in hooks.prepared:
+                hook()
+            status = int(stages.prepare(s, stages.CLOSE, stages.CLOSE))
         return status
-
-    def _prepared(self, s: object, hooks: Hooks) -> int:
-        if not hooks.prepared:
-            return int(stages.prepare(s, stages.ROWS, stages.CLOSE))
-        if stages.prepare(s, stages.ROWS, stages.ROWS) == stages.BAD_COMMAND:
-            return stages.BAD_COMMAND
-        for hook in hooks.prepared:
-            hook()
-        return int(stages.prepare(s, stages.CLOSE, stages.CLOSE))
 
     def _pinv_error(self, status: int) -> SingularConfigurationError:
         if status == stages.INDEFINITE_METRIC:
@@ -252,23 +240,22 @@ class Stepper:
     def rows(self, limit: Limit) -> Constraint | Bounds:
         """What ``limit`` put in the problem of the last :meth:`prepare`: its rows that apply
         (``h`` finite; labelled), or for a box limit the box of all box limits, intersected."""
-        qp = self.arrays.qp
+        qp, block = self.arrays.qp, next((b for b in self.layout.blocks if b.limit is limit), None)
         if id(limit) in self.hooks.constraints:
             G, h = (self.layout.plan.view(slot) for slot in self.hooks.constraints[id(limit)])
-            applies = np.isfinite(h)
             named = self.hooks.describes.get(id(limit))
             labels = named() if named is not None else tuple(f"row{i}" for i in range(h.size))
-            return Constraint(G[applies], h[applies], _labels(tuple(np.array(labels)[applies])))
-        for block in self.layout.blocks:
-            if block.limit is limit:
-                rows = slice(block.start - self.layout.damper_values,
-                             block.stop - self.layout.damper_values)  # fmt: skip
-                applies = np.isfinite(qp.h[rows])
-                labels = tuple(np.asarray(block.labels, dtype=object)[applies])
-                return Constraint(qp.G[rows][applies], qp.h[rows][applies], _labels(labels))
-        if isinstance(limit, VelocityDamper):  # it has no row (e.g. no obstacle)
+        elif block is not None:
+            rows = slice(block.start - self.layout.damper_values,
+                         block.stop - self.layout.damper_values)  # fmt: skip
+            G, h, labels = qp.G[rows], qp.h[rows], block.labels
+        elif isinstance(limit, VelocityDamper):  # it has no row (e.g. no obstacle)
             return Constraint(np.zeros((0, qp.G.shape[1])), np.zeros(0))
-        return Bounds(qp.lb.copy(), qp.ub.copy())
+        else:
+            return Bounds(qp.lb.copy(), qp.ub.copy())
+        applies = np.isfinite(h)
+        kept = tuple(np.asarray(labels, dtype=object)[applies])
+        return Constraint(G[applies], h[applies], lambda: kept)
 
     @property
     def objective(self) -> Term:
@@ -281,7 +268,3 @@ class Stepper:
         qp = self.arrays.qp
         G, h = (qp.G, qp.h) if qp.h.shape[0] else (None, None)
         return solvers.Problem(qp.P, qp.cost, qp.A, qp.b, G, h, qp.lb, qp.ub)
-
-
-def _labels(labels: tuple[str, ...]) -> Callable[[], tuple[str, ...]]:
-    return lambda: labels

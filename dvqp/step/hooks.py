@@ -27,17 +27,9 @@ Hook = Callable[[], None]
 
 
 class Hooks:
-    """The parts of your own of one run (registered while the step is laid out).
-
-    Parameters
-    ----------
-    plan
-        The run's plan.
-    start
-        The run's start state: a NumPy part is called there once to learn its number of rows.
-    dt
-        The run's step, s.
-    """
+    """The parts of your own of one run on ``plan``, registered while the step is laid out; a
+    NumPy part is called once at the ``start`` state, with the run's step ``dt`` (s), to learn
+    its number of rows."""
 
     def __init__(self, plan: StepPlan, start: KinematicState, dt: float) -> None:
         self.plan, self.start, self.dt = plan, start, dt

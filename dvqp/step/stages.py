@@ -20,11 +20,10 @@ from dvqp.kinematics.model import kinematics
 from dvqp.limits.acceleration import acceleration_bounds
 from dvqp.limits.damper import damper_rows, damper_values
 from dvqp.limits.excess import worst_excess
-from dvqp.limits.joint_position import joint_room, position_bounds
-from dvqp.limits.joint_velocity import velocity_bounds
+from dvqp.limits.height import height_distances
+from dvqp.limits.joints import joint_room, position_bounds, velocity_bounds
 from dvqp.limits.obstacle_damper import obstacle_distances
 from dvqp.limits.self_collision import pair_distances, self_distances
-from dvqp.limits.surface_height import height_distances
 from dvqp.limits.tilt import tilt_angle, tilt_distance
 from dvqp.objective.obstacle_links import obstacle_links
 from dvqp.objective.obstacle_points import obstacle_points

@@ -8,9 +8,6 @@ from numpy.typing import NDArray
 
 from dvqp.tasks.task import Task
 
-LABELS = ("tool/l", "tool/z", "tool/h", "tool/alpha")
-"""What the task's four rows hold."""
-
 
 class ToolTask(Task):
     """``J̄(Q) Q̇ = ẋ``: the tool moves at the commanded DV velocity ``[l̇, ż, ḣ, α̇]``.

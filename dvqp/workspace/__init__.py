@@ -2,25 +2,10 @@
 packing of many arrays into one numba struct. It imports no domain module of dvqp."""
 
 from dvqp.workspace.buffers import PairBuffers, ProximityBuffers, StateBuffers
-from dvqp.workspace.plan import (
-    CheckBuffers,
-    DamperBuffers,
-    Kernel,
-    QPBuffers,
-    Slot,
-    StepPlan,
-)
+from dvqp.workspace.plan import CheckBuffers, DamperBuffers, Kernel, QPBuffers, Slot, StepPlan
 from dvqp.workspace.struct import as_struct
 
 __all__ = [
-    "CheckBuffers",
-    "DamperBuffers",
-    "Kernel",
-    "PairBuffers",
-    "ProximityBuffers",
-    "QPBuffers",
-    "Slot",
-    "StateBuffers",
-    "StepPlan",
-    "as_struct",
-]
+    "CheckBuffers", "DamperBuffers", "Kernel", "PairBuffers", "ProximityBuffers", "QPBuffers",
+    "Slot", "StateBuffers", "StepPlan", "as_struct",
+]  # fmt: skip

@@ -51,16 +51,9 @@ class StateBuffers:
     def allocate(cls, n: int, k: int) -> StateBuffers:
         """Zeroed buffers for n joints and k body points."""
         m = k + 1
-        return cls(
-            np.zeros(n),
-            np.zeros((m, 3)),
-            np.zeros((m, 3)),
-            np.zeros((m, 6, n)),
-            np.zeros((m, 3)),
-            np.zeros((m, 3, n)),
-            np.zeros(4),
-            np.zeros((4, n)),
-        )
+        return cls(np.zeros(n), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 6, n)),
+                   np.zeros((m, 3)), np.zeros((m, 3, n)), np.zeros(4),
+                   np.zeros((4, n)))  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -95,17 +88,8 @@ class ProximityBuffers:
     def allocate(cls, count: int, k: int) -> ProximityBuffers:
         """Zeroed buffers for ``count`` obstacles and k body points."""
         p, s = (count, k + 1), (count, k)
-        return cls(
-            np.zeros(p),
-            np.zeros((*p, 2)),
-            np.zeros(p),
-            np.zeros((*p, 2)),
-            np.zeros(s),
-            np.zeros((*s, 2)),
-            np.zeros(s),
-            np.zeros((*s, 2)),
-            np.zeros(s),
-        )
+        return cls(np.zeros(p), np.zeros((*p, 2)), np.zeros(p), np.zeros((*p, 2)), np.zeros(s),
+                   np.zeros((*s, 2)), np.zeros(s), np.zeros((*s, 2)), np.zeros(s))  # fmt: skip
 
 
 @dataclass(frozen=True)

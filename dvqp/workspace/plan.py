@@ -26,16 +26,9 @@ from dvqp.workspace.buffers import PairBuffers, ProximityBuffers, StateBuffers
 
 Array = NDArray[np.float64]
 
-BLOCKS = {
-    "A": "tasks",
-    "b": "tasks",
-    "distance": "dampers",
-    "gradient": "dampers",
-    "usable": "dampers",
-    "G": "constraints",
-    "h": "constraints",
-    "values": "values",
-}
+BLOCKS = {"A": "tasks", "b": "tasks", "distance": "dampers", "gradient": "dampers",
+          "usable": "dampers", "G": "constraints", "h": "constraints",
+          "values": "values"}  # fmt: skip
 """Each array a :class:`Slot` may name, and the block of rows it belongs to."""
 
 
@@ -187,16 +180,9 @@ class StepPlan:
             return
         n, s = self.n, self._sizes
         m, d, p, v = s["tasks"], s["dampers"], s["constraints"], s["values"]
-        self.qp = QPBuffers(
-            np.eye(n),
-            np.zeros(n),
-            np.zeros((m, n)),
-            np.zeros(m),
-            np.zeros((d + p, n)),
-            np.full(d + p, np.inf),
-            self.lb,
-            self.ub,
-        )
+        G, h = np.zeros((d + p, n)), np.full(d + p, np.inf)
+        self.qp = QPBuffers(np.eye(n), np.zeros(n), np.zeros((m, n)), np.zeros(m), G, h, self.lb,
+                            self.ub)  # fmt: skip
         self.dampers = DamperBuffers(np.zeros(d), np.zeros((d, n)), np.zeros(d, dtype=np.bool_))
         joined = lambda parts: np.concatenate(parts) if parts else np.zeros(0)  # noqa: E731
         self.checks = CheckBuffers(np.zeros(v), joined(self._safe), joined(self._tolerance),

@@ -35,9 +35,8 @@ class Band(Shape):
     weight: float = 1.0
     kind: ClassVar[str] = "band"
     SCENE_FIELDS: ClassVar[dict[str, tuple[str, Any]]] = {
-        "z": ("interval", None),
-        "weight": ("weight", 1.0),
-    }
+        "z": ("interval", None), "weight": ("weight", 1.0),
+    }  # fmt: skip
 
     def __post_init__(self) -> None:
         lo, hi = float(self.z_min), float(self.z_max)

@@ -46,10 +46,8 @@ class Inlet(Shape):
     weight: float = 1.0
     kind: ClassVar[str] = "inlet"
     SCENE_FIELDS: ClassVar[dict[str, tuple[str, Any]]] = {
-        "center": ("point", None),
-        "radius": ("length", None),
-        "weight": ("weight", 1.0),
-    }
+        "center": ("point", None), "radius": ("length", None), "weight": ("weight", 1.0),
+    }  # fmt: skip
     polygon: Polygon = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -58,9 +56,8 @@ class Inlet(Shape):
         r = _validate.positive("radius", self.radius)
         big = _validate.positive("pipe_radius", self.pipe_radius)
         if not r < big:
-            raise ParameterError(
-                "radius", f"{r:g} m must be smaller than the pipe radius {big:g} m"
-            )
+            raise ParameterError("radius", f"{r:g} m must be smaller than the pipe radius "
+                                 f"{big:g} m")  # fmt: skip
         object.__setattr__(self, "radius", r)
         object.__setattr__(self, "weight", _validate.positive("weight", self.weight, strict=False))
         object.__setattr__(self, "polygon", Polygon(self.curve(VERTICES), self.weight))

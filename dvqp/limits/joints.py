@@ -1,4 +1,4 @@
-"""Joint position limits as velocity bounds one step ahead."""
+"""Joint position and velocity limits: boxes on this step's joint velocities."""
 
 from __future__ import annotations
 
@@ -52,3 +52,26 @@ def joint_room(q: Array, q_min: Array, q_max: Array, values: Array, start: int) 
     for i in range(n):
         values[start + i] = q_max[i] - q[i]
         values[start + n + i] = q[i] - q_min[i]
+
+
+class JointVelocityLimit(Limit):
+    """``−q̇_max ≤ Q̇ ≤ q̇_max`` (rad/s), from the robot's ``qd_max``, shape (n,) (compiled:
+    :func:`velocity_bounds`).
+
+    A bound of the QP held exactly by every accepted solution (the solution check recomputes
+    it), so it needs no exact verification of the integrated motion.
+    """
+
+    name = "joint_velocity"
+
+    def __init__(self, robot: Robot) -> None:
+        self.qd_max = robot.qd_max
+
+
+@njit(cache=True)
+def velocity_bounds(qd_max: NDArray[np.float64], lb: NDArray[np.float64],
+                    ub: NDArray[np.float64]) -> None:  # fmt: skip
+    """``−q̇_max ≤ Q̇ ≤ q̇_max``, intersected into ``lb``, ``ub`` in place."""
+    for i in range(qd_max.shape[0]):
+        lb[i] = max(lb[i], -qd_max[i])
+        ub[i] = min(ub[i], qd_max[i])
