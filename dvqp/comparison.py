@@ -275,10 +275,6 @@ def machine() -> dict[str, Any]:
 
 
 def quiet_worker() -> None:
-    """Make Ctrl-C end this worker process at once, silently (exit code 130).
-
-    For ``ProcessPoolExecutor(initializer=quiet_worker)``: workers not forked from inside
-    :func:`dvqp.cli.progress.interruptible` (``spawn``, ``forkserver``) then stop as forked
-    ones do, instead of each printing a traceback.
-    """
+    """Make Ctrl-C end this worker process at once, silently (exit 130), as a forked one does
+    (``ProcessPoolExecutor(initializer=quiet_worker)`` for ``spawn`` / ``forkserver``)."""
     signal.signal(signal.SIGINT, lambda signum, frame: os._exit(130))

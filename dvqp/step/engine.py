@@ -83,6 +83,7 @@ class Stepper:
         self.solver = (QPSolver(resolver.factory, plan.qp, spec.task_weight)
                        if isinstance(resolver, QPResolver) else None)  # fmt: skip
         self.hooks = self.layout.hooks
+        self._prepare = stages.prepare_baseline if self.arrays.pinv.baseline else stages.prepare
         self.state = KinematicState.view(plan.state, radius)
         self.x = self.arrays.x
         self.record_at = self.arrays.record.index
@@ -190,13 +191,13 @@ class Stepper:
         a.command[:] = command
         a.dt[0] = dt
         last = stages.ROWS if hooks.prepared else stages.CLOSE
-        status = int(stages.prepare(s, stages.ROWS, last))
+        status = int(self._prepare(s, stages.ROWS, last))
         if status == stages.BAD_COMMAND:
             raise ParameterError("command", "must be finite (no NaN or inf)")
         if hooks.prepared:
             for hook in hooks.prepared:
                 hook()
-            status = int(stages.prepare(s, stages.CLOSE, stages.CLOSE))
+            status = int(self._prepare(s, stages.CLOSE, stages.CLOSE))
         return status
 
     def _pinv_error(self, status: int) -> SingularConfigurationError:

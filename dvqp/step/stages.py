@@ -3,8 +3,8 @@
 :func:`evaluate` measures a configuration (kinematics, obstacles, link pairs), assesses it (the
 objective, the dampers' distances) and concludes (the exact verification, the diagnostics, the
 trajectory's sample); :func:`prepare` writes a step's QP (the tasks' rows, the cost, the
-bounds, the damper rows) and closes it (crossed bounds, or the baseline's step). Each stage
-calls the kernels of the parts' own modules on the arrays of one packed
+bounds, the damper rows) and closes it, :func:`prepare_baseline` the baseline's step. Each
+stage calls the kernels of the parts' own modules on the arrays of one packed
 :class:`~dvqp.step.arrays.Pipeline`. A run with parts of your own calls the stages one at a
 time (``first``, ``last``) and runs its parts in between (:mod:`dvqp.step.hooks`).
 """
@@ -161,57 +161,63 @@ def _sample(s) -> None:  # type: ignore[no-untyped-def]
     excess = s.checks.excess
     r.limit_excess[at], r.limits_kept[at] = max(excess[0], 0.0), excess[1] <= 1.0
     d = s.diagnostics
-    r.tilt[at], r.self_distance[at], r.min_clearance[at], r.probe_clearance[at] = (
-        d[0],
-        d[1],
-        d[2],
-        d[3],
-    )
+    r.tilt[at], r.self_distance[at], r.min_clearance[at], r.probe_clearance[at] = d[:4]
 
 
 @njit(cache=True)
 def prepare(s, first, last) -> int:  # type: ignore[no-untyped-def]
-    """Write this step's problem (stage ``ROWS``) and close it (``CLOSE``): returns −1, the
-    first joint whose bounds cross (QP), :data:`SINGULAR_TASK` / :data:`INDEFINITE_METRIC`
-    (the baseline, whose step is otherwise in ``s.pinv.x``) or :data:`BAD_COMMAND`."""
-    qp, p = s.qp, s.pinv
+    """Write this step's QP (stage ``ROWS``: the tasks' rows, the cost, the bounds reset and
+    every box intersected, the damper rows) and close it (``CLOSE``): returns −1, the first
+    joint whose bounds cross, or :data:`BAD_COMMAND`."""
+    qp, b, q, dt = s.qp, s.bounds, s.state.q, s.dt[0]
     if first <= ROWS <= last:
-        for i in range(4):
-            if not math.isfinite(s.command[i]):
-                return BAD_COMMAND
-        for t in range(s.measures.tool_rows.shape[0]):
-            tool_rows(s.state.tool_jacobian, s.command, qp.A, qp.b, s.measures.tool_rows[t])
-        if p.dense:
-            for i in range(qp.P.shape[0]):
-                for j in range(qp.P.shape[1]):
-                    qp.P[i, j] = p.weights[i] if i == j else 0.0
-        gain = s.objective.gain
-        for i in range(qp.cost.shape[0]):
-            qp.cost[i] = -gain * s.objective.gradient[i]
-        if not p.baseline:
-            _limits(s)
+        if not _rows(s):
+            return BAD_COMMAND
+        for i in range(qp.lb.shape[0]):
+            qp.lb[i], qp.ub[i] = -math.inf, math.inf
+        position_bounds(q, b.q_min, b.q_max, dt, qp.lb, qp.ub)
+        velocity_bounds(b.qd_max, qp.lb, qp.ub)
+        if b.accelerate:
+            acceleration_bounds(q, b.accel_q_min, b.accel_q_max, b.qdd_max, b.previous, dt,
+                                qp.lb, qp.ub)  # fmt: skip
+        damper_rows(s.params, s.dampers, dt, qp.G, qp.h)
     if first <= CLOSE <= last:
-        if p.baseline:
-            status = pinv_step(qp.A, qp.b, qp.cost, p.weights, qp.P, p.dense, p.damping, p.info,
-                               p.x)  # fmt: skip
-            if status == -1:
-                return -1
-            return INDEFINITE_METRIC if status == NOT_DEFINITE else SINGULAR_TASK
         for i in range(qp.lb.shape[0]):
             if qp.lb[i] > qp.ub[i]:
                 return i
     return -1
 
 
+@njit(cache=True)
+def prepare_baseline(s, first, last) -> int:  # type: ignore[no-untyped-def]
+    """:func:`prepare` for the baseline (its own function: neither compiles the other's code),
+    its step in ``s.pinv.x``: −1, :data:`SINGULAR_TASK`, :data:`INDEFINITE_METRIC` or
+    :data:`BAD_COMMAND`."""
+    qp, p = s.qp, s.pinv
+    if first <= ROWS <= last and not _rows(s):
+        return BAD_COMMAND
+    if first <= CLOSE <= last:
+        status = pinv_step(qp.A, qp.b, qp.cost, p.weights, qp.P, p.dense, p.damping, p.info,
+                           p.x)  # fmt: skip
+        if status != -1:
+            return INDEFINITE_METRIC if status == NOT_DEFINITE else SINGULAR_TASK
+    return -1
+
+
 @njit(cache=True, inline="always")
-def _limits(s) -> None:  # type: ignore[no-untyped-def]
-    """The bounds (reset, then every box intersected) and the damper rows."""
-    qp, b, q, dt = s.qp, s.bounds, s.state.q, s.dt[0]
-    for i in range(qp.lb.shape[0]):
-        qp.lb[i], qp.ub[i] = -math.inf, math.inf
-    position_bounds(q, b.q_min, b.q_max, dt, qp.lb, qp.ub)
-    velocity_bounds(b.qd_max, qp.lb, qp.ub)
-    if b.accelerate:
-        acceleration_bounds(q, b.accel_q_min, b.accel_q_max, b.qdd_max, b.previous, dt, qp.lb,
-                            qp.ub)  # fmt: skip
-    damper_rows(s.params, s.dampers, dt, qp.G, qp.h)
+def _rows(s) -> bool:  # type: ignore[no-untyped-def]
+    """The tasks' rows, the metric and the cost; False if the command is not finite."""
+    qp, p = s.qp, s.pinv
+    for i in range(4):
+        if not math.isfinite(s.command[i]):
+            return False
+    for t in range(s.measures.tool_rows.shape[0]):
+        tool_rows(s.state.tool_jacobian, s.command, qp.A, qp.b, s.measures.tool_rows[t])
+    if p.dense:
+        for i in range(qp.P.shape[0]):
+            for j in range(qp.P.shape[1]):
+                qp.P[i, j] = p.weights[i] if i == j else 0.0
+    gain = s.objective.gain
+    for i in range(qp.cost.shape[0]):
+        qp.cost[i] = -gain * s.objective.gradient[i]
+    return True
