@@ -8,7 +8,7 @@ Each repeat runs the whole scene once per backend, in a rotated order so that dr
 machine's speed falls on every backend alike, each run in a fresh process (a backend's side
 effects on a process — HiGHS leaves later backends measurably slower — reach no other run).
 A "full step" is what ``simulate`` times: kinematics, objective, the resolution, the exact
-check of the integrated step and the recording (the compiled step, ``engine="auto"``).
+check of the integrated step and the recording (the compiled step).
 "resolve" is the resolver alone (QP assembly + solve + residual check, or the
 pseudoinverse), "solver" the time inside the QP backend's own calls (data update and solve),
 "rest" the full step less the solver. The peer line is

@@ -251,10 +251,11 @@ def lay_out(robot: Robot, radius: float, resolver: Resolver, q0: ArrayLike, dt: 
     fields = [f for f in RecordArrays.__dataclass_fields__ if f != "index"]
     record = (RecordArrays.none(n, k) if samples is None else
               RecordArrays(np.full(1, -1, np.int64), *(samples[f] for f in fields)))  # fmt: skip
+    x = np.zeros(n)  # the step: the baseline's is written there directly
     return layout, Pipeline(
-        float(radius), plan.dt, plan.command, np.zeros(n), np.zeros(2), robot.model_arrays(),
+        float(radius), plan.dt, plan.command, x, np.zeros(2), robot.model_arrays(),
         plan.state, shapes, plan.proximity, plan.pairs, layout.objective, layout.bounds,
         layout.measures, layout.params, plan.dampers, plan.qp,
-        PinvArrays(baseline, weights, layout.hooks.soft, damping, np.zeros(2), np.zeros(n)),
+        PinvArrays(baseline, weights, layout.hooks.soft, damping, np.zeros(2), x),
         plan.checks, layout.joint_values, layout.damper_values, rows, np.zeros(5), record,
     )  # fmt: skip

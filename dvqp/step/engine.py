@@ -168,7 +168,6 @@ class Stepper:
         if self.solver is None:
             if status != -1:
                 raise self._pinv_error(status)
-            self.x[:] = a.pinv.x
             return Resolution(True, "optimal", None, prepared - started, prepared - started)
         if status != -1:
             lb, ub = a.qp.lb[status], a.qp.ub[status]
