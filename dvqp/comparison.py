@@ -118,7 +118,7 @@ def _clearances(scene: Scene, traj: Trajectory) -> Row:
         k = int(np.argmin(traj.min_clearance))
         state = KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius)
         _, part, j = proximity(state, scene.obstacles).closest()
-        closest = f"{part}/obstacle{j + 1}"
+        closest = f"{part}/{scene.obstacles.labels[j]}"
     if traj.self_distance.size:
         k = int(np.argmin(traj.self_distance))
         _, pair = self_distance(KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius))

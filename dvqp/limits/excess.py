@@ -30,7 +30,7 @@ class Excess:
     tolerance : float
         The limit's verification tolerance, same unit: the step is accepted up to it.
     label : str
-        What broke it, e.g. ``"probe/obstacle3"``, ``"point2/height"``, ``"joint4"``.
+        What broke it, e.g. ``"probe/obstacles[2]"``, ``"point2/height"``, ``"joint4"``.
     quantity : str
         ``"clearance"``, ``"height"``, ``"tilt"``, ``"joint position"``, ...
     unit : str
@@ -58,7 +58,7 @@ class Excess:
         return self.value / self.tolerance
 
     def describe(self) -> str:
-        """One line, e.g. ``"probe/obstacle3 clearance 0.0061 m < 0.0099 m (by 3.8 mm)"``."""
+        """One line, e.g. ``"probe/obstacles[2] clearance 0.0061 m < 0.0099 m (by 3.8 mm)"``."""
         if math.isinf(self.value):
             return f"{self.label} ({self.quantity})"
         by = f"{self.value * 1e3:.3g} mm" if self.unit == "m" else f"{self.value:.3g} {self.unit}"

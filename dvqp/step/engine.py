@@ -76,6 +76,8 @@ class Stepper:
                  samples: Mapping[str, np.ndarray] | None = None) -> None:  # fmt: skip
         spec = resolver.spec
         self.robot, self.resolver = robot, resolver
+        self.obstacles = ObstacleSet() if obstacles is None else obstacles
+        """The obstacles the diagnostics measure (their ``labels`` name them)."""
         self.layout, self.arrays = lay_out(robot, radius, resolver, q0, dt, obstacles, samples)
         plan = self.layout.plan
         self.struct = as_struct(self.arrays)
