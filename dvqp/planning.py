@@ -133,6 +133,7 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
         or is past a bound the start broke (then ``sample`` is 0, the start).
     """
     where = f"{scene.source}: {traj.backend}"
+    started = "; ".join(start_broken_lines(traj.start_broken))
     if traj.limits_kept.shape[0] and not traj.limits_kept.all():
         worst = worst_sample_excess(scene, traj, limits)
         if worst is None or not worst[1].broken:  # a limit given to plan, not to check_run
@@ -142,8 +143,9 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
             sample = worst[0]
             detail = f": worst at t = {traj.t[sample]:.3f} s, {worst[1].describe()}"
         count = int(np.sum(~traj.limits_kept))
+        also = f"; it starts outside its limits: {started}" if started else ""
         raise LimitViolationError(
-            f"{where}: {count} of {traj.t.shape[0]} samples break a limit{detail}",
+            f"{where}: {count} of {traj.t.shape[0]} samples break a limit{detail}{also}",
             sample, float(traj.limit_excess[sample]),
         )  # fmt: skip
     if not traj.ok:
@@ -166,8 +168,7 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
         )
     if traj.start_broken:
         worst = max(traj.start_broken, key=lambda b: b.excess.ratio).excess
-        lines = "; ".join(start_broken_lines(traj.start_broken))
-        raise LimitViolationError(f"{where}: starts outside its limits: {lines}", 0, worst.value)
+        raise LimitViolationError(f"{where}: starts outside its limits: {started}", 0, worst.value)
 
 
 def worst_sample_excess(

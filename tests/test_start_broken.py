@@ -116,6 +116,10 @@ def test_the_baseline_that_makes_it_worse_is_broken_and_says_by_how_much() -> No
     assert "mm worse than at the start" in line
     limits = text.split("\nlimits          ")[1].split("\nstep time")[0].split("\n")
     assert limits[0].startswith("BROKEN: ") and limits[1] == f"                {line}"
+    why = summarize(s, traj)["error"]  # the samples it made worse, and the start's
+    assert " samples break a limit: " in why and why.endswith(
+        f"; it starts outside its limits: {line}"
+    )
 
 
 def test_a_run_that_starts_within_every_bound_still_says_every_limit_kept() -> None:
