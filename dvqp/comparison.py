@@ -23,7 +23,7 @@ from dvqp import load_scene, plan
 from dvqp.errors import DvqpError
 from dvqp.geometry import proximity
 from dvqp.kinematics import KinematicState
-from dvqp.limits import self_distance
+from dvqp.limits import self_distance, start_broken_lines
 from dvqp.planning import check_run, final_errors, worst_sample_excess
 from dvqp.resolution.registry import PINV
 
@@ -35,7 +35,7 @@ FIELDS = (
     "median_step_us", "p95_step_us", "median_solver_us", "median_rest_us", "median_iterations",
     "ratio_to_pinv", "max_task_error", "min_clearance",
     "closest", "min_probe_clearance", "min_tilt", "min_self_distance", "closest_pair",
-    "max_joint_acceleration", "max_limit_excess", "worst_limit",
+    "max_joint_acceleration", "max_limit_excess", "worst_limit", "start_broken",
     "max_joint_limit_violation", "max_velocity_limit_violation", "final_tracking_error", "error",
 )  # fmt: skip
 """Keys of a result row, in table / CSV order."""
@@ -67,10 +67,12 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
     the part and obstacle that have it (``closest``); the probe's own smallest clearance (m);
     the smallest probe tilt from radial (rad); the smallest distance between non-adjacent
     links (m) and that pair (``closest_pair``); the largest joint acceleration (rad/s²);
-    ``max_limit_excess`` of the worst limit (in its unit, see ``worst_limit``); the largest
-    joint-limit violation (rad) of ``q`` and velocity-limit violation (rad/s) of ``Q̇``; the
-    final tracking error (m) against the commanded motion; ``final_tool`` ``[l, z, h, α]``.
-    Undefined figures are None.
+    ``max_limit_excess`` of the worst limit past its true bound (in its unit, see
+    ``worst_limit``), also of a limit the start broke, which ``start_broken`` names (a line
+    per limit of :func:`dvqp.limits.start_broken_lines`, ``"; "``-joined; None if none); the
+    largest joint-limit violation (rad) of ``q`` and velocity-limit violation (rad/s) of
+    ``Q̇``; the final tracking error (m) against the commanded motion; ``final_tool``
+    ``[l, z, h, α]``. Undefined figures are None.
     """
     ok = traj.success
     steps_us = traj.step_time * 1e6
@@ -118,7 +120,7 @@ def _clearances(scene: Scene, traj: Trajectory) -> Row:
         k = int(np.argmin(traj.min_clearance))
         state = KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius)
         _, part, j = proximity(state, scene.obstacles).closest()
-        closest = f"{part}/obstacle{j + 1}"
+        closest = f"{part}/{scene.obstacles.labels[j]}"
     if traj.self_distance.size:
         k = int(np.argmin(traj.self_distance))
         _, pair = self_distance(KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius))
@@ -139,10 +141,14 @@ def _limit_figures(scene: Scene, traj: Trajectory) -> Row:
     q_out = np.maximum(robot.q_min - traj.q, traj.q - robot.q_max)
     qd_out = np.abs(traj.qdot) - robot.qd_max
     worst = worst_sample_excess(scene, traj)
-    excess = worst[1] if worst is not None and not worst[1].value <= 0.0 else None  # else kept
+    found = [b.excess for b in traj.start_broken]  # past their true bounds, not their starts'
+    if worst is not None and not worst[1].value <= 0.0:  # else kept
+        found.append(worst[1])
+    excess = max(found, key=lambda e: e.ratio) if found else None
     return {
         "max_limit_excess": float(excess.value) if excess else 0.0,
         "worst_limit": f"{excess.label} {excess.quantity} ({excess.unit})" if excess else None,
+        "start_broken": "; ".join(start_broken_lines(traj.start_broken)) or None,
         "max_joint_limit_violation": float(max(0.0, np.max(q_out))),
         "max_velocity_limit_violation": float(max(0.0, np.max(qd_out, initial=0.0))),
     }

@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from dvqp.errors import LimitViolationError, UnreachableTargetError
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits import Excess, Limit
+from dvqp.limits import Excess, Limit, start_broken_lines
 from dvqp.motion.jog import box_average, jog_commands
 from dvqp.motion.simulate import dv_error, simulate
 from dvqp.motion.trajectory import Trajectory
@@ -117,7 +117,8 @@ def plan(
 
 
 def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> None:
-    """Raise if a planned run failed: steps that failed, a broken limit, a path's end missed.
+    """Raise if a planned run failed: steps that failed, a broken limit, a path's end missed,
+    or a limit the start broke (kept no worse, yet past its bound: :attr:`Trajectory.start_broken`).
 
     The path's end is reached when the final position error is within ``path.tolerance`` (m)
     and the heading error within ``path.heading_tolerance`` (rad). ``limits``: those given to
@@ -128,9 +129,11 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
     UnreachableTargetError
         A step failed, or the path's end was not reached.
     LimitViolationError
-        A saved sample breaks a limit by more than its tolerance (the baseline holds none).
+        A saved sample breaks a limit by more than its tolerance (the baseline holds none),
+        or is past a bound the start broke (then ``sample`` is 0, the start).
     """
     where = f"{scene.source}: {traj.backend}"
+    started = "; ".join(start_broken_lines(traj.start_broken))
     if traj.limits_kept.shape[0] and not traj.limits_kept.all():
         worst = worst_sample_excess(scene, traj, limits)
         if worst is None or not worst[1].broken:  # a limit given to plan, not to check_run
@@ -140,8 +143,9 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
             sample = worst[0]
             detail = f": worst at t = {traj.t[sample]:.3f} s, {worst[1].describe()}"
         count = int(np.sum(~traj.limits_kept))
+        also = f"; it starts outside its limits: {started}" if started else ""
         raise LimitViolationError(
-            f"{where}: {count} of {traj.t.shape[0]} samples break a limit{detail}",
+            f"{where}: {count} of {traj.t.shape[0]} samples break a limit{detail}{also}",
             sample, float(traj.limit_excess[sample]),
         )  # fmt: skip
     if not traj.ok:
@@ -152,10 +156,9 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
             f"({traj.status[first]})",
             step=first,
         )
-    if scene.path is None or traj.tracking_error.shape[0] == 0:
-        return
-    position, heading = final_errors(traj)
-    if position > scene.path.tolerance or heading > scene.path.heading_tolerance:
+    position, heading = final_errors(traj) if traj.tracking_error.shape[0] else (0.0, 0.0)
+    if scene.path is not None and (position > scene.path.tolerance
+                                   or heading > scene.path.heading_tolerance):  # fmt: skip
         raise UnreachableTargetError(
             f"{where}: target not reached at t = {traj.t[-1]:.3f} s: tracking error "
             f"{position * 1e3:.3g} mm / {heading:.3g} rad (tolerance "
@@ -163,6 +166,9 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
             step=traj.n_steps,
             error=position,
         )
+    if traj.start_broken:
+        worst = max(traj.start_broken, key=lambda b: b.excess.ratio).excess
+        raise LimitViolationError(f"{where}: starts outside its limits: {started}", 0, worst.value)
 
 
 def worst_sample_excess(

@@ -236,9 +236,9 @@ def _clearances(limit: ObstacleDamper, state: KinematicState) -> Measured:
     gradient = np.concatenate([point_rows.reshape(-1, n), link_rows.reshape(-1, n)])
     usable = np.concatenate([point_ok.ravel(), link_ok.ravel()])
     labels = (
-        *(f"{'probe' if i == k else f'point{i + 1}'}/obstacle{j + 1}"
+        *(f"{'probe' if i == k else f'point{i + 1}'}/obstacles[{j}]"
           for j in range(count) for i in range(k + 1)),
-        *(f"{link_name(i, k)}/obstacle{j + 1}" for j in range(count) for i in range(k)),
+        *(f"{link_name(i, k)}/obstacles[{j}]" for j in range(count) for i in range(k)),
     )  # fmt: skip
     return Measured(value, gradient, np.full(value.shape, limit.margin), labels,
                     usable & (value < limit.influence))  # fmt: skip

@@ -157,7 +157,7 @@ def test_the_straight_motion_of_a_large_step_is_checked_between_its_ends(robot: 
     status = moved.step.status
     assert not moved.step.success and np.all(moved.step.qdot == 0.0)
     assert status.startswith("failed: ") and status.endswith(" in 1 substeps")
-    assert "/obstacle1 clearance" in status and "straight motion" not in status
+    assert "/obstacles[0] clearance" in status and "straight motion" not in status
     assert moved.excess.quantity == "clearance" and moved.excess.value > 0.005
     np.testing.assert_array_equal(s.state.q, Q_A)  # the arm holds still
     # the points checked: on the segment, at most JOINT_STRIDE apart, ends excluded
@@ -198,7 +198,7 @@ def test_a_split_step_is_also_checked_along_its_straight_motion(robot: Robot) ->
     moved = advance(s, np.zeros(4), 1.0)
     assert not moved.step.success and moved.substeps == 2
     assert moved.step.status.startswith("failed: the straight motion: ")
-    assert "/obstacle1 clearance" in moved.step.status
+    assert "/obstacles[0] clearance" in moved.step.status
     assert moved.step.status.endswith(" in 2 substeps")
     np.testing.assert_array_equal(s.state.q, Q_A)
     # with the obstacle only where the whole step would end, the split step is taken: its

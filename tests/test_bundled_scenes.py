@@ -111,7 +111,7 @@ def test_narrow_passage_makes_the_qp_rows_active_which_the_baseline_breaks() -> 
     assert margin - 1e-4 < qp.min_clearance.min() < margin + 1e-4
     assert h_min - 1e-4 < body_heights(qp).min() < h_min + 1e-4
     tight = tight_rows(s, qp)
-    assert sum(n for label, n in tight.items() if "/obstacle" in label) > 50
+    assert sum(n for label, n in tight.items() if "/obstacles[" in label) > 50
     assert sum(n for label, n in tight.items() if label.endswith("/height")) > 50
     assert base.min_clearance.min() < -0.02  # through an inlet
     assert body_heights(base).min() < h_min - 0.005  # below the minimum height
@@ -141,6 +141,7 @@ def test_many_obstacles_scene_holds_the_margin_at_several_obstacles() -> None:
     check_run(s, qp)
     assert qp.min_clearance.min() > damper(s).margin - 5e-4
     tight = tight_rows(s, qp)
-    obstacles = {label.split("/")[1] for label in tight if "/obstacle" in label}
-    assert len(obstacles & {"obstacle1", "obstacle2", "obstacle3"}) >= 2  # low clamps in turn
+    obstacles = {label.split("/")[1] for label in tight if "/obstacles[" in label}
+    low_clamps = {"obstacles[0]", "obstacles[1]", "obstacles[2]"}
+    assert len(obstacles & low_clamps) >= 2  # the low clamps in turn
     assert base.min_clearance.min() < -0.003

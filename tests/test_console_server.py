@@ -105,7 +105,7 @@ def test_a_client_gets_the_scene_then_states_at_30_hz_or_more(server: RunningCon
     assert set(last) >= STATE_KEYS and len(last["tool"]) == 4
     assert np.array(last["points"]).shape == (5, 3)
     assert last["status"] == "optimal" and last["min_clearance"] > 0.01
-    assert last["closest"].endswith(("obstacle1", "obstacle2"))
+    assert last["closest"].endswith(("obstacles[0]", "obstacles[1]"))
 
 
 GARBAGE = [

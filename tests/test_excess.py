@@ -54,12 +54,12 @@ def test_a_clearance_below_the_start_is_broken_and_described(robot: Robot, q0: n
     assert not s.broken and not s.excess().broken
     assert s.load(q) and s.broken
     found = s.excess()
-    assert found.broken and found.label == "probe/obstacle1" and found.unit == "m"
+    assert found.broken and found.label == "probe/obstacles[0]" and found.unit == "m"
     assert found.quantity == "clearance" and found.tolerance == 1e-4
     assert found.actual == pytest.approx(-0.002, abs=1e-9)
     start_clearance = proximity(start, damper.obstacles).point_clearance[0, -1]
     assert found.bound == pytest.approx(min(0.001, start_clearance))
-    assert found.describe().startswith("probe/obstacle1 clearance -0.002 m < ")
+    assert found.describe().startswith("probe/obstacles[0] clearance -0.002 m < ")
     np.testing.assert_allclose(s.excess_now, [found.value, found.value / 1e-4], rtol=1e-12)
     assert_excess(found, oracle_worst([damper], start, moved))
 
@@ -105,8 +105,8 @@ def test_nothing_to_verify_is_no_excess(robot: Robot, q0: np.ndarray) -> None:
 
 
 def test_describe_reads_as_one_line() -> None:
-    e = Excess(0.0038, 1e-4, "probe/obstacle3", "clearance", "m", 0.0062, 0.01)
-    assert e.describe() == "probe/obstacle3 clearance 0.0062 m < 0.01 m (by 3.8 mm)"
+    e = Excess(0.0038, 1e-4, "probe/obstacles[2]", "clearance", "m", 0.0062, 0.01)
+    assert e.describe() == "probe/obstacles[2] clearance 0.0062 m < 0.01 m (by 3.8 mm)"
     tilt = Excess(0.05, 1e-3, "probe/tilt", "tilt", "rad", 0.15, 0.2)
     assert tilt.describe() == "probe/tilt tilt 0.15 rad < 0.2 rad (by 0.05 rad)"
     bad = Excess(math.inf, 1.0, "singular configuration", "tool on the pipe axis")

@@ -25,7 +25,7 @@ def test_pairs_outside_the_influence_distance_add_no_row(
     t = near.link_t
     expected += int(np.sum((near.link_clearance < 0.04) & (t > 0) & (t < 1)))
     assert isinstance(rows, Constraint) and rows.rows == expected > 0
-    assert not any(label.endswith("obstacle3") for label in rows.labels)
+    assert not any(label.endswith("obstacles[2]") for label in rows.labels)
     far = ObstacleDamper(ObstacleSet([Obstacle(np.array([-0.5, -1.0]), 0.05)]), 0.005, 0.04)
     s = stepping.stepper(robot, q0, limits=[far], backend="daqp")
     s.prepare(np.zeros(4), DT)
@@ -40,8 +40,8 @@ def clearance_of(robot: Robot, q: np.ndarray, obstacles: ObstacleSet, label: str
     """The clearance a row's label names, measured by ``proximity`` alone."""
     state = KinematicState.compute(robot, q, PIPE_RADIUS)
     near = proximity(state, obstacles)
-    kind, j = label.split("/obstacle")
-    j = int(j) - 1
+    kind, name = label.split("/")
+    j = obstacles.labels.index(name)
     if kind == "probe":
         return float(near.point_clearance[j, state.k])
     if kind == "holder":
@@ -104,7 +104,7 @@ def test_a_small_drift_below_the_margin_is_pulled_back(
     d = float(proximity(state0, obstacles).point_clearance[0, 2])  # point 3's clearance, 2 cm
     damper = ObstacleDamper(obstacles, margin=d + 5e-5, gain=0.5)  # 0.05 mm inside
     rows = stepping.rows(damper, robot, q0)
-    assert rows.labels[0] == "point3/obstacle1"  # type: ignore[union-attr]
+    assert rows.labels[0] == "point3/obstacles[0]"  # type: ignore[union-attr]
     assert rows.h[0] == pytest.approx(max(-0.5 / DT * 5e-5, -damper.deceleration * DT))  # type: ignore[union-attr]
     assert rows.h[0] < 0.0  # type: ignore[union-attr]
 
@@ -113,7 +113,7 @@ def test_dampers_over_different_obstacle_sets_keep_each_its_own_rows(
     robot: Robot, q0: np.ndarray, state0: KinematicState
 ) -> None:
     """Three obstacle dampers in one step, over sets that share shapes: each writes the rows of
-    its own set (labels numbered in it), with its own margin, gain and deceleration."""
+    its own set (labels indexed in it), with its own margin, gain and deceleration."""
     a, b, c = near_obstacles(state0)
     p = state0.guarded[:, :2]
     d = Obstacle(p[-1] + np.array([0.0, 0.05]), 0.03)
@@ -128,8 +128,8 @@ def test_dampers_over_different_obstacle_sets_keep_each_its_own_rows(
     for q in [q0, *configurations(robot, q0, 4, seed=3, spread=0.05)]:
         rows = [damper_rows(s, damper, q, 0.01, fd=q is q0) for damper in dampers]
         assert all(r.rows > 0 for r in rows)
-        assert any(label.startswith("point3/obstacle1") for label in rows[0].labels)
-        assert any(label.startswith("probe/obstacle2") for label in rows[1].labels)
+        assert any(label.startswith("point3/obstacles[0]") for label in rows[0].labels)
+        assert any(label.startswith("probe/obstacles[1]") for label in rows[1].labels)
         problem = s.problem()
         applies = np.isfinite(problem.h)
         stacked = np.vstack([r.G for r in rows])
@@ -161,7 +161,7 @@ def test_every_shape_class_gives_rows_of_minus_its_clearance_gradient(
     for q in [q0, *configurations(robot, q0, 3, seed=4, spread=0.03)]:
         rows = damper_rows(s, damper, q, fd=True)
         seen |= {label.split("/")[1] for label in rows.labels}
-    assert seen == {"obstacle1", "obstacle2", "obstacle3"}
+    assert seen == {"obstacles[0]", "obstacles[1]", "obstacles[2]"}
 
 
 def test_an_obstacle_across_the_seam_acts_on_a_point_on_the_other_side(
@@ -176,7 +176,7 @@ def test_an_obstacle_across_the_seam_acts_on_a_point_on_the_other_side(
     damper = ObstacleDamper(ObstacleSet([Obstacle(centre, 0.01)]), margin=0.005)
     s = stepping.stepper(robot, q, limits=[damper], backend="daqp")
     rows = damper_rows(s, damper, q, fd=True)
-    at = rows.labels.index("point3/obstacle1")
+    at = rows.labels.index("point3/obstacles[0]")
     assert rows.h[at] == pytest.approx(damper_rhs(np.array([0.02]), 0.005, 0.5, DT, 1e-4, 1.0)[0])
 
 

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 from dvqp.cli.figures import write_atomic
 from dvqp.comparison import Row, aligned, cell
 from dvqp.comparison import rows_to_csv as rows_to_csv  # part of this module's API (docs)
+from dvqp.limits import start_broken_lines
 
 if TYPE_CHECKING:
     from dvqp import Scene, Trajectory
@@ -56,7 +57,7 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         f"self distance   {cell(row['min_self_distance'], '{:.4f} m')}"
         + (f" ({row['closest_pair']})" if row["closest_pair"] else ""),
         f"acceleration    max |qdd| {cell(row['max_joint_acceleration'], '{:.3g} rad/s^2')}",
-        f"limits          {_worst(row, bool(traj.limits_kept.all()))}",
+        f"limits          {_limits(row, traj)}",
         f"step time       median {cell(row['median_step_us'], '{:.0f}')} us, "
         f"p95 {cell(row['p95_step_us'], '{:.0f}')} us",
         f"solver          {cell(row['median_solver_us'], '{:.1f}')} us a step in the solver's "
@@ -92,12 +93,18 @@ def _steps(row: Row) -> str:
     return text + (f"; {row['substepped']} split into substeps" if row["substepped"] else "")
 
 
-def _worst(row: Row, kept: bool) -> str:
-    """The worst limit excess with its limit, or that every limit was kept."""
-    if not row["worst_limit"]:
-        return "every limit kept"
-    worst = f"{row['worst_limit']} past its bound by {row['max_limit_excess']:.2g}"
-    return f"every limit kept to its tolerance (deepest: {worst})" if kept else f"BROKEN: {worst}"
+def _limits(row: Row, traj: Trajectory) -> str:
+    """That every limit was kept (and the deepest excess within tolerance), or the worst one
+    broken, and each limit the start broke (one line each)."""
+    worst = (f"{row['worst_limit']} past its bound by {row['max_limit_excess']:.2g}"
+             if row["worst_limit"] else "a limit given to plan, not named here")  # fmt: skip
+    lines = start_broken_lines(traj.start_broken)
+    if not traj.limits_kept.all():
+        lines.insert(0, f"BROKEN: {worst}")
+    elif not lines:
+        lines = ["every limit kept" + (f" to its tolerance (deepest: {worst})"
+                                       if row["worst_limit"] else "")]  # fmt: skip
+    return "\n                ".join(lines)
 
 
 def write_text(path: Path, text: str) -> None:

@@ -35,7 +35,7 @@ SAMPLED = ("q", "tool", "points", *PER_SAMPLE, "limits_kept")
 class Sample:
     """What the console shows and records of one configuration: the values a
     :class:`Trajectory` holds per sample, under the same names and in the same units (l and α
-    not unwrapped), and ``closest``, the ``"<part>/obstacle<j>"`` that has ``min_clearance``
+    not unwrapped), and ``closest``, the ``"<part>/<obstacle>"`` that has ``min_clearance``
     (None: no obstacle)."""
 
     q: NDArray[np.float64]
@@ -59,7 +59,7 @@ class Sample:
         if closest >= 0:
             obstacle, part = divmod(int(closest), 2 * k + 1)
             name = point_label(part, k) if part <= k else link_label(part - k - 1, k)
-            where = f"{name}/obstacle{obstacle + 1}"
+            where = f"{name}/{stepper.obstacles.labels[obstacle]}"
         excess = stepper.excess_now
         return cls(a.state.q.copy(), a.state.tool.copy(), a.state.guarded[:-1].copy(),
                    float(a.objective.value[0]), clearance, probe, where, tilt, apart,

@@ -7,7 +7,7 @@ and the exact verification of its distances.
 
 from dvqp.limits.acceleration import DEFAULT_QDD_MAX, AccelerationLimit
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, damper_value
-from dvqp.limits.excess import NO_EXCESS, Excess
+from dvqp.limits.excess import NO_EXCESS, Excess, StartBroken, start_broken_lines
 from dvqp.limits.height import ProbeHeight, SurfaceHeight
 from dvqp.limits.joints import JointPositionLimit, JointVelocityLimit
 from dvqp.limits.limit import Bounds, Constraint, Limit
@@ -18,6 +18,6 @@ from dvqp.limits.tilt import TiltLimit
 __all__ = [
     "DEFAULT_DECELERATION", "DEFAULT_QDD_MAX", "NO_EXCESS", "AccelerationLimit", "Bounds",
     "Constraint", "Distances", "Excess", "JointPositionLimit", "JointVelocityLimit", "Limit",
-    "ObstacleDamper", "ProbeHeight", "SelfCollision", "SurfaceHeight", "TiltLimit",
-    "VelocityDamper", "damper_value", "self_distance",
+    "ObstacleDamper", "ProbeHeight", "SelfCollision", "StartBroken", "SurfaceHeight",
+    "TiltLimit", "VelocityDamper", "damper_value", "self_distance", "start_broken_lines",
 ]  # fmt: skip

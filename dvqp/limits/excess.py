@@ -6,12 +6,14 @@ quantities (clearances, heights, tilt, joint room, ...) are evaluated at the con
 reached, without linearisation, and the worst :class:`Excess` is kept.
 
 A quantity is kept while at or above ``min(safe, value at the run's start)``: a part that
-starts inside its margin may stay there but not get worse, and excesses cannot add up.
+starts inside its margin may stay there but not get worse, and excesses cannot add up. Such a
+start is not hidden: the values it broke are reported (:class:`StartBroken`).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from numba import njit
@@ -30,7 +32,7 @@ class Excess:
     tolerance : float
         The limit's verification tolerance, same unit: the step is accepted up to it.
     label : str
-        What broke it, e.g. ``"probe/obstacle3"``, ``"point2/height"``, ``"joint4"``.
+        What broke it, e.g. ``"probe/obstacles[2]"``, ``"point2/height"``, ``"joint4"``.
     quantity : str
         ``"clearance"``, ``"height"``, ``"tilt"``, ``"joint position"``, ...
     unit : str
@@ -58,10 +60,10 @@ class Excess:
         return self.value / self.tolerance
 
     def describe(self) -> str:
-        """One line, e.g. ``"probe/obstacle3 clearance 0.0061 m < 0.0099 m (by 3.8 mm)"``."""
+        """One line, e.g. ``"probe/obstacles[2] clearance 0.0061 m < 0.0099 m (by 3.8 mm)"``."""
         if math.isinf(self.value):
             return f"{self.label} ({self.quantity})"
-        by = f"{self.value * 1e3:.3g} mm" if self.unit == "m" else f"{self.value:.3g} {self.unit}"
+        by = amount(self.value, self.unit)
         below = "<" if self.quantity not in ("joint position", "joint velocity") else "past"
         return (f"{self.label} {self.quantity} {self.actual:.4g} {self.unit} {below} "
                 f"{self.bound:.4g} {self.unit} (by {by})")  # fmt: skip
@@ -69,6 +71,69 @@ class Excess:
 
 NO_EXCESS = Excess(value=-math.inf, tolerance=1.0)
 """What a step with nothing to check reports."""
+
+
+def amount(value: float, unit: str) -> str:
+    """``"3.8 mm"`` for metres, else ``"0.159 rad"``."""
+    return f"{value * 1e3:.3g} mm" if unit == "m" else f"{value:.3g} {unit}"
+
+
+@dataclass(frozen=True)
+class StartBroken:
+    """A verified value that the run's start put past its bound and that a saved sample has
+    past it by more than its tolerance: the run was held only to keep it no worse.
+
+    Attributes
+    ----------
+    limit : str
+        What sets the bound: the scene key (``"min_height"``, ``"margin"``), else the
+        limit's name.
+    label, quantity, unit : str
+        As in :class:`Excess` (``"point2/height"``, ``"height"``, ``"m"``).
+    bound, start, lowest : float
+        The bound (the limit's safe value), the value at the start and the smallest at any
+        saved sample, in ``unit``.
+    tolerance : float
+        The limit's verification tolerance, same unit.
+    """
+
+    limit: str
+    label: str
+    quantity: str
+    unit: str
+    bound: float
+    start: float
+    lowest: float
+    tolerance: float
+
+    @property
+    def excess(self) -> Excess:
+        """How far past the bound at worst over the run (the true figure, not the start's)."""
+        return Excess(self.bound - self.lowest, self.tolerance, self.label, self.quantity,
+                      self.unit, self.lowest, self.bound)  # fmt: skip
+
+    @property
+    def worse(self) -> float:
+        """How much further past it than at the start a sample went (<= tolerance: never
+        worse)."""
+        return self.start - self.lowest
+
+
+def start_broken_lines(found: Sequence[StartBroken]) -> list[str]:
+    """One line per limit (in order of first appearance): its worst value, e.g.
+    ``"min_height: broken from the start by 21.3 mm (point2/height and 4 more), never worse"``;
+    a limit that got worse says by how much (``"…, 5.1 mm worse than at the start"``)."""
+    lines = []
+    for limit in dict.fromkeys(b.limit for b in found):
+        group = [b for b in found if b.limit == limit]
+        top = max(group, key=lambda b: b.excess.ratio)
+        more = f" and {len(group) - 1} more" if len(group) > 1 else ""
+        worst = max(group, key=lambda b: b.worse / b.tolerance)
+        then = ("never worse" if worst.worse <= worst.tolerance
+                else f"{amount(worst.worse, worst.unit)} worse than at the start")  # fmt: skip
+        lines.append(f"{limit}: broken from the start by {amount(top.excess.value, top.unit)} "
+                     f"({top.label}{more}), {then}")  # fmt: skip
+    return lines
 
 
 @njit(cache=True)

@@ -29,7 +29,7 @@ class Constraint:
     h : ndarray, shape (p,)
         Usually m/s (a damper) or rad/s; ``+inf`` for a row that does not apply.
     describe : callable, optional
-        Returns what each row holds, e.g. ``"point3/obstacle1"``; called only when
+        Returns what each row holds, e.g. ``"point3/obstacles[0]"``; called only when
         :attr:`labels` is read.
     """
 

@@ -67,11 +67,12 @@ class ObstacleDamper(VelocityDamper):
         return self.influence
 
     def labels(self, k: int) -> tuple[str, ...]:
-        """``"point3/obstacle1"``, ...: every point then every link, obstacle-major."""
-        count = range(len(self.obstacles))
+        """``"point3/obstacles[0]"`` (or ``"point3/<name>"``), ...: every point then every
+        link, obstacle-major."""
+        names = self.obstacles.labels
         return (
-            *(f"{point_label(i, k)}/obstacle{j + 1}" for j in count for i in range(k + 1)),
-            *(f"{link_label(i, k)}/obstacle{j + 1}" for j in count for i in range(k)),
+            *(f"{point_label(i, k)}/{name}" for name in names for i in range(k + 1)),
+            *(f"{link_label(i, k)}/{name}" for name in names for i in range(k)),
         )
 
 

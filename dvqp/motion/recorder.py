@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from dvqp.limits.excess import StartBroken
 from dvqp.motion.trajectory import Trajectory
 from dvqp.step import Advance
 
@@ -47,12 +48,14 @@ class TrajectoryRecorder:
         if step.success:
             a["qdot"][k] = step.qdot
 
-    def trajectory(self, dt: float, pipe_radius: float, backend: str) -> Trajectory:
+    def trajectory(self, dt: float, pipe_radius: float, backend: str,
+                   start_broken: tuple[StartBroken, ...] = ()) -> Trajectory:  # fmt: skip
         """The recorded run (l and α unwrapped), with ``qddot``: the change of joint velocity
-        at the start of each step over dt (the run starts at rest), rad/s²."""
+        at the start of each step over dt (the run starts at rest), rad/s²; and the limits
+        the start broke (:meth:`dvqp.step.Stepper.start_broken`)."""
         qdot = self.arrays["qdot"]
         before = np.vstack([np.zeros((1, qdot.shape[1])), qdot[:-1]])
         return Trajectory.from_samples(
             dt=dt, pipe_radius=pipe_radius, backend=backend, status=self.status,
-            qddot=(qdot - before) / dt, **self.arrays,
+            qddot=(qdot - before) / dt, start_broken=start_broken, **self.arrays,
         )  # fmt: skip

@@ -156,4 +156,4 @@ def simulate(
         started = now
         if progress is not None:
             progress(i + 1, cmd.shape[0])
-    return record.trajectory(dt, radius, resolver.name)
+    return record.trajectory(dt, radius, resolver.name, stepper.start_broken())

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import zipfile
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +15,7 @@ from dvqp._files import atomic_file, output_path
 from dvqp._versions import versions
 from dvqp.errors import DvqpError
 from dvqp.kinematics.developed_view import unwrap
+from dvqp.limits.excess import StartBroken
 
 ARRAYS = ("t", "q", "qdot", "tool", "points", "w", "min_clearance", "solve_time", "step_time",
           "task_error", "iterations", "success", "status")  # fmt: skip
@@ -89,6 +90,11 @@ class Trajectory:
     qddot : ndarray, shape (N, n)
         Joint acceleration at the start of each step, ``(qdot[k] − qdot[k−1]) / dt`` with the
         run starting at rest, rad/s².
+    start_broken : tuple of StartBroken
+        The limits the start already broke (``limit_excess`` counts them from their start
+        value) that the samples break against their true bound: each value, its bound, its
+        value at the start and its lowest (empty: none; files written before it was added
+        load with none).
     """
 
     t: NDArray[np.float64]
@@ -116,6 +122,7 @@ class Trajectory:
     self_distance: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     qddot: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 0)))
     solver_time: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    start_broken: tuple[StartBroken, ...] = ()
 
     @classmethod
     def from_samples(
@@ -184,6 +191,7 @@ class Trajectory:
                     pipe_radius=np.float64(self.pipe_radius),
                     scene=np.str_(self.scene_text),
                     tracking_error=self.tracking_error,
+                    start_broken=np.str_(json.dumps([asdict(b) for b in self.start_broken])),
                     meta=np.str_(json.dumps({"versions": versions(), **CONVENTIONS})),
                 )
             else:
@@ -213,8 +221,10 @@ class Trajectory:
                 }
                 optional = (*DIAGNOSTICS, "tracking_error")
                 arrays.update({name: data[name] for name in optional if name in data})
+                broken = json.loads(str(data["start_broken"])) if "start_broken" in data else []
                 return cls(
                     **arrays,
+                    start_broken=tuple(StartBroken(**b) for b in broken),
                     backend=str(data["backend"]),
                     pipe_radius=float(data["pipe_radius"]),
                     scene_text=str(data["scene"]),
@@ -222,7 +232,7 @@ class Trajectory:
         except OSError as exc:
             reason = exc.strerror or type(exc).__name__
             raise DvqpError(f"{path}: cannot read: {reason}") from exc
-        except (KeyError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        except (KeyError, ValueError, TypeError, EOFError, zipfile.BadZipFile) as exc:
             # numpy's own text for pickled data suggests loading it unsafely: never pass it on
             reason = "a missing array" if isinstance(exc, KeyError) else "not a dvqp .npz file"
             raise DvqpError(f"{path}: not a dvqp trajectory ({reason})") from exc

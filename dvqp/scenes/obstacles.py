@@ -2,7 +2,8 @@
 
 ``shape`` names the kind (default ``"circle"``, so scenes written before there were other
 shapes still read); the other keys are those the shape class declares in ``SCENE_FIELDS``, so
-a new shape needs no change here.
+a new shape needs no change here. An optional ``name`` labels the obstacle in every report
+(:attr:`~dvqp.geometry.obstacle.ObstacleSet.labels`).
 """
 
 from __future__ import annotations
@@ -19,20 +20,23 @@ from dvqp.scenes.sections import POSITION, SIZE, WEIGHT
 
 def obstacles(f: Fields, doc: dict[str, Any], pipe_radius: float) -> ObstacleSet:
     """``[[obstacles]]``: shapes in the (l, z) plane (none if absent)."""
-    keys = ("shape", *dict.fromkeys(k for cls in SHAPES.values() for k in cls.SCENE_FIELDS))
-    out = []
+    keys = ("shape", "name",
+            *dict.fromkeys(k for cls in SHAPES.values() for k in cls.SCENE_FIELDS))  # fmt: skip
+    out, names = [], []
     for i, t in enumerate(f.tables(doc, "obstacles", "", keys)):
         prefix = join("obstacles", i)
         kind = f.string(t, "shape", prefix, "circle")
         cls = SHAPES.get(kind)
         if cls is None:
             f.fail(join(prefix, "shape"), f"unknown shape {kind!r} (known: {', '.join(SHAPES)})")
-        f.check_keys(t, prefix, ("shape", *cls.SCENE_FIELDS))
+        f.check_keys(t, prefix, ("shape", "name", *cls.SCENE_FIELDS))
+        names.append(f.string(t, "name", prefix) if "name" in t else None)
         values = {key: _value(f, t, prefix, key, what, default)
                   for key, (what, default) in cls.SCENE_FIELDS.items()}  # fmt: skip
         with f.mapped(prefix):
             out.append(cls.from_scene(values, pipe_radius))
-    return ObstacleSet(out)
+    with f.mapped(""):  # a name's error names its field, obstacles[j].name
+        return ObstacleSet(out, names)
 
 
 def _value(f: Fields, t: dict[str, Any], prefix: str, key: str, kind: str, default: Any) -> Any:

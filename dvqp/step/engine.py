@@ -23,12 +23,12 @@ from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState, singular_frame
 from dvqp.limits import Bounds, Constraint, JointPositionLimit, Limit, VelocityDamper
-from dvqp.limits.excess import NO_EXCESS, Excess
+from dvqp.limits.excess import NO_EXCESS, Excess, StartBroken
 from dvqp.objective import Term
 from dvqp.resolution.qp import QPResolver, QPSolver
 from dvqp.resolution.step import Resolver
 from dvqp.step import stages
-from dvqp.step.build import lay_out
+from dvqp.step.build import Block, lay_out
 from dvqp.workspace import as_struct
 
 Array = NDArray[np.float64]
@@ -76,6 +76,8 @@ class Stepper:
                  samples: Mapping[str, np.ndarray] | None = None) -> None:  # fmt: skip
         spec = resolver.spec
         self.robot, self.resolver = robot, resolver
+        self.obstacles = ObstacleSet() if obstacles is None else obstacles
+        """The obstacles the diagnostics measure (their ``labels`` name them)."""
         self.layout, self.arrays = lay_out(robot, radius, resolver, q0, dt, obstacles, samples)
         plan = self.layout.plan
         self.struct = as_struct(self.arrays)
@@ -122,7 +124,7 @@ class Stepper:
 
     def start(self, q0: ArrayLike) -> None:
         """Load the run's start: the limits' floors are ``min(safe, value there)``, the
-        limits that remember motion start at rest, the backends cold.
+        limits that remember motion start at rest, the backends cold, no sample recorded.
 
         Raises
         ------
@@ -137,6 +139,7 @@ class Stepper:
         if not self.load(q0):
             raise self.singular()
         np.minimum(checks.safe, checks.values, out=checks.floor)
+        checks.lowest[:], checks.settled[:], checks.row[0] = np.inf, np.inf, -1
         self.load(q0)  # again, against the floors: the start's excess (and sample)
 
     def singular(self) -> SingularConfigurationError:
@@ -222,20 +225,40 @@ class Stepper:
             return NO_EXCESS
         ratio = over / c.tolerance
         i = int(np.argmax(np.where(np.isnan(ratio), np.inf, ratio)))
-        block = next(b for b in self.layout.blocks if b.start <= i < b.stop)
         broken = not over[i] <= 0.0  # past the floor, or NaN
-        label = block.labels[i - block.start] if broken else ""
-        if broken and id(block.limit) in self.hooks.describes:
-            label = self.hooks.describes[id(block.limit)]()[i - block.start]
-        if block.limit is JointPositionLimit:
-            n = self.robot.n
-            q = float(self.arrays.state.q[(i - block.start) % n])
-            bound = q - over[i] if i - block.start < n else q + over[i]
+        limit, label = self._named(i) if broken else (self._block(i).limit, "")
+        if limit is JointPositionLimit:
+            n, at = self.robot.n, i - self._block(i).start
+            q = float(self.arrays.state.q[at % n])
+            bound = q - over[i] if at < n else q + over[i]
             return Excess(float(over[i]), float(c.tolerance[i]), label, "joint position", "rad",
                           q, float(bound))  # fmt: skip
-        limit = block.limit
         return Excess(float(over[i]), float(c.tolerance[i]), label, limit.quantity, limit.unit,  # type: ignore[attr-defined]
                       float(c.values[i]), float(c.floor[i]))  # fmt: skip
+
+    def start_broken(self) -> tuple[StartBroken, ...]:
+        """The verified values the run's start put below their safe value that a recorded
+        sample (since :meth:`start`) has below it by more than its tolerance."""
+        c = self.arrays.checks
+        found = np.flatnonzero((c.floor < c.safe) & (c.lowest < c.safe - c.tolerance))
+        return tuple(self._start_broken(int(i)) for i in found)
+
+    def _start_broken(self, i: int) -> StartBroken:
+        c, (limit, label) = self.arrays.checks, self._named(i)
+        keys = [k for k in getattr(limit, "SCENE_KEYS", {}) if not k.startswith("damper_")]
+        kind = (("joint room", "rad") if limit is JointPositionLimit
+                else (limit.quantity, limit.unit))  # type: ignore[attr-defined]  # fmt: skip
+        values = (float(a[i]) for a in (c.safe, c.floor, c.lowest, c.tolerance))
+        return StartBroken(keys[0] if keys else limit.name, label, *kind, *values)  # type: ignore[attr-defined]
+
+    def _block(self, i: int) -> Block:
+        return next(b for b in self.layout.blocks if b.start <= i < b.stop)
+
+    def _named(self, i: int) -> tuple[object, str]:
+        """The limit of verified value ``i`` and the value's label."""
+        block = self._block(i)
+        describe = self.hooks.describes.get(id(block.limit))
+        return block.limit, (describe() if describe else block.labels)[i - block.start]
 
     def rows(self, limit: Limit) -> Constraint | Bounds:
         """What ``limit`` put in the problem of the last :meth:`prepare`: its rows that apply

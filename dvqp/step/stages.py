@@ -148,7 +148,8 @@ def _diagnostics(s) -> None:  # type: ignore[no-untyped-def]
 
 @njit(cache=True, inline="always")
 def _sample(s) -> None:  # type: ignore[no-untyped-def]
-    """Row ``s.record.index[0]`` of the trajectory's samples."""
+    """Row ``s.record.index[0]`` of the trajectory's samples, and each verified value's lowest
+    over the samples."""
     r, st, at = s.record, s.state, s.record.index[0]
     for i in range(st.q.shape[0]):
         r.q[at, i] = st.q[i]
@@ -158,10 +159,16 @@ def _sample(s) -> None:  # type: ignore[no-untyped-def]
         for i in range(3):
             r.points[at, p, i] = st.guarded[p, i]
     r.w[at] = s.objective.value[0]
-    excess = s.checks.excess
-    r.limit_excess[at], r.limits_kept[at] = max(excess[0], 0.0), excess[1] <= 1.0
+    c = s.checks
+    r.limit_excess[at], r.limits_kept[at] = max(c.excess[0], 0.0), c.excess[1] <= 1.0
     d = s.diagnostics
     r.tilt[at], r.self_distance[at], r.min_clearance[at], r.probe_clearance[at] = d[:4]
+    if c.row[0] != at:  # a new sample: those before it are final
+        c.row[0] = at
+        for i in range(c.lowest.shape[0]):
+            c.settled[i] = c.lowest[i]
+    for i in range(c.lowest.shape[0]):  # NaN never lowers it (a NaN sample is not kept)
+        c.lowest[i] = c.values[i] if c.values[i] < c.settled[i] else c.settled[i]
 
 
 @njit(cache=True)

@@ -86,13 +86,19 @@ class DamperBuffers:
 class CheckBuffers:
     """The exact values verified after every step (V,): a step keeps its limits while every
     value stays at or above ``floor − tolerance``, ``floor = min(safe, value at the run's
-    start)``; ``excess`` (2,) is ``[floor − value, (floor − value)/tolerance]`` of the worst."""
+    start)``; ``excess`` (2,) is ``[floor − value, (floor − value)/tolerance]`` of the worst.
+    ``lowest`` (V,) is each value's smallest over the recorded samples (``inf`` before any),
+    ``settled`` (V,) the same over the samples before ``row[0]``, the one last written (a
+    sample written again replaces its value)."""
 
     values: Array
     safe: Array
     tolerance: Array
     floor: Array
     excess: Array
+    lowest: Array
+    settled: Array
+    row: NDArray[np.int64]
 
 
 class StepPlan:
@@ -186,7 +192,8 @@ class StepPlan:
         self.dampers = DamperBuffers(np.zeros(d), np.zeros((d, n)), np.zeros(d, dtype=np.bool_))
         joined = lambda parts: np.concatenate(parts) if parts else np.zeros(0)  # noqa: E731
         self.checks = CheckBuffers(np.zeros(v), joined(self._safe), joined(self._tolerance),
-                                   np.zeros(v), np.zeros(2))  # fmt: skip
+                                   np.zeros(v), np.zeros(2), np.full(v, np.inf),
+                                   np.full(v, np.inf), np.full(1, -1, np.int64))  # fmt: skip
 
     def view(self, slot: Slot) -> Array:
         """The rows of the finalised array that ``slot`` names."""
