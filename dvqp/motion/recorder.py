@@ -47,12 +47,25 @@ class TrajectoryRecorder:
         if step.success:
             a["qdot"][k] = step.qdot
 
-    def trajectory(self, dt: float, pipe_radius: float, backend: str) -> Trajectory:
-        """The recorded run (l and α unwrapped), with ``qddot``: the change of joint velocity
-        at the start of each step over dt (the run starts at rest), rad/s²."""
-        qdot = self.arrays["qdot"]
+    def extend(self, steps: int) -> None:
+        """Room for ``steps`` more steps and their samples, those recorded kept (new arrays:
+        hand them to the stepper, :meth:`~dvqp.step.Stepper.record_into`)."""
+        for name, a in self.arrays.items():
+            room = np.zeros((steps, *a.shape[1:]), dtype=a.dtype)
+            self.arrays[name] = np.concatenate([a, room])
+        self.status = np.concatenate([self.status, np.full(steps, "", dtype=object)])
+
+    def trajectory(self, dt: float, pipe_radius: float, backend: str, steps: int | None = None,
+                   brake_start: int = -1) -> Trajectory:  # fmt: skip
+        """The first ``steps`` (default all) recorded steps and their samples (l and α
+        unwrapped), with ``qddot``: the change of joint velocity at the start of each step over
+        dt (the run starts at rest), rad/s²; ``brake_start`` the first braking step (−1: none)."""
+        n = self.arrays["qdot"].shape[0]
+        steps = n if steps is None else steps
+        kept = {name: a[: steps + a.shape[0] - n] for name, a in self.arrays.items()}
+        qdot = kept["qdot"]
         before = np.vstack([np.zeros((1, qdot.shape[1])), qdot[:-1]])
         return Trajectory.from_samples(
-            dt=dt, pipe_radius=pipe_radius, backend=backend, status=self.status,
-            qddot=(qdot - before) / dt, **self.arrays,
+            dt=dt, pipe_radius=pipe_radius, backend=backend, status=self.status[:steps],
+            qddot=(qdot - before) / dt, brake_start=brake_start, **kept,
         )  # fmt: skip

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
@@ -28,6 +29,7 @@ from dvqp.objective import Term
 from dvqp.resolution.qp import QPResolver, QPSolver
 from dvqp.resolution.step import Resolver
 from dvqp.step import stages
+from dvqp.step.arrays import RecordArrays
 from dvqp.step.build import lay_out
 from dvqp.workspace import as_struct
 
@@ -95,6 +97,11 @@ class Stepper:
         self.limits: tuple[Limit, ...] = spec.limits
         self._observers = [lim for lim in spec.limits if type(lim).observe is not Limit.observe
                            and resolver.holds_limits]  # fmt: skip
+        self.stopping = False
+        """Braking steps: the hard tasks' right sides and the cost's linear part are 0 (the
+        tool and every task held still, λ = 0), a damper holds a drift below its safe value
+        instead of pulling it back (right side at least 0), and Q̇ = 0 is taken when it is
+        feasible (:meth:`~dvqp.resolution.qp.QPSolver.solve`)."""
 
     def load(self, q: ArrayLike) -> bool:
         """Evaluate the state at ``q`` (rad); False if a guarded frame is on the pipe axis."""
@@ -174,7 +181,7 @@ class Stepper:
             why = (f"failed: the bounds on joint{status + 1}'s velocity cross "
                    f"({lb:.4g} > {ub:.4g} rad/s)")  # fmt: skip
             return Resolution(False, why, None, 0.0, time.perf_counter() - started)
-        answer = self.solver.solve()
+        answer = self.solver.solve(rest=self.stopping)
         if answer.x is not None:
             self.x[:] = answer.x
         return Resolution(answer.x is not None, answer.status, answer.iterations,
@@ -189,13 +196,17 @@ class Stepper:
             raise ShapeError("command", (4,), np.shape(command))
         a.command[:] = command
         a.dt[0] = dt
-        last = stages.ROWS if hooks.prepared else stages.CLOSE
-        status = int(self._prepare(s, stages.ROWS, last))
+        split = bool(hooks.prepared) or self.stopping
+        status = int(self._prepare(s, stages.ROWS, stages.ROWS if split else stages.CLOSE))
         if status == stages.BAD_COMMAND:
             raise ParameterError("command", "must be finite (no NaN or inf)")
-        if hooks.prepared:
+        if split:
             for hook in hooks.prepared:
                 hook()
+            if self.stopping:
+                a.qp.b[:], a.qp.cost[:] = 0.0, 0.0
+                held = a.qp.h[: a.dampers.distance.shape[0]]  # the damper rows come first
+                np.maximum(held, 0.0, out=held)
             status = int(self._prepare(s, stages.CLOSE, stages.CLOSE))
         return status
 
@@ -207,6 +218,14 @@ class Stepper:
             f"task Jacobian is (nearly) rank deficient (Cholesky pivots from {lo:.3g} to "
             f"{hi:.3g}); use a damped inverse"
         )
+
+    def record_into(self, samples: Mapping[str, np.ndarray]) -> None:
+        """Write the samples of the states concluded from now on into ``samples`` (the
+        recorder's arrays, e.g. grown; :attr:`record_at` stays the same array)."""
+        names = [f for f in RecordArrays.__dataclass_fields__ if f != "index"]
+        record = replace(self.arrays.record, **{f: samples[f] for f in names})
+        self.arrays = replace(self.arrays, record=record)
+        self.struct = as_struct(self.arrays)
 
     def observe(self, qdot: Array, dt: float) -> None:
         """Tell the limits that remember motion (acceleration) the velocity applied."""
