@@ -8,6 +8,7 @@ independent backend agrees that 0 is the last step's answer.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 
@@ -20,8 +21,8 @@ from dvqp import Bounds, Limit, Scene, Trajectory
 from dvqp.cli.report import format_summary
 from dvqp.comparison import summarize
 from dvqp.errors import UnreachableTargetError
-from dvqp.limits import AccelerationLimit
-from dvqp.motion.stop import MARGIN, braking_steps
+from dvqp.limits import AccelerationLimit, JointVelocityLimit
+from dvqp.motion.stop import MARGIN, braking_steps, room
 from dvqp.planning import check_run, scene_commands
 from dvqp.scenes.scene import loads
 from tests.runs import BUNDLED, QP, run, scene
@@ -124,6 +125,29 @@ def test_the_last_braking_step_is_the_qp_answer_of_its_problem_exactly() -> None
     (before, x_before), (last, x_last) = answers
     assert not before and np.abs(x_before - traj.qdot[moving]).max() < 1e-5
     assert last and np.abs(x_last).max() < 1e-7 and not traj.qdot[-1].any()
+
+
+def test_a_stop_longer_than_the_room_reserved_grows_the_record() -> None:
+    """Without a velocity limit nothing bounds the last speed in advance: the stop gets the
+    room of a still arm, and the record grows when the stop needs more; every braking sample
+    is still the state its step reached."""
+    s = fast()
+    spec = s.spec()
+    free = dataclasses.replace(
+        spec, limits=tuple(lim for lim in spec.limits if not isinstance(lim, JointVelocityLimit))
+    )
+    resolver, c = dvqp.QPResolver(free, "daqp"), scene_commands(s)
+    traj = dvqp.simulate(s.robot, s.pipe_radius, resolver, s.q0, c.velocity, s.dt,
+                         obstacles=s.obstacles, reference=c.reference[:-1],
+                         feedback_gain=c.feedback_gain)  # fmt: skip
+    k = traj.brake_start
+    assert traj.n_steps - k > room(s.robot, resolver, s.dt) == math.ceil(MARGIN / s.dt) + 1
+    assert traj.ok and not traj.qdot[-1].any()
+    assert np.all(np.abs(accelerations(traj)) <= qdd_max(s) + 1e-6)
+    np.testing.assert_allclose(traj.q[k + 1 :], traj.q[k:-1] + s.dt * traj.qdot[k:], atol=1e-12)
+    for i in range(k + 1, traj.n_steps + 1):  # written into the grown arrays, at their rows
+        tool = dvqp.KinematicState.compute(s.robot, traj.q[i], s.pipe_radius).tool
+        np.testing.assert_allclose(traj.tool[i], tool, atol=1e-12)
 
 
 class KeepTurning(Limit):

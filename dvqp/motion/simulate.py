@@ -23,7 +23,7 @@ from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.developed_view import wrap, wrap_angle
 from dvqp.kinematics.robot import Robot
 from dvqp.motion.recorder import TrajectoryRecorder
-from dvqp.motion.stop import brake
+from dvqp.motion.stop import brake, room
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.step import Resolver
 from dvqp.step import MAX_HALVINGS, Stepper, advance
@@ -142,7 +142,8 @@ def simulate(
     cmd, ref = _check_commands(commands, reference)
     check = resolver.holds_limits if verify is None else verify
     q_start = robot.check_q(q0, "q0")
-    record = TrajectoryRecorder(cmd.shape[0], robot.n, robot.n_points)
+    reserved = room(robot, resolver, dt) if stop else 0  # the stop's samples, in advance
+    record = TrajectoryRecorder(cmd.shape[0] + reserved, robot.n, robot.n_points)
     with _noticed(notice):
         stepper = Stepper(robot, radius, resolver, q_start, dt, obstacles, record.arrays)
         stepper.start(q_start)

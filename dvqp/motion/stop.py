@@ -4,9 +4,11 @@ The braking steps are ordinary verified steps (:func:`dvqp.step.advance`) of the
 with the tool held still (command 0) and the stepper :attr:`~dvqp.step.Stepper.stopping`: every
 task's right side and the cost's linear part are 0 (λ = 0, no null-space motion), so the QP
 minimises ``½ Q̇ᵀWQ̇`` under every limit of the run — the acceleration limit's box around the
-previous step's velocity among them — and slows the joints as fast as that box allows. Once
-``Q̇ = 0`` is feasible it is the exact minimiser and is taken as it is (exactly 0, no backend):
-the run's last step. The baseline, which holds no limit, stops in one step.
+previous step's velocity among them — and slows the joints as fast as that box allows (a
+damper holds a drift below its safe value rather than pulling it back, which would never end).
+Once ``Q̇ = 0`` is feasible it is the exact minimiser and is taken as it is (exactly 0, no
+backend): the run's last step. The baseline, which holds no limit, stops in one step. The
+stop's samples are reserved with the run's (:func:`room`), so recording it copies nothing.
 
 **The bound.** With ``N = ‖Q̇‖_W`` (``W`` the step's metric, smallest weight ``w``) and the
 slowest joint acceleration ``a`` (``qdd_max``), the previous velocity scaled by ``1 − s``,
@@ -24,9 +26,11 @@ import time
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp.limits import AccelerationLimit
+from dvqp.kinematics.robot import Robot
+from dvqp.limits import AccelerationLimit, JointVelocityLimit
 from dvqp.motion.recorder import TrajectoryRecorder
-from dvqp.resolution.step import Step
+from dvqp.resolution.spec import StepSpec
+from dvqp.resolution.step import Resolver, Step
 from dvqp.step import Advance, Stepper, advance
 
 MARGIN = 0.05
@@ -47,24 +51,40 @@ def braking_steps(qdot: Array, weights: Array, qdd_max: Array | None, dt: float)
     return max(1, math.ceil((bound + MARGIN) / dt))
 
 
+def _qdd_max(spec: StepSpec) -> Array | None:
+    """The spec's joint acceleration limit, rad/s² (n,), or None."""
+    accel = next((lim for lim in spec.limits if isinstance(lim, AccelerationLimit)), None)
+    return None if accel is None else accel.qdd_max
+
+
+def room(robot: Robot, resolver: Resolver, dt: float) -> int:
+    """Steps to reserve for a stop: the bound from the velocity limits (a run that keeps them
+    ends no faster) and the failed step; a stop that needs more grows the recorder then."""
+    spec = resolver.spec
+    limited = resolver.holds_limits and np.all(np.isfinite(robot.qd_max)) and any(
+        isinstance(lim, JointVelocityLimit) for lim in spec.limits)  # fmt: skip
+    fastest = robot.qd_max if limited else np.zeros(robot.n)
+    return braking_steps(fastest, spec.diagonal(robot.n), _qdd_max(spec), dt) + 1
+
+
 def brake(stepper: Stepper, record: TrajectoryRecorder, first: int, dt: float, *,
           verify: bool, max_halvings: int) -> int:  # fmt: skip
     """Brake from the end of step ``first − 1`` until every joint has stopped; the number of
     braking steps recorded (0 if the run ended at rest).
 
-    The recorder is grown by the bound (:func:`braking_steps`) and one step more: a run still
-    moving after the bound gets a failed last step (the arm held still, as every failed step)
-    whose status says ``could not stop within qdd_max in T s`` and names the fastest joint.
+    The stop may take the bound (:func:`braking_steps`) and one step more: a run still moving
+    after the bound gets a failed last step (the arm held still, as every failed step) whose
+    status says ``could not stop within qdd_max in T s`` and names the fastest joint.
     """
     last = record.arrays["qdot"][first - 1].copy() if first else np.zeros(stepper.robot.n)
     if not last.any():
         return 0
     spec = stepper.resolver.spec
-    accel = next((lim for lim in spec.limits if isinstance(lim, AccelerationLimit)), None)
-    qdd_max = None if accel is None else accel.qdd_max
+    qdd_max = _qdd_max(spec)
     bound = braking_steps(last, spec.diagonal(stepper.robot.n), qdd_max, dt)
-    record.extend(bound + 1)
-    stepper.record_into(record.arrays)
+    if record.arrays["qdot"].shape[0] < first + bound + 1:  # beyond the room reserved
+        record.extend(first + bound + 1 - record.arrays["qdot"].shape[0])
+        stepper.record_into(record.arrays)
     still, started = np.zeros(4), time.perf_counter()
     stepper.stopping = True
     try:
