@@ -36,7 +36,8 @@ FIELDS = (
     "ratio_to_pinv", "max_task_error", "min_clearance",
     "closest", "min_probe_clearance", "min_tilt", "min_self_distance", "closest_pair",
     "max_joint_acceleration", "max_limit_excess", "worst_limit", "start_broken",
-    "max_joint_limit_violation", "max_velocity_limit_violation", "final_tracking_error", "error",
+    "max_joint_limit_violation", "max_velocity_limit_violation", "final_tracking_error",
+    "final_joint_speed", "braking_time", "error",
 )  # fmt: skip
 """Keys of a result row, in table / CSV order."""
 
@@ -71,7 +72,9 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
     ``worst_limit``), also of a limit the start broke, which ``start_broken`` names (a line
     per limit of :func:`dvqp.limits.start_broken_lines`, ``"; "``-joined; None if none); the
     largest joint-limit violation (rad) of ``q`` and velocity-limit violation (rad/s) of
-    ``Q̇``; the final tracking error (m) against the commanded motion; ``final_tool``
+    ``Q̇``; the final tracking error (m) against the commanded motion; ``final_joint_speed``,
+    the largest ``|Q̇|`` of the last step that succeeded (rad/s; 0: the run ended at rest), and
+    ``braking_time``, how long the stop at the end took (s; None: not stopped); ``final_tool``
     ``[l, z, h, α]``. Undefined figures are None.
     """
     ok = traj.success
@@ -94,9 +97,17 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
         **_clearances(scene, traj),
         **_limit_figures(scene, traj),
         "final_tracking_error": final_errors(traj)[0] if traj.tracking_error.size else None,
+        "final_joint_speed": final_joint_speed(traj),
+        "braking_time": traj.braking_time,
         "final_tool": [float(v) for v in traj.tool[-1]],
         "error": why,
     }
+
+
+def final_joint_speed(traj: Trajectory) -> float:
+    """The largest ``|Q̇|`` of the run's last step that succeeded, rad/s (0 if none did)."""
+    moved = np.flatnonzero(traj.success)
+    return float(np.abs(traj.qdot[moved[-1]]).max(initial=0.0)) if moved.size else 0.0
 
 
 def _solver_figures(traj: Trajectory) -> Row:

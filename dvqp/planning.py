@@ -80,11 +80,13 @@ def plan(
     limits: Sequence[Limit] = (),
     progress: Callable[[int, int], None] | None = None,
     notice: Callable[[str], None] | None = None,
+    stop: bool = True,
 ) -> Trajectory:
-    """Run a scene with a resolver and return its trajectory.
+    """Run a scene with a resolver and return its trajectory, ended at rest.
 
     The trajectory carries the scene text and ``tracking_error`` (``x_d − x`` per sample,
-    l and α wrapped). A failed run is returned as well; :func:`check_run` says why it failed.
+    l and α wrapped; the braking samples against the motion's end, held). A failed run is
+    returned as well; :func:`check_run` says why it failed.
 
     Parameters
     ----------
@@ -97,6 +99,9 @@ def plan(
     notice
         Called with one line if compiling the step takes long (the first run after
         installing); see :func:`dvqp.motion.simulate.simulate`.
+    stop
+        Brake after the last command (JOG) or the path's end until every joint has stopped
+        (:mod:`dvqp.motion.stop`); False: end with the last command.
 
     Raises
     ------
@@ -110,9 +115,10 @@ def plan(
     traj = simulate(
         scene.robot, scene.pipe_radius, resolver, scene.q0, c.velocity, scene.dt,
         obstacles=scene.obstacles, reference=c.reference[:-1] if c.feedback_gain > 0 else None,
-        feedback_gain=c.feedback_gain, progress=progress, notice=notice,
+        feedback_gain=c.feedback_gain, progress=progress, notice=notice, stop=stop,
     )  # fmt: skip
-    error = dv_error(c.reference, traj.tool, scene.pipe_radius)
+    held = c.reference[-1:].repeat(traj.t.shape[0] - c.reference.shape[0], axis=0)
+    error = dv_error(np.vstack([c.reference, held]), traj.tool, scene.pipe_radius)
     return dataclasses.replace(traj, tracking_error=error, scene_text=scene.text)
 
 

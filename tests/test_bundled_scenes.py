@@ -30,7 +30,8 @@ def tight_rows(s: Scene, traj: Trajectory, tol: float = 1e-6) -> Counter[str]:
     tight: Counter[str] = Counter()
     for k in range(traj.n_steps):
         assert step.load(traj.q[k])
-        step.prepare(commands[k], s.dt)
+        step.stopping = k >= traj.brake_start  # the stop at the end: the tool held still
+        step.prepare(commands[k] if k < traj.brake_start else np.zeros(4), s.dt)
         for limit in limits:
             rows = step.rows(limit)
             assert isinstance(rows, Constraint)

@@ -61,19 +61,21 @@ def test_plan_writes_the_trajectory_and_prints_a_summary(
     assert main(["plan", scene, "--backend", "pinv", "-o", str(out)]) == 0
     captured = capsys.readouterr()
     labels = [
-        "steps           20: 20 optimal, 0 relaxed, 0 failed",
+        "steps           21: 21 optimal, 0 relaxed, 0 failed",
         "result          safe to send: every limit kept",
         "max task error",
         "min clearance",
         "step time       median",
         "final tool DV   l = 0.3023 m",
+        "end             at rest after 0.005 s of braking (1 step)",
         f"saved           {out}",
     ]
     for label in labels:
         assert label in captured.out
     assert captured.err == ""
     traj = Trajectory.load(out)
-    assert traj.n_steps == 20 and traj.backend == "pinv" and "small" in traj.scene_text
+    assert traj.n_steps == 21 and traj.backend == "pinv" and "small" in traj.scene_text
+    assert traj.brake_start == 20 and not traj.qdot[-1].any()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml", "traj.npz"]
 
 
@@ -81,7 +83,7 @@ def test_plan_writes_csv_by_suffix(tmp_path: Path, capsys: pytest.CaptureFixture
     out = tmp_path / "traj.csv"
     assert main(["plan", write_scene(tmp_path), "--backend", "pinv", "-o", str(out)]) == 0
     table = np.loadtxt(out, delimiter=",", skiprows=1)
-    assert table.shape == (21, 1 + 13 + 13 + 4 + 4)  # t, q, qdot, tool, tracking error
+    assert table.shape == (22, 1 + 13 + 13 + 4 + 4)  # t, q, qdot, tool, tracking error
 
 
 @pytest.mark.parametrize(
@@ -129,7 +131,8 @@ def test_plan_of_an_unreachable_path_exits_1_with_one_line(
     captured = capsys.readouterr()
     lines = captured.err.splitlines()
     assert len(lines) == 1 and no_traceback(captured.err)
-    assert lines[0].startswith(f"dvqp: {scene}: daqp: target not reached at t = 0.215 s: ")
+    # the path ends at 0.215 s, at 1.5 rad/s: the stop takes 43 steps, the tool held first
+    assert lines[0].startswith(f"dvqp: {scene}: daqp: target not reached at t = 0.430 s: ")
     assert out.exists()  # the failed run is kept, to look at
     assert "final deviation" in captured.out
 
@@ -151,10 +154,10 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
                                 "err", "clearance", "m", "closest", "self", "m",
                                 "qdd", "excess", "q",
                                 "viol", "rad", "qd", "viol", "rad/s", "relaxed", "split",
-                                "fails"]  # fmt: skip
+                                "fails", "end", "qd", "brake", "s"]  # fmt: skip
     assert [line.split()[:4] for line in lines[2:6]] == [
-        ["one", "pinv", "yes", "20"], ["one", "daqp", "yes", "20"],
-        ["two", "pinv", "yes", "20"], ["two", "daqp", "yes", "20"],
+        ["one", "pinv", "yes", "21"], ["one", "daqp", "yes", "23"],
+        ["two", "pinv", "yes", "21"], ["two", "daqp", "yes", "23"],
     ]  # fmt: skip
     assert no_traceback(captured.err)
     doc = json.loads(js.read_text(encoding="utf-8"), parse_constant=pytest.fail)  # no NaN/inf
@@ -162,12 +165,15 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
     assert {"dvqp", "numpy", "pinocchio", "daqp"} <= set(doc["versions"])
     assert doc["backends"] == ["pinv", "daqp"] and len(doc["results"]) == 4
     first = doc["results"][0]
-    assert first["ratio_to_pinv"] == 1.0 and first["success"] is True and first["steps"] == 20
+    assert first["ratio_to_pinv"] == 1.0 and first["success"] is True and first["steps"] == 21
     keys = ["median_step_us", "p95_step_us", "max_task_error", "min_clearance",
             "min_probe_clearance", "min_tilt", "max_limit_excess", "max_joint_limit_violation",
-            "max_velocity_limit_violation", "failures", "relaxed", "substepped"]  # fmt: skip
+            "max_velocity_limit_violation", "failures", "relaxed", "substepped",
+            "braking_time"]  # fmt: skip
     for key in keys:
         assert isinstance(first[key], (int, float)), key
+    assert [r["final_joint_speed"] for r in doc["results"]] == [0.0] * 4  # every run at rest
+    assert [r["braking_time"] for r in doc["results"]] == pytest.approx([0.005, 0.015] * 2)
     header = cs.read_text(encoding="utf-8").splitlines()[0].split(",")
     assert header[:3] == ["scene", "file", "backend"] and "ratio_to_pinv" in header
 

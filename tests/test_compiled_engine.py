@@ -37,12 +37,16 @@ from tests.runs import BUNDLED, run, scene
 
 
 def commands(s: dvqp.Scene, traj: dvqp.Trajectory) -> np.ndarray:
-    """The tool command of every step, with the position feedback of a path, (N, 4)."""
+    """The tool command of every step, with the position feedback of a path, (N, 4): the
+    braking steps at the end (from ``traj.brake_start``) hold the tool still (0)."""
     c = scene_commands(s)
+    given = c.velocity.shape[0]
+    assert traj.brake_start == given
+    still = np.zeros((traj.n_steps - given, 4))
     if c.feedback_gain == 0.0:
-        return c.velocity  # type: ignore[no-any-return]
-    error = dv_error(c.reference[:-1], traj.tool[:-1], s.pipe_radius)
-    return c.velocity + c.feedback_gain * error  # type: ignore[no-any-return]
+        return np.vstack([c.velocity, still])
+    error = dv_error(c.reference[:-1], traj.tool[:given], s.pipe_radius)
+    return np.vstack([c.velocity + c.feedback_gain * error, still])
 
 
 def checked_samples(traj: dvqp.Trajectory) -> list[int]:
@@ -110,7 +114,8 @@ def test_the_task_error_of_every_step_is_measured_on_the_motion(name: str, backe
 def test_every_answer_of_the_qp_is_optimal_for_the_problem_of_its_step(name: str) -> None:
     """At each step's state: the problem the step writes, and its answer certified: eq. 18
     where no inequality is active, else the KKT conditions (strict, or relaxed with the task
-    weight ρ); braking is the velocity closest to rest in the box."""
+    weight ρ); braking is the velocity closest to rest in the box. The stop at the end has no
+    objective (λ = 0) and holds the tool still, its last step exactly at rest."""
     s, traj = scene(name), run(name, "daqp")
     spec = s.spec()
     step = Stepper(s.robot, s.pipe_radius, QPResolver(spec, "daqp"), s.q0, s.dt)
@@ -119,9 +124,10 @@ def test_every_answer_of_the_qp_is_optimal_for_the_problem_of_its_step(name: str
     free = 0
     for k in np.flatnonzero(traj.success & (traj.substeps == 1)):
         step.observe(traj.qdot[k - 1] if k else np.zeros(s.robot.n), s.dt)  # the velocity so far
+        step.stopping = k >= traj.brake_start
         assert step.load(traj.q[k]) and step.prepare(xdot[k], s.dt) == -1
         p, x, status = step.problem(), traj.qdot[k], traj.status[k]
-        g = spec.objective.gain * step.objective.gradient
+        g = (0.0 if step.stopping else spec.objective.gain) * step.objective.gradient
         np.testing.assert_array_equal(p.b, xdot[k])
         np.testing.assert_array_equal(p.q, -g)
         np.testing.assert_array_equal(p.P, np.diag(weights))
@@ -141,6 +147,7 @@ def test_every_answer_of_the_qp_is_optimal_for_the_problem_of_its_step(name: str
             expected = eq18(p.A, p.b, g, weights)
             np.testing.assert_allclose(x, expected, rtol=0, atol=1e-9 * max(1.0, np.abs(x).max()))
     assert free > 0  # eq. 18 was met as well as the active rows
+    assert not traj.qdot[-1].any() and traj.status[-1] == "optimal"  # at rest, exactly
 
 
 @pytest.mark.parametrize(("name", "spread"), [("pipe-rack", 0.3), ("fold", 0.8),

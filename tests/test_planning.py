@@ -84,7 +84,8 @@ def test_a_jog_plan_tracks_its_commands_and_carries_the_scene() -> None:
     s = scene()
     traj = plan(s, "pinv")
     assert traj.ok and traj.backend == "pinv" and traj.scene_text == s.text
-    assert traj.tracking_error.shape == (31, 4)
+    assert traj.brake_start == 30 and traj.n_steps == 31  # the baseline stops in one step
+    assert traj.tracking_error.shape == (32, 4)  # the stop against the motion's end, held
     assert np.abs(traj.tracking_error[:, :3]).max() < 2e-4  # Euler drift only
     check_run(s, traj)
 
@@ -166,7 +167,7 @@ def test_failed_steps_are_reported_with_the_first_time() -> None:
         check_run(s, dataclasses.replace(traj, success=success, status=status))
     why = info.value
     assert str(why) == (
-        f"small.toml: pinv: 2 of 30 steps failed, first at t = {traj.t[7]:.3f} s "
+        f"small.toml: pinv: 2 of 31 steps failed, first at t = {traj.t[7]:.3f} s "
         "(failed: solver gave up)"
     )
     assert why.step == 7

@@ -204,8 +204,9 @@ def test_an_infeasible_command_is_relaxed_with_a_reported_task_error(
     spec = paper_spec(robot, objective_with([]), ObstacleSet(), 0.0)
     cmd = jog_commands([JogSegment(0.1, np.array([2.0, 0.0, 0.0, 0.0]))], DT)  # 2 m/s: too fast
     traj = run(robot, PIPE_RADIUS, QPResolver(spec, backend), q0, cmd, DT)
-    assert traj.ok and set(traj.status) == {"relaxed"}
-    assert traj.task_error.min() > 0.1
+    commanded = slice(0, traj.brake_start)  # then the stop: the tool held still
+    assert traj.ok and set(traj.status[commanded]) == {"relaxed"}
+    assert traj.task_error[commanded].min() > 0.1
     assert np.all(np.abs(traj.qdot) <= robot.qd_max + 1e-6)  # solver tolerance
 
 

@@ -2,7 +2,8 @@
 
 ``tests/data/reference_runs.npz`` holds the joint trajectories, objective values, clearances,
 task errors and statuses of each bundled scene on the baseline and on the two exact active-set
-backends, written by ``tests/data/make_reference_runs.py`` at commit 4a597ea.
+backends, written by ``tests/data/make_reference_runs.py`` at commit 4a597ea and rewritten on
+purpose since (see there): each run now ends with its braking steps, at rest.
 """
 
 from __future__ import annotations

@@ -100,10 +100,12 @@ def test_the_safety_diagnostics_round_trip_and_old_files_still_load(tmp_path: Pa
         limit_excess=np.array([0.0, 2e-5, 0.0, 0.0]),
         limits_kept=np.ones(n, dtype=bool),
         substeps=np.array([1, 4, 1], dtype=np.int64),
+        brake_start=2,
     )
     back = Trajectory.load(full.save(tmp_path / "new.npz"))
     for name in ("probe_clearance", "tilt", "limit_excess", "limits_kept", "substeps"):
         np.testing.assert_array_equal(getattr(back, name), getattr(full, name))
+    assert back.brake_start == 2 and back.braking_time == pytest.approx(0.01)  # the last step
     # a file written before 0.2: "dv" for the tool, no diagnostics
     arrays = {name: getattr(traj, name) for name in ("t", "q", "qdot", "points", "w",
               "min_clearance", "solve_time", "step_time", "task_error", "iterations",
@@ -113,3 +115,4 @@ def test_the_safety_diagnostics_round_trip_and_old_files_still_load(tmp_path: Pa
     loaded = Trajectory.load(old)
     np.testing.assert_array_equal(loaded.tool, traj.tool)
     assert loaded.limits_kept.shape == (0,) and loaded.substeps.shape == (0,)
+    assert loaded.brake_start == -1 and loaded.braking_time is None  # not known to be stopped

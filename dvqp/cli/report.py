@@ -30,6 +30,7 @@ TABLE = (  # (row key, header, format)
     ("max_joint_limit_violation", "q viol rad", "{:.3g}"),
     ("max_velocity_limit_violation", "qd viol rad/s", "{:.3g}"), ("relaxed", "relaxed", "{}"),
     ("substepped", "split", "{}"), ("failures", "fails", "{}"),
+    ("final_joint_speed", "end qd", "{:.3g}"), ("braking_time", "brake s", "{:.3f}"),
 )  # fmt: skip
 """Columns of :func:`format_table`: (row key, header, format of a defined value)."""
 
@@ -66,6 +67,7 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         f"final tool DV   l = {tool[0]:.4f} m, z = {tool[1]:.4f} m, h = {tool[2]:.4f} m, "
         f"alpha = {tool[3]:.4f} rad",
     ]
+    lines.append(f"end             {_end(traj, row)}")
     if row["final_tracking_error"] is not None:
         lines.append(
             f"final deviation {row['final_tracking_error'] * 1e3:.3g} mm from the commanded motion"
@@ -105,6 +107,17 @@ def _limits(row: Row, traj: Trajectory) -> str:
         lines = ["every limit kept" + (f" to its tolerance (deepest: {worst})"
                                        if row["worst_limit"] else "")]  # fmt: skip
     return "\n                ".join(lines)
+
+
+def _end(traj: Trajectory, row: Row) -> str:
+    """``at rest after 0.025 s of braking (5 steps)``, or the final joint speed."""
+    speed, time = row["final_joint_speed"], row["braking_time"]
+    if time is None:
+        return f"not stopped: final joint speed {speed:.3g} rad/s"
+    if speed == 0.0:
+        steps = traj.n_steps - traj.brake_start
+        return f"at rest after {time:.3f} s of braking ({steps} step{'s' * (steps != 1)})"
+    return f"NOT at rest: final joint speed {speed:.3g} rad/s after {time:.3f} s of braking"
 
 
 def write_text(path: Path, text: str) -> None:

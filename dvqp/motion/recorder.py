@@ -48,14 +48,28 @@ class TrajectoryRecorder:
         if step.success:
             a["qdot"][k] = step.qdot
 
-    def trajectory(self, dt: float, pipe_radius: float, backend: str,
+    def extend(self, steps: int) -> None:
+        """Room for ``steps`` more steps and their samples, those recorded kept (new arrays:
+        hand them to the stepper, :meth:`~dvqp.step.Stepper.record_into`)."""
+        for name, a in self.arrays.items():
+            room = np.zeros((steps, *a.shape[1:]), dtype=a.dtype)
+            self.arrays[name] = np.concatenate([a, room])
+        self.status = np.concatenate([self.status, np.full(steps, "", dtype=object)])
+
+    def trajectory(self, dt: float, pipe_radius: float, backend: str, steps: int | None = None,
+                   brake_start: int = -1,
                    start_broken: tuple[StartBroken, ...] = ()) -> Trajectory:  # fmt: skip
-        """The recorded run (l and α unwrapped), with ``qddot``: the change of joint velocity
-        at the start of each step over dt (the run starts at rest), rad/s²; and the limits
-        the start broke (:meth:`dvqp.step.Stepper.start_broken`)."""
-        qdot = self.arrays["qdot"]
+        """The first ``steps`` (default all) recorded steps and their samples (l and α
+        unwrapped), with ``qddot``: the change of joint velocity at the start of each step over
+        dt (the run starts at rest), rad/s²; ``brake_start`` the first braking step (−1: none);
+        the limits the start broke (:meth:`dvqp.step.Stepper.start_broken`)."""
+        n = self.arrays["qdot"].shape[0]
+        steps = n if steps is None else steps
+        kept = {name: a[: steps + a.shape[0] - n] for name, a in self.arrays.items()}
+        qdot = kept["qdot"]
         before = np.vstack([np.zeros((1, qdot.shape[1])), qdot[:-1]])
         return Trajectory.from_samples(
-            dt=dt, pipe_radius=pipe_radius, backend=backend, status=self.status,
-            qddot=(qdot - before) / dt, start_broken=start_broken, **self.arrays,
+            dt=dt, pipe_radius=pipe_radius, backend=backend, status=self.status[:steps],
+            qddot=(qdot - before) / dt, brake_start=brake_start, start_broken=start_broken,
+            **kept,
         )  # fmt: skip

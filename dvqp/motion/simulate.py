@@ -23,6 +23,7 @@ from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.developed_view import wrap, wrap_angle
 from dvqp.kinematics.robot import Robot
 from dvqp.motion.recorder import TrajectoryRecorder
+from dvqp.motion.stop import brake, room
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.step import Resolver
 from dvqp.step import MAX_HALVINGS, Stepper, advance
@@ -92,6 +93,7 @@ def simulate(
     max_halvings: int = MAX_HALVINGS,
     progress: Callable[[int, int], None] | None = None,
     notice: Callable[[str], None] | None = None,
+    stop: bool = True,
 ) -> Trajectory:
     """Run the commands from ``q0`` and return the trajectory.
 
@@ -123,6 +125,10 @@ def simulate(
         Called with one line (e.g. for a progress bar) if compiling the step takes longer than
         :data:`COMPILE_NOTICE_SECONDS` (the first run after installing dvqp compiles it; later
         runs load it from numba's cache), and once more when compiling is done.
+    stop
+        After the last command, brake until every joint has stopped (:mod:`dvqp.motion.stop`):
+        the run ends at rest, ``qdot[-1] == 0`` exactly, and ``brake_start`` is the first
+        braking step. False: end after the last command (e.g. to chain runs).
 
     Notes
     -----
@@ -136,7 +142,8 @@ def simulate(
     cmd, ref = _check_commands(commands, reference)
     check = resolver.holds_limits if verify is None else verify
     q_start = robot.check_q(q0, "q0")
-    record = TrajectoryRecorder(cmd.shape[0], robot.n, robot.n_points)
+    reserved = room(robot, resolver, dt) if stop else 0  # the stop's samples, in advance
+    record = TrajectoryRecorder(cmd.shape[0] + reserved, robot.n, robot.n_points)
     with _noticed(notice):
         stepper = Stepper(robot, radius, resolver, q_start, dt, obstacles, record.arrays)
         stepper.start(q_start)
@@ -156,4 +163,9 @@ def simulate(
         started = now
         if progress is not None:
             progress(i + 1, cmd.shape[0])
-    return record.trajectory(dt, radius, resolver.name, stepper.start_broken())
+    if not stop:
+        return record.trajectory(dt, radius, resolver.name, cmd.shape[0],
+                                 start_broken=stepper.start_broken())  # fmt: skip
+    steps = brake(stepper, record, cmd.shape[0], dt, verify=check, max_halvings=max_halvings)
+    return record.trajectory(dt, radius, resolver.name, cmd.shape[0] + steps, cmd.shape[0],
+                             stepper.start_broken())  # fmt: skip

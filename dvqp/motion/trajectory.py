@@ -95,6 +95,10 @@ class Trajectory:
         value) that the samples break against their true bound: each value, its bound, its
         value at the start and its lowest (empty: none; files written before it was added
         load with none).
+    brake_start : int
+        The first step of the stop that ends the run at rest (steps ``brake_start..N−1`` brake,
+        with the tool held still; ``N`` if the run needed none): −1 if the run was not stopped
+        (``stop=False``, or a file written before runs were stopped).
     """
 
     t: NDArray[np.float64]
@@ -123,6 +127,7 @@ class Trajectory:
     qddot: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 0)))
     solver_time: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     start_broken: tuple[StartBroken, ...] = ()
+    brake_start: int = -1
 
     @classmethod
     def from_samples(
@@ -166,6 +171,14 @@ class Trajectory:
         return int(self.qdot.shape[0])
 
     @property
+    def braking_time(self) -> float | None:
+        """How long the stop at the end took, s (None: the run was not stopped)."""
+        if self.brake_start < 0:
+            return None
+        steps = self.n_steps - self.brake_start
+        return float(steps * self.t[1]) if steps else 0.0  # t[1] is dt
+
+    @property
     def ok(self) -> bool:
         """Every step succeeded."""
         return bool(np.all(self.success))
@@ -192,6 +205,7 @@ class Trajectory:
                     scene=np.str_(self.scene_text),
                     tracking_error=self.tracking_error,
                     start_broken=np.str_(json.dumps([asdict(b) for b in self.start_broken])),
+                    brake_start=np.int64(self.brake_start),
                     meta=np.str_(json.dumps({"versions": versions(), **CONVENTIONS})),
                 )
             else:
@@ -228,6 +242,7 @@ class Trajectory:
                     backend=str(data["backend"]),
                     pipe_radius=float(data["pipe_radius"]),
                     scene_text=str(data["scene"]),
+                    brake_start=int(data["brake_start"]) if "brake_start" in data else -1,
                 )
         except OSError as exc:
             reason = exc.strerror or type(exc).__name__

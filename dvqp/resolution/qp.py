@@ -116,8 +116,17 @@ class QPSolver:
         )  # fmt: skip
         self.backends = factory(), factory()
 
-    def solve(self) -> Answer:
-        """Strict, else relaxed, else braking (``x`` a view, valid until the next solve)."""
+    def solve(self, rest: bool = False) -> Answer:
+        """Strict, else relaxed, else braking (``x`` a view, valid until the next solve).
+
+        ``rest``: a step of a stop, whose cost has no linear part and whose tasks ask for no
+        motion (``b = 0``). If ``Q̇ = 0`` is then feasible (every ``lb ≤ 0 ≤ ub``, ``h ≥ 0``)
+        it is the exact minimiser of ``½ Q̇ᵀPQ̇`` (``P`` positive definite), taken without a
+        backend: a backend's answer would be 0 only to its tolerance.
+        """
+        qp = self.qp
+        if rest and not (np.any(qp.lb > 0.0) or np.any(qp.ub < 0.0) or np.any(qp.h < 0.0)):
+            return Answer(np.zeros_like(qp.cost), "optimal", 0, 0.0)
         strict, relaxed = self.backends
         solution = strict.solve(self.strict)
         spent, status = solution.solver_time, "optimal"
@@ -126,8 +135,7 @@ class QPSolver:
             solution = relaxed.solve(self.relaxed)
             spent, status = spent + solution.solver_time, "relaxed"
         if solution.found and solution.x is not None:
-            return Answer(solution.x[: self.qp.cost.shape[0]], status, solution.iterations, spent)
-        qp = self.qp
+            return Answer(solution.x[: qp.cost.shape[0]], status, solution.iterations, spent)
         if np.any(qp.lb > qp.ub):
             return Answer(None, f"failed: {solution.message}", solution.iterations, spent)
         return Answer(np.clip(0.0, qp.lb, qp.ub), "braking", solution.iterations, spent)

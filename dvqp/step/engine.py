@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
@@ -22,13 +23,14 @@ from dvqp.errors import ParameterError, ShapeError, SingularConfigurationError
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState, singular_frame
-from dvqp.limits import Bounds, Constraint, JointPositionLimit, Limit, VelocityDamper
-from dvqp.limits.excess import NO_EXCESS, Excess, StartBroken
+from dvqp.limits import Bounds, Constraint, Limit, VelocityDamper
 from dvqp.objective import Term
 from dvqp.resolution.qp import QPResolver, QPSolver
 from dvqp.resolution.step import Resolver
 from dvqp.step import stages
-from dvqp.step.build import Block, lay_out
+from dvqp.step.arrays import RecordArrays
+from dvqp.step.build import lay_out
+from dvqp.step.verification import Verification
 from dvqp.workspace import as_struct
 
 Array = NDArray[np.float64]
@@ -46,7 +48,7 @@ class Resolution(NamedTuple):
     solve_time: float
 
 
-class Stepper:
+class Stepper(Verification):
     """The compiled step of ``resolver`` on ``robot`` in a pipe of ``radius`` (m).
 
     Parameters
@@ -97,6 +99,11 @@ class Stepper:
         self.limits: tuple[Limit, ...] = spec.limits
         self._observers = [lim for lim in spec.limits if type(lim).observe is not Limit.observe
                            and resolver.holds_limits]  # fmt: skip
+        self.stopping = False
+        """Braking steps: the hard tasks' right sides and the cost's linear part are 0 (the
+        tool and every task held still, λ = 0), a damper holds a drift below its safe value
+        instead of pulling it back (right side at least 0), and Q̇ = 0 is taken when it is
+        feasible (:meth:`~dvqp.resolution.qp.QPSolver.solve`)."""
 
     def load(self, q: ArrayLike) -> bool:
         """Evaluate the state at ``q`` (rad); False if a guarded frame is on the pipe axis."""
@@ -177,7 +184,7 @@ class Stepper:
             why = (f"failed: the bounds on joint{status + 1}'s velocity cross "
                    f"({lb:.4g} > {ub:.4g} rad/s)")  # fmt: skip
             return Resolution(False, why, None, 0.0, time.perf_counter() - started)
-        answer = self.solver.solve()
+        answer = self.solver.solve(rest=self.stopping)
         if answer.x is not None:
             self.x[:] = answer.x
         return Resolution(answer.x is not None, answer.status, answer.iterations,
@@ -192,13 +199,17 @@ class Stepper:
             raise ShapeError("command", (4,), np.shape(command))
         a.command[:] = command
         a.dt[0] = dt
-        last = stages.ROWS if hooks.prepared else stages.CLOSE
-        status = int(self._prepare(s, stages.ROWS, last))
+        split = bool(hooks.prepared) or self.stopping
+        status = int(self._prepare(s, stages.ROWS, stages.ROWS if split else stages.CLOSE))
         if status == stages.BAD_COMMAND:
             raise ParameterError("command", "must be finite (no NaN or inf)")
-        if hooks.prepared:
+        if split:
             for hook in hooks.prepared:
                 hook()
+            if self.stopping:
+                a.qp.b[:], a.qp.cost[:] = 0.0, 0.0
+                held = a.qp.h[: a.dampers.distance.shape[0]]  # the damper rows come first
+                np.maximum(held, 0.0, out=held)
             status = int(self._prepare(s, stages.CLOSE, stages.CLOSE))
         return status
 
@@ -211,54 +222,18 @@ class Stepper:
             f"{hi:.3g}); use a damped inverse"
         )
 
+    def record_into(self, samples: Mapping[str, np.ndarray]) -> None:
+        """Write the samples of the states concluded from now on into ``samples`` (the
+        recorder's arrays, e.g. grown; :attr:`record_at` stays the same array)."""
+        names = [f for f in RecordArrays.__dataclass_fields__ if f != "index"]
+        record = replace(self.arrays.record, **{f: samples[f] for f in names})
+        self.arrays = replace(self.arrays, record=record)
+        self.struct = as_struct(self.arrays)
+
     def observe(self, qdot: Array, dt: float) -> None:
         """Tell the limits that remember motion (acceleration) the velocity applied."""
         for limit in self._observers:
             limit.observe(qdot, dt)
-
-    def excess(self) -> Excess:
-        """The worst excess of the loaded state, named (:data:`~dvqp.limits.NO_EXCESS` with
-        nothing to verify)."""
-        c = self.arrays.checks
-        over = c.floor - c.values
-        if over.shape[0] == 0:
-            return NO_EXCESS
-        ratio = over / c.tolerance
-        i = int(np.argmax(np.where(np.isnan(ratio), np.inf, ratio)))
-        broken = not over[i] <= 0.0  # past the floor, or NaN
-        limit, label = self._named(i) if broken else (self._block(i).limit, "")
-        if limit is JointPositionLimit:
-            n, at = self.robot.n, i - self._block(i).start
-            q = float(self.arrays.state.q[at % n])
-            bound = q - over[i] if at < n else q + over[i]
-            return Excess(float(over[i]), float(c.tolerance[i]), label, "joint position", "rad",
-                          q, float(bound))  # fmt: skip
-        return Excess(float(over[i]), float(c.tolerance[i]), label, limit.quantity, limit.unit,  # type: ignore[attr-defined]
-                      float(c.values[i]), float(c.floor[i]))  # fmt: skip
-
-    def start_broken(self) -> tuple[StartBroken, ...]:
-        """The verified values the run's start put below their safe value that a recorded
-        sample (since :meth:`start`) has below it by more than its tolerance."""
-        c = self.arrays.checks
-        found = np.flatnonzero((c.floor < c.safe) & (c.lowest < c.safe - c.tolerance))
-        return tuple(self._start_broken(int(i)) for i in found)
-
-    def _start_broken(self, i: int) -> StartBroken:
-        c, (limit, label) = self.arrays.checks, self._named(i)
-        keys = [k for k in getattr(limit, "SCENE_KEYS", {}) if not k.startswith("damper_")]
-        kind = (("joint room", "rad") if limit is JointPositionLimit
-                else (limit.quantity, limit.unit))  # type: ignore[attr-defined]  # fmt: skip
-        values = (float(a[i]) for a in (c.safe, c.floor, c.lowest, c.tolerance))
-        return StartBroken(keys[0] if keys else limit.name, label, *kind, *values)  # type: ignore[attr-defined]
-
-    def _block(self, i: int) -> Block:
-        return next(b for b in self.layout.blocks if b.start <= i < b.stop)
-
-    def _named(self, i: int) -> tuple[object, str]:
-        """The limit of verified value ``i`` and the value's label."""
-        block = self._block(i)
-        describe = self.hooks.describes.get(id(block.limit))
-        return block.limit, (describe() if describe else block.labels)[i - block.start]
 
     def rows(self, limit: Limit) -> Constraint | Bounds:
         """What ``limit`` put in the problem of the last :meth:`prepare`: its rows that apply
