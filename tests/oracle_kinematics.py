@@ -101,7 +101,8 @@ def reference(robot: Robot, q: ArrayLike, radius: float) -> dict[str, Array]:
     origins, axes, jac = pinocchio_frames(robot, q)
     guarded = dv_position(origins, radius)
     rows = dv_rows(origins, jac[:, :3], radius)
-    alpha, _ = heading(origins[-1], axes[-1])
+    t = robot.n_points  # the tool's frame: after the body points (the rail point, if any, last)
+    alpha, _ = heading(origins[t], axes[t])
     return {
         "q": np.asarray(q, dtype=np.float64),
         "origins": origins,
@@ -109,10 +110,10 @@ def reference(robot: Robot, q: ArrayLike, radius: float) -> dict[str, Array]:
         "frame_jacobians": jac,
         "guarded": guarded,
         "guarded_jacobians": rows,
-        "points": guarded[:-1],
-        "point_jacobians": rows[:-1],
-        "tool": np.append(guarded[-1], alpha),
-        "tool_jacobian": np.vstack([rows[-1], heading_row(origins[-1], axes[-1], jac[-1])]),
+        "points": guarded[:t],
+        "point_jacobians": rows[:t],
+        "tool": np.append(guarded[t], alpha),
+        "tool_jacobian": np.vstack([rows[t], heading_row(origins[t], axes[t], jac[t])]),
     }
 
 

@@ -119,28 +119,47 @@ def segment_distance(a: Array, b: Array, c: Array, d: Array) -> tuple[Array, Arr
     return ends.min(axis=0), np.choose(best, [np.zeros_like(s), np.ones_like(s), s])
 
 
-def link_pairs(k: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """The non-adjacent pairs ``(i, j)``, ``j ≥ i + 2``, among k guarded links, listed."""
-    pairs = [(i, j) for i in range(k) for j in range(i + 2, k)]
+def guarded_links(k: int, rail: bool) -> Array:
+    """The guarded links as point indices, written out: body links ``i → i+1``, the holder
+    ``k−1 → k`` (last body point to the probe), the carriage ``k+1 → 0`` (rail point to body
+    point 1)."""
+    body = [(i, i + 1) for i in range(k - 1)]
+    return np.array([*body, (k - 1, k), *([(k + 1, 0)] if rail else [])], np.int64)
+
+
+def link_pairs(k: int, rail: bool = False) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The pairs ``(i, j)``, ``i < j``, of guarded links with no point in common, listed."""
+    ends = guarded_links(k, rail)
+    pairs = [(i, j) for i in range(len(ends)) for j in range(i + 1, len(ends))
+             if len({*ends[i], *ends[j]}) == 4]  # fmt: skip
     return np.array([p[0] for p in pairs], np.int64), np.array([p[1] for p in pairs], np.int64)
 
 
 def link_name(i: int, k: int) -> str:
-    """``"link3"``, or ``"holder"`` for the last guarded link."""
-    return "holder" if i == k - 1 else f"link{i + 1}"
+    """``"link3"``; ``"holder"`` for guarded link k−1, ``"carriage"`` for k."""
+    return {k - 1: "holder", k: "carriage"}.get(i, f"link{i + 1}")
 
 
-def self_distances(origins: Array) -> Array:
-    """Brute-force distances of every non-adjacent pair of the chain ``origins`` (k+1, 3)."""
-    i, j = link_pairs(origins.shape[0] - 1)
+def point_name(i: int, k: int) -> str:
+    """``"point3"``; ``"probe"`` for guarded point k, ``"rail"`` for k+1."""
+    return {k: "probe", k + 1: "rail"}.get(i, f"point{i + 1}")
+
+
+def self_distances(origins: Array, k: int) -> Array:
+    """Brute-force distances of every pair of guarded links with no common point, from the
+    guarded frames' ``origins`` (m, 3) of an arm with k body points."""
     o = np.asarray(origins, dtype=float)
-    return segment_distance(o[i], o[i + 1], o[j], o[j + 1])[0]
+    rail = o.shape[0] > k + 1
+    ends = guarded_links(k, rail)
+    i, j = link_pairs(k, rail)
+    return segment_distance(o[ends[i, 0]], o[ends[i, 1]], o[ends[j, 0]], o[ends[j, 1]])[0]
 
 
 def tilt_cosine(state: KinematicState) -> tuple[float, Array]:
     """``u = cos θ`` of the probe axis to the radial direction and ``∂u/∂Q`` (the old NumPy
     formula: ``(a × r̂)ᵀ J_ω + aᵀ (P − r̂ r̂ᵀ) J_v / ρ``)."""
-    origin, axis, jac = state.origins[-1], state.axes[-1], state.frame_jacobians[-1]
+    t = state.k
+    origin, axis, jac = state.origins[t], state.axes[t], state.frame_jacobians[t]
     rho = math.hypot(origin[0], origin[1])
     rx, ry = origin[0] / rho, origin[1] / rho
     ax, ay, az = axis.tolist()
@@ -152,15 +171,15 @@ def tilt_cosine(state: KinematicState) -> tuple[float, Array]:
 
 def tilt(state: KinematicState) -> float:
     """θ, rad in [0, π]: the angle between the probe's axis and the radial direction at the
-    tool, from the last frame."""
-    o, a = state.origins[-1], state.axes[-1]
+    tool (guarded frame k)."""
+    o, a = state.origins[state.k], state.axes[state.k]
     radial = np.array([o[0], o[1], 0.0]) / math.hypot(o[0], o[1])
     return math.acos(max(-1.0, min(1.0, float(a @ radial))))
 
 
 def tilt_sine(state: KinematicState) -> float:
     """``sin θ``: the length of the probe axis' projection on the pipe's tangent plane."""
-    o, a = state.origins[-1], state.axes[-1]
+    o, a = state.origins[state.k], state.axes[state.k]
     u = (a[0] * o[0] + a[1] * o[1]) / math.hypot(o[0], o[1])
     return math.sqrt(max(1.0 - u * u, 0.0))
 
@@ -201,8 +220,8 @@ def measure(limit: object, state: KinematicState) -> Measured:
         return Measured(np.array([d]), gradient[None, :], np.array([limit.safe]),
                         ("probe/tilt",), np.ones(1, bool))  # fmt: skip
     if type(limit) is SelfCollision:
-        i, j = link_pairs(k)
-        value = self_distances(np.array(state.origins))
+        i, j = link_pairs(k, state.rail)
+        value = self_distances(np.array(state.origins), k)
         labels = tuple(f"{link_name(a, k)}/{link_name(b, k)}" for a, b in zip(i, j, strict=True))
         return Measured(value, None, np.full(value.shape, limit.margin), labels,
                         value < limit.margin + limit.influence)  # fmt: skip
@@ -224,11 +243,12 @@ def _clearances(limit: ObstacleDamper, state: KinematicState) -> Measured:
     if count == 0:
         return Measured(np.zeros(0), np.zeros((0, n)), np.zeros(0), (), np.zeros(0, bool))
     near = proximity(state, limit.obstacles)
-    jac = np.array(state.guarded_jacobians[:, :2, :])  # (k+1, 2, n)
+    jac = np.array(state.guarded_jacobians[:, :2, :])  # (m, 2, n)
     points, links = near.points, near.links
-    point_rows = np.einsum("jpc,pcn->jpn", points.normal, jac)  # (J, k+1, n)
+    point_rows = np.einsum("jpc,pcn->jpn", points.normal, jac)  # (J, m, n)
     t = links.t[..., None, None]
-    between = (1.0 - t) * jac[None, :-1] + t * jac[None, 1:]  # (J, k, 2, n)
+    ends = guarded_links(k, state.rail)
+    between = (1.0 - t) * jac[None, ends[:, 0]] + t * jac[None, ends[:, 1]]  # (J, L, 2, n)
     link_rows = np.einsum("jlc,jlcn->jln", links.normal, between)
     point_ok = (points.normal != 0.0).any(axis=-1)
     link_ok = (links.normal != 0.0).any(axis=-1) & (links.t > 0.0) & (links.t < 1.0)
@@ -236,9 +256,8 @@ def _clearances(limit: ObstacleDamper, state: KinematicState) -> Measured:
     gradient = np.concatenate([point_rows.reshape(-1, n), link_rows.reshape(-1, n)])
     usable = np.concatenate([point_ok.ravel(), link_ok.ravel()])
     labels = (
-        *(f"{'probe' if i == k else f'point{i + 1}'}/obstacles[{j}]"
-          for j in range(count) for i in range(k + 1)),
-        *(f"{link_name(i, k)}/obstacles[{j}]" for j in range(count) for i in range(k)),
+        *(f"{point_name(i, k)}/obstacles[{j}]" for j in range(count) for i in range(len(jac))),
+        *(f"{link_name(i, k)}/obstacles[{j}]" for j in range(count) for i in range(len(ends))),
     )  # fmt: skip
     return Measured(value, gradient, np.full(value.shape, limit.margin), labels,
                     usable & (value < limit.influence))  # fmt: skip

@@ -35,6 +35,7 @@ from dvqp.limits import (
     SurfaceHeight,
     TiltLimit,
 )
+from tests.oracle_limits import guarded_links, link_pairs
 
 Array = NDArray[np.float64]
 
@@ -66,15 +67,16 @@ def kkt(jac: Array, xdot: Array, g: Array, metric: Array) -> Array:
 class Frames:
     """The guarded frames of one configuration, from Pinocchio.
 
-    ``origins``, ``axes`` (k+1, 3): the body points then the tool, base frame; ``guarded``
-    (k+1, 3): ``[l, z, h]`` with ``l = R atan2(y, x)``, ``h = ρ − R``; ``tool`` (4,):
-    ``[l, z, h, α]`` with ``α = atan2(a_z, (O_x a_y − O_y a_x)/ρ)``.
+    ``origins``, ``axes`` (m, 3): the k body points, the tool, the rail point (if any), base
+    frame; ``guarded`` (m, 3): ``[l, z, h]`` with ``l = R atan2(y, x)``, ``h = ρ − R``;
+    ``tool`` (4,): ``[l, z, h, α]`` with ``α = atan2(a_z, (O_x a_y − O_y a_x)/ρ)``.
     """
 
     origins: Array
     axes: Array
     guarded: Array
     tool: Array
+    k: int
 
 
 def frames(robot: Robot, q: Array, radius: float) -> Frames:
@@ -87,9 +89,10 @@ def frames(robot: Robot, q: Array, radius: float) -> Frames:
     guarded = np.column_stack(
         [radius * np.arctan2(origins[:, 1], origins[:, 0]), origins[:, 2], rho - radius]
     )
-    o, a = origins[-1], axes[-1]
-    alpha = math.atan2(a[2], (o[0] * a[1] - o[1] * a[0]) / rho[-1])
-    return Frames(origins, axes, guarded, np.array([*guarded[-1], alpha]))
+    k = robot.n_points
+    o, a = origins[k], axes[k]
+    alpha = math.atan2(a[2], (o[0] * a[1] - o[1] * a[0]) / rho[k])
+    return Frames(origins, axes, guarded, np.array([*guarded[k], alpha]), k)
 
 
 def wrapped(dl: Array, period: float) -> Array:
@@ -99,7 +102,7 @@ def wrapped(dl: Array, period: float) -> Array:
 
 def tilt(f: Frames) -> float:
     """The probe axis' angle from the radial direction at the tool, rad, in [0, π]."""
-    o, a = f.origins[-1], f.axes[-1]
+    o, a = f.origins[f.k], f.axes[f.k]
     radial = np.array([o[0], o[1], 0.0]) / math.hypot(o[0], o[1])
     return math.acos(max(-1.0, min(1.0, float(a @ radial))))
 
@@ -155,17 +158,18 @@ def point_distances(obstacles: Sequence[Shape], p: Array, period: float) -> Arra
     return np.array(out).reshape(len(out), p.shape[0])
 
 
-def link_distances(obstacles: Sequence[Shape], guarded: Array, period: float,
+def link_distances(obstacles: Sequence[Shape], guarded: Array, period: float, k: int,
                    samples: int = 401) -> Array:  # fmt: skip
-    """Signed distance (m) of every guarded link to every obstacle, brute force: each link
-    sampled at ``samples`` points, then again at ``samples`` points between the neighbours of
-    each obstacle's closest sample: (J, k)."""
+    """Signed distance (m) of every guarded link (of an arm with k body points) to every
+    obstacle, brute force: each link sampled at ``samples`` points, then again at ``samples``
+    points between the neighbours of each obstacle's closest sample: (J, L)."""
     lz = guarded[:, :2]
     coarse = np.linspace(0.0, 1.0, samples)
     step = coarse[1]
-    out = np.zeros((len(obstacles), lz.shape[0] - 1))
-    for i in range(lz.shape[0] - 1):
-        a, b = lz[i], lz[i + 1].copy()
+    ends = guarded_links(k, lz.shape[0] > k + 1)
+    out = np.zeros((len(obstacles), len(ends)))
+    for i, (first, last) in enumerate(ends):
+        a, b = lz[first], lz[last].copy()
         b[0] = a[0] + wrapped(b[0] - a[0], period)
         d = point_distances(obstacles, a + coarse[:, None] * (b - a), period)
         for j, shape in enumerate(obstacles):
@@ -194,12 +198,14 @@ def segment_distance(a: Array, b: Array, c: Array, d: Array) -> float:
     return min(float(np.linalg.norm(r + s * u - t * v)) for s, t in candidates)
 
 
-def self_distances(origins: Array) -> Array:
-    """Distances (m) of every pair of non-adjacent guarded links ``(i, j)``, ``j ≥ i + 2``,
-    in ``np.triu_indices(k, 2)`` order (k links between the k+1 frames)."""
-    k = origins.shape[0] - 1
-    i, j = np.triu_indices(k, 2)
-    return np.array([segment_distance(origins[a], origins[a + 1], origins[b], origins[b + 1])
+def self_distances(origins: Array, k: int) -> Array:
+    """Distances (m) of every pair of guarded links with no common point (an arm of k body
+    points; the rail point's carriage link if ``origins`` has one), in :func:`link_pairs`
+    order."""
+    ends = guarded_links(k, origins.shape[0] > k + 1)
+    i, j = link_pairs(k, origins.shape[0] > k + 1)
+    return np.array([segment_distance(origins[ends[a, 0]], origins[ends[a, 1]],
+                                      origins[ends[b, 0]], origins[ends[b, 1]])
                      for a, b in zip(i, j, strict=True)])  # fmt: skip
 
 
@@ -229,20 +235,21 @@ def verified_values(limits: tuple, robot: Robot, q: Array, radius: float) -> lis
             out.append(Verified(values, 0.0, limit.tolerance, "joint position"))
         elif kind is ObstacleDamper and len(limit.obstacles):
             points = point_distances(limit.obstacles, f.guarded[:, :2], period)
-            links = link_distances(limit.obstacles, f.guarded, period)
+            links = link_distances(limit.obstacles, f.guarded, period, f.k)
             values = np.concatenate([points.ravel(), links.ravel()])
             out.append(Verified(values, limit.margin, limit.tolerance, limit.quantity))
         elif kind is SurfaceHeight:
-            out.append(Verified(f.guarded[:-1, 2], limit.min_height, limit.tolerance,
+            out.append(Verified(f.guarded[: f.k, 2], limit.min_height, limit.tolerance,
                                 limit.quantity))  # fmt: skip
         elif kind is ProbeHeight:
-            out.append(Verified(f.guarded[-1:, 2], limit.floor, limit.tolerance, limit.quantity))
+            out.append(Verified(f.guarded[f.k : f.k + 1, 2], limit.floor, limit.tolerance,
+                                limit.quantity))  # fmt: skip
         elif kind is TiltLimit and limit.min_tilt > 0.0:
             angle = tilt(f)
             out.append(Verified(np.array([min(angle, math.pi - angle)]), limit.min_tilt,
                                 limit.tolerance, limit.quantity))  # fmt: skip
         elif kind is SelfCollision:
-            out.append(Verified(self_distances(f.origins), limit.margin, limit.tolerance,
+            out.append(Verified(self_distances(f.origins, f.k), limit.margin, limit.tolerance,
                                 limit.quantity))  # fmt: skip
     return out
 

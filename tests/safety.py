@@ -31,18 +31,19 @@ def clearances(scene: Scene, q: np.ndarray) -> tuple[float, float]:
     """Smallest clearance (m) of the whole guarded arm, and of the probe and its holder."""
     if not len(scene.obstacles):
         return math.inf, math.inf
-    g = _frames(scene, q).guarded  # points 1..k, then the tool
+    f = _frames(scene, q)
+    g, k = f.guarded, f.k  # points 1..k, the tool, the rail point
     period = 2.0 * math.pi * scene.pipe_radius
-    links = link_distances(scene.obstacles, g, period)  # the links' ends included
+    links = link_distances(scene.obstacles, g, period, k)  # the links' ends included
     points = point_distances(scene.obstacles, g[:, :2], period)
-    return float(min(links.min(), points.min())), float(links[:, -1].min())
+    return float(min(links.min(), points.min())), float(links[:, k - 1].min())
 
 
 def heights(scene: Scene, q: np.ndarray) -> tuple[float, float]:
     """Lowest body point height and the probe's height over the surface, m (from x, y)."""
-    o = _frames(scene, q).origins
-    rho = np.hypot(o[:, 0], o[:, 1]) - scene.pipe_radius
-    return float(rho[:-1].min()), float(rho[-1])
+    f = _frames(scene, q)
+    rho = np.hypot(f.origins[:, 0], f.origins[:, 1]) - scene.pipe_radius
+    return float(rho[: f.k].min()), float(rho[f.k])
 
 
 def tilt(scene: Scene, q: np.ndarray) -> float:

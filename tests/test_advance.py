@@ -106,15 +106,15 @@ obstacle in the way of the straight motion Q_A → Q_B."""
 
 def in_the_way(robot: Robot) -> ObstacleSet:
     """A 1 cm circle 3 cm ahead of the tool, on the line it follows from Q_A to Q_B."""
-    tool = frames(robot, Q_A, PIPE_RADIUS).guarded[-1, :2]
+    tool = frames(robot, Q_A, PIPE_RADIUS).tool[:2]
     return ObstacleSet([Obstacle(tool + np.array([0.03, 0.0]), 0.01)])
 
 
 def clearance(robot: Robot, obstacles: ObstacleSet, q: np.ndarray) -> float:
     """Smallest clearance of the guarded parts at ``q`` (oracle: Pinocchio, brute force)."""
-    g = frames(robot, q, PIPE_RADIUS).guarded
-    return float(min(point_distances(obstacles, g[:, :2], PERIOD).min(),
-                     link_distances(obstacles, g, PERIOD).min()))  # fmt: skip
+    f = frames(robot, q, PIPE_RADIUS)
+    return float(min(point_distances(obstacles, f.guarded[:, :2], PERIOD).min(),
+                     link_distances(obstacles, f.guarded, PERIOD, f.k).min()))  # fmt: skip
 
 
 def along(robot: Robot, obstacles: ObstacleSet, a: np.ndarray, b: np.ndarray) -> float:

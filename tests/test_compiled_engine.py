@@ -76,11 +76,12 @@ def test_every_sample_of_a_run_is_the_state_its_joints_reach(name: str, backend:
         np.testing.assert_allclose(traj.tool[k, 1:3], f.tool[1:3], rtol=0, atol=1e-12)
         assert wrapped(traj.tool[k, 3] - f.tool[3], 2 * math.pi) == pytest.approx(0.0, abs=1e-12)
         points = traj.points[k]
-        np.testing.assert_allclose(wrapped(points[:, 0] - f.guarded[:-1, 0], period), 0.0,
+        np.testing.assert_allclose(wrapped(points[:, 0] - f.guarded[: f.k, 0], period), 0.0,
                                    atol=1e-12)  # fmt: skip
-        np.testing.assert_allclose(points[:, 1:], f.guarded[:-1, 1:], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(points[:, 1:], f.guarded[: f.k, 1:], rtol=0, atol=1e-12)
         assert traj.tilt[k] == pytest.approx(tilt(f), abs=1e-9)
-        assert traj.self_distance[k] == pytest.approx(self_distances(f.origins).min(), abs=1e-12)
+        true = self_distances(f.origins, f.k).min()
+        assert traj.self_distance[k] == pytest.approx(true, abs=1e-12)
         if len(s.obstacles):
             whole, probe = safety.clearances(s, traj.q[k])
             assert traj.min_clearance[k] == pytest.approx(whole, abs=1e-7)

@@ -23,12 +23,20 @@ from tests.compiled_cases import (
     scene_case,
 )
 from tests.oracle_geometry import UserCircle, polygon_points, short_way, twin
+from tests.oracle_limits import guarded_links, link_name, point_name
 
 FIELDS = ("distance", "normal", "penalty", "penalty_gradient", "t")
 
 
 def states(case: Case, count: int, spread: float) -> list[KinematicState]:
     return [case.state(q) for q in case.configurations(count, spread)]
+
+
+def links_of(state: KinematicState) -> tuple[np.ndarray, np.ndarray]:
+    """``[l, z]`` of the starts and ends of the guarded links (the oracle's list)."""
+    ends = guarded_links(state.k, state.rail)
+    lz = state.guarded[:, :2]
+    return lz[ends[:, 0]], lz[ends[:, 1]]
 
 
 def assert_rows_equal(got: Proximity, want: Proximity, rows: list[int], atol: float) -> None:
@@ -51,7 +59,6 @@ def assert_matches_the_oracle(state: KinematicState, obstacles: ObstacleSet) -> 
     for name in ("distance", "normal", "penalty", "penalty_gradient"):
         a, b = getattr(mine.points, name), getattr(numpy.points, name)
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-12, err_msg=f"points {name}")
-    lz = state.guarded[:, :2]
     period = 2 * math.pi * state.radius
     for j, shape in enumerate(obstacles):
         if not isinstance(shape, Polygon | Inlet):
@@ -63,8 +70,9 @@ def assert_matches_the_oracle(state: KinematicState, obstacles: ObstacleSet) -> 
             np.testing.assert_allclose(a, b, rtol=0, atol=1e-12, err_msg=f"link {name} {j}")
         np.testing.assert_allclose(d, numpy.links.distance[j], rtol=0, atol=1e-9)
         vertices = shape.polygon.vertices if isinstance(shape, Inlet) else shape.vertices
-        ends = short_way(lz[:-1], lz[1:], period)
-        at_t, n_at_t = polygon_points(vertices, lz[:-1] + t[:, None] * (ends - lz[:-1]), period)
+        starts, stops = links_of(state)
+        ends = short_way(starts, stops, period)
+        at_t, n_at_t = polygon_points(vertices, starts + t[:, None] * (ends - starts), period)
         np.testing.assert_allclose(at_t, d, rtol=0, atol=1e-12)
         np.testing.assert_allclose(n_at_t, n, rtol=0, atol=1e-9)
     return mine
@@ -99,8 +107,9 @@ def test_the_seam_case_has_a_point_on_either_side_of_the_seam() -> None:
 
 @pytest.mark.parametrize("name", [*BUNDLED_WITH_OBSTACLES, "mixed", "mixed-seam"])
 def test_the_chain_measurement_equals_per_point_and_per_link_calls(name: str) -> None:
-    """Point i of the chain is guarded point i, link i joins points i and i + 1 (the probe
-    holder last), the penalty rows follow each shape's size."""
+    """Point i of the chain is guarded point i, link i joins the oracle's pair of points (the
+    body links, the probe holder, the carriage link), the penalty rows follow each shape's
+    size."""
     case = mixed_case(paper_robot(), name == "mixed-seam") if "mixed" in name else scene_case(name)
     period = 2 * math.pi * case.radius
     rho = np.array([s.size for s in case.obstacles])[:, None]
@@ -111,8 +120,9 @@ def test_the_chain_measurement_equals_per_point_and_per_link_calls(name: str) ->
             d, n = distances(case.obstacles, lz[i : i + 1], period)
             np.testing.assert_array_equal(chain.points.distance[:, i : i + 1], d)
             np.testing.assert_array_equal(chain.points.normal[:, i : i + 1], n)
-        for i in range(lz.shape[0] - 1):
-            d, t, n = segment_distances(case.obstacles, lz[i : i + 1], lz[i + 1 : i + 2], period)
+        starts, stops = links_of(state)
+        for i in range(starts.shape[0]):
+            d, t, n = segment_distances(case.obstacles, starts[i : i + 1], stops[i : i + 1], period)
             np.testing.assert_array_equal(chain.links.distance[:, i : i + 1], d)
             np.testing.assert_array_equal(chain.links.t[:, i : i + 1], t)
             np.testing.assert_array_equal(chain.links.normal[:, i : i + 1], n)
@@ -135,7 +145,7 @@ def test_rows_follow_the_order_of_the_set_not_the_grouping_by_class() -> None:
         d, n = distances([shape], lz, period)
         np.testing.assert_array_equal(chain.points.distance[row], d[0])
         np.testing.assert_array_equal(chain.points.normal[row], n[0])
-        d, t, n = segment_distances([shape], lz[:-1], lz[1:], period)
+        d, t, n = segment_distances([shape], *links_of(state), period)
         np.testing.assert_array_equal(chain.links.distance[row], d[0])
         np.testing.assert_array_equal(chain.links.t[row], t[0])
         np.testing.assert_array_equal(chain.links.normal[row], n[0])
@@ -169,8 +179,8 @@ def test_shapes_of_one_s_own_among_dvqp_s_give_the_rows_of_the_same_geometry() -
 
 def test_an_empty_set_has_empty_rows_and_no_clearance_limit(state0: KinematicState) -> None:
     near = proximity(state0, ObstacleSet())
-    assert near.points.distance.shape == (0, 6) and near.links.t.shape == (0, 5)
-    assert near.points.normal.shape == (0, 6, 2) and near.links.penalty_gradient.shape == (0, 5, 2)
+    assert near.points.distance.shape == (0, 7) and near.links.t.shape == (0, 6)
+    assert near.points.normal.shape == (0, 7, 2) and near.links.penalty_gradient.shape == (0, 6, 2)
     assert near.min_clearance() == math.inf and near.probe_clearance() == math.inf
     assert min_clearance(state0, ObstacleSet()) == math.inf
     with pytest.raises(ValueError):
@@ -184,12 +194,12 @@ def test_the_clearances_name_the_closest_part_and_obstacle() -> None:
         points, links = near.point_clearance, near.link_clearance
         smallest = min(points.min(), links.min())
         assert near.min_clearance() == smallest == min_clearance(state, case.obstacles)
-        assert near.probe_clearance() == min(points[:, -1].min(), links[:, -1].min())
+        assert near.probe_clearance() == min(points[:, 5].min(), links[:, 4].min())
         value, part, j = near.closest()
         assert value == smallest
         if links.min() < points.min():
             i = int(np.argmin(links[j]))
-            assert links[j, i] == value and part == ("holder" if i == 4 else f"link{i + 1}")
+            assert links[j, i] == value and part == link_name(i, 5)
         else:
             i = int(np.argmin(points[j]))
-            assert points[j, i] == value and part == ("probe" if i == 5 else f"point{i + 1}")
+            assert points[j, i] == value and part == point_name(i, 5)

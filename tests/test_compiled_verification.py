@@ -94,10 +94,11 @@ def test_the_tilt_is_folded_into_zero_to_a_right_angle(robot: Robot, q0: np.ndar
     assert floors[:2] == pytest.approx([0.3, 1.4], abs=1e-15)
 
 
-def expected_rows(limit: object, k: int, pairs: int) -> int:
-    """How many rows of ``G`` (and verified values) one of dvqp's dampers adds."""
+def expected_rows(limit: object, k: int, pairs: int, rail: bool) -> int:
+    """How many rows of ``G`` (and verified values) one of dvqp's dampers adds (k body points,
+    the rail point and the carriage link if ``rail``)."""
     if isinstance(limit, ObstacleDamper):
-        return len(limit.obstacles) * (2 * k + 1)
+        return len(limit.obstacles) * (2 * k + 1 + 2 * rail)
     if isinstance(limit, TiltLimit):
         return int(limit.min_tilt > 0.0)
     return {"SurfaceHeight": k, "ProbeHeight": 1, "SelfCollision": pairs}[type(limit).__name__]
@@ -114,7 +115,9 @@ def test_every_bundled_scene_s_limits_are_in_its_step() -> None:
         s.start(sc.q0)
         s.prepare(np.zeros(4), DT)
         dampers = [lim for lim in limits if isinstance(lim, VelocityDamper)]
-        rows = sum(expected_rows(lim, k, k * (k - 1) // 2 - (k - 1)) for lim in dampers)
+        rail = sc.robot.has_rail  # the carriage link: against every link but link 1
+        pairs = k * (k - 1) // 2 - (k - 1) + (k - 1) * rail
+        rows = sum(expected_rows(lim, k, pairs, rail) for lim in dampers)
         G = s.problem().G
         assert (0 if G is None else G.shape[0]) == rows, path.stem
         joints = 2 * sc.robot.n * any(isinstance(lim, JointPositionLimit) for lim in limits)

@@ -19,7 +19,7 @@ def test_pinocchio_forward_kinematics_equals_plain_dh_product(robot: Robot) -> N
     table, tool = ndt13_table(LINK_LENGTHS)
     for q in random_configurations(50, seed=1, spread=np.pi):
         ref = forward_dh(table, q, tool)
-        expected = [ref[j - 1] for j in NDT13_POINT_JOINTS] + [ref[-1]]
+        expected = [ref[j - 1] for j in NDT13_POINT_JOINTS] + [ref[-1], ref[1]]  # tool, rail
         for got, want in zip(pinocchio_frames(robot, q), expected, strict=True):
             np.testing.assert_allclose(got, want, atol=1e-12, rtol=0)
 

@@ -57,7 +57,7 @@ def test_a_clearance_below_the_start_is_broken_and_described(robot: Robot, q0: n
     assert found.broken and found.label == "probe/obstacles[0]" and found.unit == "m"
     assert found.quantity == "clearance" and found.tolerance == 1e-4
     assert found.actual == pytest.approx(-0.002, abs=1e-9)
-    start_clearance = proximity(start, damper.obstacles).point_clearance[0, -1]
+    start_clearance = proximity(start, damper.obstacles).point_clearance[0, 5]  # the probe
     assert found.bound == pytest.approx(min(0.001, start_clearance))
     assert found.describe().startswith("probe/obstacles[0] clearance -0.002 m < ")
     np.testing.assert_allclose(s.excess_now, [found.value, found.value / 1e-4], rtol=1e-12)

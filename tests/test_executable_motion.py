@@ -28,7 +28,8 @@ def test_accelerations_and_self_distance_stay_within_their_limits(name: str, bac
     assert traj.self_distance.min() >= margin - 1e-3
     # the recorded figure is the true one (Pinocchio's frames, closest points of our own)
     for k in {int(np.argmin(traj.self_distance)), 0, traj.n_steps}:
-        true = self_distances(frames(s.robot, traj.q[k], s.pipe_radius).origins).min()
+        f = frames(s.robot, traj.q[k], s.pipe_radius)
+        true = self_distances(f.origins, f.k).min()
         assert traj.self_distance[k] == pytest.approx(true, abs=1e-12)
         state = dvqp.KinematicState.compute(s.robot, traj.q[k], s.pipe_radius)
         assert self_distance(state)[0] == pytest.approx(true, abs=1e-12)

@@ -30,7 +30,8 @@ def test_pairs_outside_the_influence_distance_add_no_row(
     s = stepping.stepper(robot, q0, limits=[far], backend="daqp")
     s.prepare(np.zeros(4), DT)
     assert s.rows(far).rows == 0 and problem_rows(s) == 0  # type: ignore[union-attr]
-    assert s.problem().G.shape[0] == 2 * 5 + 1  # its rows are there, none applies
+    # its rows are there (6 points, 5 links, the rail point and the carriage), none applies
+    assert s.problem().G.shape[0] == 2 * 5 + 1 + 2
     empty = stepping.stepper(robot, q0, limits=[ObstacleDamper(ObstacleSet())], backend="daqp")
     empty.prepare(np.zeros(4), DT)
     assert empty.problem().G is None  # no obstacle: no row at all
@@ -116,7 +117,7 @@ def test_dampers_over_different_obstacle_sets_keep_each_its_own_rows(
     its own set (labels indexed in it), with its own margin, gain and deceleration."""
     a, b, c = near_obstacles(state0)
     p = state0.guarded[:, :2]
-    d = Obstacle(p[-1] + np.array([0.0, 0.05]), 0.03)
+    d = Obstacle(p[5] + np.array([0.0, 0.05]), 0.03)  # near the probe
     dampers = [
         ObstacleDamper(ObstacleSet([a, b]), margin=0.01, influence=0.2, gain=0.3),
         ObstacleDamper(ObstacleSet([b, d, c]), margin=0.02, influence=0.1, gain=0.8,

@@ -74,7 +74,7 @@ def frames_at(robot: Robot, q: np.ndarray) -> list[np.ndarray]:
 
 def test_the_bundled_urdf_is_the_ndt13_arm(robot: Robot) -> None:
     points = [f"point{k}" for k in range(1, 6)]
-    urdf = Robot.from_urdf(SCENES / "ndt13.urdf", points, "probe")
+    urdf = Robot.from_urdf(SCENES / "ndt13.urdf", points, "probe", rail="rail")
     assert urdf.n == 13 and urdf.name == "ndt13-urdf"
     np.testing.assert_array_equal(urdf.q_min, robot.q_min)  # joint 1 continuous: unlimited
     np.testing.assert_allclose(urdf.q_max, robot.q_max, rtol=0, atol=1e-15)

@@ -421,6 +421,6 @@ def test_urdf_errors_name_robot_urdf_and_keep_the_parser_quiet(
 
 def test_the_bundled_urdf_scene_runs_as_the_paper_scene() -> None:
     urdf, paper = load_scene(SCENES / "urdf-arm.toml"), load_scene(SCENES / "paper-two-inlets.toml")
-    assert urdf.robot.n == 13 and urdf.robot.frame_names[-1] == "probe"
+    assert urdf.robot.n == 13 and urdf.robot.frame_names[-2:] == ("probe", "rail")
     assert urdf.robot.q_min[0] == -np.inf  # the carriage is a continuous joint
     np.testing.assert_allclose(plan(urdf, "pinv").q, plan(paper, "pinv").q, rtol=0, atol=1e-12)

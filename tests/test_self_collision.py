@@ -65,6 +65,10 @@ def test_pairs_are_the_non_adjacent_links() -> None:
         "link1/link3", "link1/link4", "link1/holder", "link2/link4", "link2/holder",
         "link3/holder",
     )  # fmt: skip
+    railed = PairBuffers.allocate(5, rail=True)  # the carriage link (5) against all but link1
+    pairs = list(zip(railed.i.tolist(), railed.j.tolist(), strict=True))
+    assert [p for p in pairs if 5 in p] == [(1, 5), (2, 5), (3, 5), (4, 5)] and len(pairs) == 10
+    assert SelfCollision().labels(5, rail=True)[-1] == "holder/carriage"
 
 
 def test_rows_are_minus_the_gradient_of_the_link_distances(robot: Robot) -> None:
@@ -74,13 +78,13 @@ def test_rows_are_minus_the_gradient_of_the_link_distances(robot: Robot) -> None
     s = stepping.stepper(robot, configurations[0], limits=[limit], backend="daqp", dt=DT)
     for q in configurations:
         rows = damper_rows(s, limit, q, DT, atol=1e-9)  # h to the search's precision
-        assert rows.rows == 6
+        assert rows.rows == 10  # 6 pairs of body links and holder, 4 with the carriage link
 
 
 def test_only_pairs_within_the_margin_plus_influence_add_rows(robot: Robot) -> None:
     configurations = random_configurations(8, seed=42, spread=1.0)
     state = KinematicState.compute(robot, configurations[0], PIPE_RADIUS)
-    d = np.sort(self_distances(np.array(state.origins)))  # pairs often tie (equal links)
+    d = np.sort(self_distances(np.array(state.origins), state.k))  # pairs often tie (equal links)
     gaps = np.flatnonzero(np.diff(d) > 2e-3)
     low, high = (0.5 * (d[g] + d[g + 1]) for g in gaps[:2])
     limits = [
@@ -95,25 +99,30 @@ def test_only_pairs_within_the_margin_plus_influence_add_rows(robot: Robot) -> N
 
 
 def test_the_smallest_distance_names_its_pair(robot: Robot) -> None:
-    names = SelfCollision().labels(5)
+    names = SelfCollision().labels(5, robot.has_rail)
     for q in random_configurations(4, seed=43, spread=0.8):
         state = KinematicState.compute(robot, q, PIPE_RADIUS)
         d, pair = self_distance(state)
-        brute = self_distances(np.array(state.origins))
+        brute = self_distances(np.array(state.origins), state.k)
         assert d == pytest.approx(brute.min(), abs=1e-12)
         assert brute[names.index(pair)] == pytest.approx(d, abs=1e-12)  # pairs may tie
 
 
 def test_the_excess_names_the_pair_that_folded_closer_than_at_the_start(robot: Robot) -> None:
     start, q = random_configurations(2, seed=44, spread=0.8)
-    at_start = self_distances(np.array(KinematicState.compute(robot, start, PIPE_RADIUS).origins))
-    at_q = self_distances(np.array(KinematicState.compute(robot, q, PIPE_RADIUS).origins))
+
+    def distances(v: np.ndarray) -> np.ndarray:
+        return self_distances(np.array(KinematicState.compute(robot, v, PIPE_RADIUS).origins), 5)
+
+    at_start, at_q = distances(start), distances(q)
     margin = float(np.max(at_start)) + 0.01  # every pair starts inside: its start is its floor
     found = stepping.excess([SelfCollision(margin=margin)], robot, start, q)
     over = at_start - at_q
     assert found.value == pytest.approx(over.max(), abs=1e-12) and found.value > 0
     assert found.quantity == "self distance" and found.unit == "m"
-    assert over[SelfCollision().labels(5).index(found.label)] == pytest.approx(found.value)
+    assert over[SelfCollision().labels(5, rail=True).index(found.label)] == pytest.approx(
+        found.value
+    )
 
 
 def test_constructor_validates_its_parameters() -> None:

@@ -20,6 +20,13 @@ from dvqp.geometry.proximity import measure
 from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon, Shape
 from tests.oracle_geometry import short_way, twin, wrap
 
+
+def chain_links(points: np.ndarray) -> np.ndarray:
+    """The links of a chain through ``points``: i → i + 1."""
+    m = points.shape[0]
+    return np.stack([np.arange(m - 1), np.arange(1, m)], axis=1)
+
+
 R = 0.254
 PERIOD = 2.0 * math.pi * R
 HALF = math.pi * R
@@ -204,7 +211,7 @@ def test_the_circle_is_the_paper_s_closed_form() -> None:
     off = [0, 2]
     np.testing.assert_allclose(n[off], -s[off] / dist[off, None], rtol=0, atol=1e-15)
     assert np.all(n[1] == 0.0)  # the centre has no normal
-    near = measure([CIRCLE], p, PERIOD)  # the penalty: ‖S − p‖² − r², ∇ = −2 (S − p)
+    near = measure([CIRCLE], p, PERIOD, chain_links(p))  # penalty ‖S − p‖² − r², ∇ −2 (S − p)
     np.testing.assert_allclose(near.point_penalty[0], dist**2 - 0.06**2, rtol=0, atol=1e-15)
     np.testing.assert_allclose(near.point_penalty_gradient[0], -2 * s, rtol=0, atol=1e-15)
 
@@ -214,7 +221,7 @@ def test_the_penalty_is_d_times_d_plus_twice_the_size_negative_exactly_inside(
     shape: Shape,
 ) -> None:
     chain = around(shape, np.random.default_rng(13), 40)
-    near = measure([shape], chain, PERIOD)
+    near = measure([shape], chain, PERIOD, chain_links(chain))
     rho = shape.size
     for side in ("point", "link"):
         d, n = getattr(near, f"{side}_distance")[0], getattr(near, f"{side}_normal")[0]

@@ -66,14 +66,15 @@ def test_jacobians_hold_across_the_l_seam(robot: Robot, q0: np.ndarray) -> None:
     check_jacobians(robot, q)
 
 
-def test_points_are_the_guarded_points_but_the_probe_and_the_tool_is_the_probe(
+def test_points_are_the_first_guarded_points_the_probe_the_next_and_the_rail_point_last(
     state0: KinematicState,
 ) -> None:
-    np.testing.assert_array_equal(state0.points, state0.guarded[:-1])
-    np.testing.assert_array_equal(state0.point_jacobians, state0.guarded_jacobians[:-1])
-    np.testing.assert_array_equal(state0.tool[:3], state0.guarded[-1])
-    np.testing.assert_array_equal(state0.tool_jacobian[:3], state0.guarded_jacobians[-1])
-    assert (state0.n, state0.k, state0.radius) == (13, 5, R)
+    np.testing.assert_array_equal(state0.points, state0.guarded[:5])
+    np.testing.assert_array_equal(state0.point_jacobians, state0.guarded_jacobians[:5])
+    np.testing.assert_array_equal(state0.tool[:3], state0.guarded[5])
+    np.testing.assert_array_equal(state0.tool_jacobian[:3], state0.guarded_jacobians[5])
+    assert (state0.n, state0.k, state0.radius, state0.rail) == (13, 5, R, True)
+    assert state0.guarded.shape == (7, 3)
 
 
 def test_state_arrays_are_read_only(state0: KinematicState) -> None:
@@ -94,8 +95,8 @@ def test_each_state_owns_its_arrays(robot: Robot, q0: np.ndarray) -> None:
 
 
 def test_a_view_shows_whatever_its_buffers_hold_now(robot: Robot, q0: np.ndarray) -> None:
-    buffers = StateBuffers.allocate(robot.n, robot.n_points)
-    view = KinematicState.view(buffers, R)
+    buffers = StateBuffers.allocate(robot.n, robot.n_points, robot.has_rail)
+    view = KinematicState.view(buffers, R, robot.n_points)
     model = as_struct(robot.model_arrays())
     for q in (q0, q0 + 0.1):
         buffers.q[:] = q

@@ -32,13 +32,13 @@ def test_the_tilt_row_is_minus_the_gradient_of_sin_tilt(robot: Robot) -> None:
 def test_the_cosine_row_is_the_derivative_of_the_cosine(robot: Robot) -> None:
     def cosine(q: np.ndarray) -> float:
         state = KinematicState.compute(robot, q, PIPE_RADIUS)
-        o, a = state.origins[-1], state.axes[-1]
+        o, a = state.origins[state.k], state.axes[state.k]
         return float(a[0] * o[0] + a[1] * o[1]) / math.hypot(o[0], o[1])
 
     for q in random_configurations(4, seed=32, spread=0.5):
         state = KinematicState.compute(robot, q, PIPE_RADIUS)
         row = np.zeros(13)
-        u = tilt_cosine(state.origins, state.axes, state.frame_jacobians, row)
+        u = tilt_cosine(state.origins, state.axes, state.frame_jacobians, state.k, row)
         assert u == pytest.approx(cosine(q), abs=1e-15)
         np.testing.assert_allclose(row, central_difference(cosine, q, 1e-7), atol=1e-7)
 
@@ -46,9 +46,9 @@ def test_the_cosine_row_is_the_derivative_of_the_cosine(robot: Robot) -> None:
 def test_tilt_is_measured_from_the_frames(robot: Robot) -> None:
     for q in random_configurations(6, seed=33, spread=1.0):
         state = KinematicState.compute(robot, q, PIPE_RADIUS)
-        o, a = state.origins[-1], state.axes[-1]
+        o, a = state.origins[state.k], state.axes[state.k]
         radial = np.array([o[0], o[1], 0.0]) / math.hypot(o[0], o[1])
-        assert tilt_angle(state.origins, state.axes) == pytest.approx(
+        assert tilt_angle(state.origins, state.axes, state.k) == pytest.approx(
             math.acos(a @ radial), abs=1e-12
         )
         assert tilt_sine(state) == pytest.approx(math.sin(tilt(state)), abs=1e-12)

@@ -42,7 +42,8 @@ class TiltTask(Task):
     @staticmethod
     def cos_tilt(state: KinematicState) -> tuple[float, np.ndarray]:
         """``cos θ`` and its row ``∂ cos θ / ∂Q``, shape (n,)."""
-        origin, axis, jac = state.origins[-1], state.axes[-1], state.frame_jacobians[-1]
+        t = state.k  # the tool: the guarded frame after the k body points
+        origin, axis, jac = state.origins[t], state.axes[t], state.frame_jacobians[t]
         rho = math.hypot(origin[0], origin[1])
         radial = np.array([origin[0] / rho, origin[1] / rho, 0.0])
         planar = np.diag([1.0, 1.0, 0.0]) - np.outer(radial, radial)

@@ -57,11 +57,12 @@ class Sample:
         tilt, apart, clearance, probe, closest = (float(v) for v in a.diagnostics)
         where = None
         if closest >= 0:
-            obstacle, part = divmod(int(closest), 2 * k + 1)
-            name = point_label(part, k) if part <= k else link_label(part - k - 1, k)
+            m = a.near.point_distance.shape[1]
+            obstacle, part = divmod(int(closest), m + a.near.ends.shape[0])
+            name = point_label(part, k) if part < m else link_label(part - m, k)
             where = f"{name}/{stepper.obstacles.labels[obstacle]}"
         excess = stepper.excess_now
-        return cls(a.state.q.copy(), a.state.tool.copy(), a.state.guarded[:-1].copy(),
+        return cls(a.state.q.copy(), a.state.tool.copy(), a.state.guarded[:k].copy(),
                    float(a.objective.value[0]), clearance, probe, where, tilt, apart,
                    max(float(excess[0]), 0.0), bool(excess[1] <= 1.0))  # fmt: skip
 

@@ -116,11 +116,10 @@ def _segment(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
 
 @njit(cache=True)
 def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
-    """Distances and normals of the points ``chain`` (m, ≥ 2; columns l, z, ...) and of the
-    links between consecutive points (as many as ``near`` has columns for) to every compiled
-    obstacle, into ``near`` (a packed :class:`~dvqp.workspace.ProximityBuffers`); rows of
-    :data:`OTHER` shapes are left alone."""
-    m, links = chain.shape[0], near.link_distance.shape[1]
+    """Distances and normals of the points ``chain`` (m; columns l, z, ...) and of the links
+    ``near.ends`` between them to every compiled obstacle, into ``near`` (a packed
+    :class:`~dvqp.workspace.ProximityBuffers`); rows of :data:`OTHER` shapes are left alone."""
+    m, ends = chain.shape[0], near.ends
     for j in range(shapes.code.shape[0]):
         if shapes.code[j] == OTHER:
             continue
@@ -128,9 +127,9 @@ def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
             d, nl, nz = _point(shapes, j, chain[i, 0], chain[i, 1])
             near.point_distance[j, i] = d
             near.point_normal[j, i, 0], near.point_normal[j, i, 1] = nl, nz
-        for i in range(links):
-            d, t, nl, nz = _segment(shapes, j, chain[i, 0], chain[i, 1], chain[i + 1, 0],
-                                    chain[i + 1, 1])  # fmt: skip
+        for i in range(ends.shape[0]):
+            a, b = ends[i, 0], ends[i, 1]
+            d, t, nl, nz = _segment(shapes, j, chain[a, 0], chain[a, 1], chain[b, 0], chain[b, 1])
             near.link_distance[j, i], near.link_t[j, i] = d, t
             near.link_normal[j, i, 0], near.link_normal[j, i, 1] = nl, nz
 
@@ -154,12 +153,13 @@ def penalties(size, near) -> None:  # type: ignore[no-untyped-def]
 
 def user_rows(shapes: Sequence[Shape], code: NDArray[np.int64], chain: Array, period: float,
               near: ProximityBuffers) -> None:  # fmt: skip
-    """Rows of the shapes of your own (code :data:`OTHER`): their NumPy ``point_distance`` and
-    ``segment_distance`` of ``chain`` (m, ≥ 2), written into ``near``."""
-    lz, links = np.ascontiguousarray(chain[:, :2]), near.link_distance.shape[1]
+    """Rows of the shapes of your own (code :data:`OTHER`): their NumPy ``point_distance`` of
+    the points ``chain`` (m) and ``segment_distance`` of the links ``near.ends``, into
+    ``near``."""
+    lz, ends = np.ascontiguousarray(chain[:, :2]), near.ends
     for j in np.flatnonzero(code == OTHER):
         shape = shapes[j]
         near.point_distance[j], near.point_normal[j] = shape.point_distance(lz, period)
-        if links:
-            d, t, n = shape.segment_distance(lz[:links], lz[1 : links + 1], period)
+        if ends.shape[0]:
+            d, t, n = shape.segment_distance(lz[ends[:, 0]], lz[ends[:, 1]], period)
             near.link_distance[j], near.link_t[j], near.link_normal[j] = d, t, n

@@ -35,7 +35,7 @@ _UNALIGNED = {"JointModelRevoluteUnaligned": REVOLUTE, "JointModelPrismaticUnali
 @dataclass(frozen=True)
 class ModelArrays:
     """A Pinocchio model's constants as :func:`kinematics` reads them (J joints, joint 0 the
-    universe; m guarded frames: the body points then the tool).
+    universe; m guarded frames: the body points, the tool (frame ``tool``), the rail point).
 
     Attributes
     ----------
@@ -53,6 +53,8 @@ class ModelArrays:
         Whether joint j moves frame f.
     work, world : (J + 2, 4, 4), (J, 3)
         Scratch: the joints' placements in the base frame, then two transforms; their axes.
+    tool : int
+        Index of the tool among the guarded frames (k, the number of body points).
     """
 
     parents: NDArray[np.int64]
@@ -65,10 +67,12 @@ class ModelArrays:
     support: NDArray[np.bool_]
     work: Array
     world: Array
+    tool: int
 
     @classmethod
-    def of(cls, model: pin.Model, frame_ids: Sequence[int]) -> ModelArrays:
-        """The constants of ``model`` for the guarded frames ``frame_ids``.
+    def of(cls, model: pin.Model, frame_ids: Sequence[int], tool: int) -> ModelArrays:
+        """The constants of ``model`` for the guarded frames ``frame_ids``, ``tool`` the index
+        of the tool frame among them.
 
         Raises
         ------
@@ -92,7 +96,7 @@ class ModelArrays:
             placements=np.array([p.homogeneous for p in model.jointPlacements]), axes=axes,
             frame_joint=np.array([f.parentJoint for f in frames], dtype=np.int64),
             frame_placement=np.array([f.placement.homogeneous for f in frames]), support=support,
-            work=np.zeros((count + 2, 4, 4)), world=np.zeros((count, 3)),
+            work=np.zeros((count + 2, 4, 4)), world=np.zeros((count, 3)), tool=int(tool),
         )  # fmt: skip
 
 
@@ -183,10 +187,13 @@ def kinematics(model, radius, state) -> int:  # type: ignore[no-untyped-def]
     ``radius`` the pipe's, m).
 
     Returns −1, or the index of a guarded frame on the pipe axis (a singular configuration:
-    its DV coordinates are undefined).
+    its DV coordinates are undefined). Raises ValueError if ``state`` is not sized for the
+    model's guarded frames.
     """
-    _joints(model, state.q)
     count, m = model.parents.shape[0], model.frame_joint.shape[0]
+    if state.guarded.shape[0] != m or state.origins.shape[0] != m:
+        raise ValueError("kinematics: the state's buffers are not sized for this model")
+    _joints(model, state.q)
     pose = model.work[count]
     for f in range(m):
         _compose(model.work[model.frame_joint[f]], model.frame_placement[f], pose)
@@ -196,13 +203,14 @@ def kinematics(model, radius, state) -> int:  # type: ignore[no-untyped-def]
         if not _developed(radius, state.origins[f], state.frame_jacobians[f],
                           state.guarded[f], state.guarded_jacobians[f]):  # fmt: skip
             return f
+    t = model.tool
     for c in range(state.q.shape[0]):
         for r in range(3):
-            state.tool_jacobian[r, c] = state.guarded_jacobians[m - 1, r, c]
+            state.tool_jacobian[r, c] = state.guarded_jacobians[t, r, c]
     for r in range(3):
-        state.tool[r] = state.guarded[m - 1, r]
-    state.tool[3] = _heading(state.origins[m - 1], state.axes[m - 1],
-                             state.frame_jacobians[m - 1], state.tool_jacobian[3])  # fmt: skip
+        state.tool[r] = state.guarded[t, r]
+    state.tool[3] = _heading(state.origins[t], state.axes[t], state.frame_jacobians[t],
+                             state.tool_jacobian[3])  # fmt: skip
     return -1
 
 

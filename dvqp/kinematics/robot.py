@@ -24,6 +24,8 @@ from dvqp.kinematics.urdf import urdf_model
 
 NDT13_POINT_JOINTS = (4, 6, 8, 10, 13)
 """Joints (1-based) whose output frames are the paper's five body points."""
+NDT13_RAIL_JOINT = 2
+"""Joint (1-based) whose output frame is the rail point: ``d_2 = L1`` out from the pipe axis."""
 
 DEFAULT_QD_MAX = 1.5
 """Default joint velocity limit, rad/s."""
@@ -40,6 +42,9 @@ class Robot:
         Names of the body-point frames, in order along the chain (k >= 2).
     tool_frame
         Name of the tool frame (its z axis is the probe axis).
+    rail_frame
+        Name of the frame at the rail point, where the carriage rides its rail: the carriage
+        link from it to the first body point is then guarded too. None: no such link.
     q_min, q_max
         Joint position limits, rad, scalar or shape (n,); ``±inf`` for none.
         Default: the model's own limits.
@@ -55,6 +60,7 @@ class Robot:
         point_frames: Sequence[str],
         tool_frame: str,
         *,
+        rail_frame: str | None = None,
         q_min: ArrayLike | None = None,
         q_max: ArrayLike | None = None,
         qd_max: ArrayLike = DEFAULT_QD_MAX,
@@ -66,6 +72,7 @@ class Robot:
         if len(point_frames) < 2:
             raise ParameterError("points", "need at least two body-point frames")
         self.point_frames, self.tool_frame = tuple(point_frames), tool_frame
+        self.rail_frame = rail_frame
         for fname in self.frame_names:
             if not model.existFrame(fname):
                 known = ", ".join(f.name for f in model.frames)
@@ -81,7 +88,8 @@ class Robot:
         if np.any(qd <= 0):
             raise ParameterError("qd_max", "must be > 0 for every joint")
         self.qd_max = _validate.readonly(qd)
-        self._arrays = ModelArrays.of(model, self.frame_ids)  # refuses other joint types
+        # refuses other joint types
+        self._arrays = ModelArrays.of(model, self.frame_ids, len(self.point_frames))
 
     def model_arrays(self) -> ModelArrays:
         """The model's constants for the compiled kinematics, with scratch arrays of their own
@@ -91,8 +99,14 @@ class Robot:
 
     @property
     def frame_names(self) -> tuple[str, ...]:
-        """Names of the body-point frames then the tool frame."""
-        return (*self.point_frames, self.tool_frame)
+        """Names of the guarded frames: the body points, the tool, the rail point (if any)."""
+        rail = () if self.rail_frame is None else (self.rail_frame,)
+        return (*self.point_frames, self.tool_frame, *rail)
+
+    @property
+    def has_rail(self) -> bool:
+        """Whether the carriage link (rail point to body point 1) is guarded."""
+        return self.rail_frame is not None
 
     @property
     def n(self) -> int:
@@ -115,6 +129,7 @@ class Robot:
         tool: ArrayLike,
         point_joints: Sequence[int],
         *,
+        rail_joint: int | None = None,
         q_min: ArrayLike = -np.pi,
         q_max: ArrayLike = np.pi,
         qd_max: ArrayLike = DEFAULT_QD_MAX,
@@ -134,6 +149,8 @@ class Robot:
             ``T_e^n``, shape (4, 4).
         point_joints
             1-based joint indices whose output frames are the body points.
+        rail_joint
+            1-based joint whose output frame (``"rail"``) is the rail point, or None.
         q_min, q_max, qd_max
             Limits, see :class:`Robot`.
         """
@@ -144,6 +161,9 @@ class Robot:
         for j in point_joints:
             if not 1 <= int(j) <= n:
                 raise ParameterError("point_joints", f"joint {j} is not in 1..{n}")
+        if rail_joint is not None and not 1 <= int(rail_joint) < min(point_joints):
+            raise ParameterError("rail_joint", f"joint {rail_joint} is not before the first "
+                                 "body point's")  # fmt: skip
         lo = _validate.limit("q_min", q_min, n)
         hi = _validate.limit("q_max", q_max, n)
         model = pin.Model()
@@ -162,10 +182,14 @@ class Robot:
             for k, j in enumerate(point_joints):
                 if int(j) == i + 1:
                     model.addFrame(pin.Frame(f"point{k + 1}", parent, placement, pin.OP_FRAME))
+            if rail_joint is not None and int(rail_joint) == i + 1:
+                model.addFrame(pin.Frame("rail", parent, placement, pin.OP_FRAME))
         tool_placement = pin.SE3(fixed_part(table[-1]) @ tool_t)
         model.addFrame(pin.Frame("tool", parent, tool_placement, pin.OP_FRAME))
         points = [f"point{k + 1}" for k in range(len(point_joints))]
-        return cls(model, points, "tool", q_min=lo, q_max=hi, qd_max=qd_max, name=name)
+        rail = None if rail_joint is None else "rail"
+        return cls(model, points, "tool", rail_frame=rail, q_min=lo, q_max=hi, qd_max=qd_max,
+                   name=name)  # fmt: skip
 
     @classmethod
     def ndt13(
@@ -176,7 +200,8 @@ class Robot:
         q_max: ArrayLike | None = None,
         qd_max: ArrayLike = DEFAULT_QD_MAX,
     ) -> Robot:
-        """The paper's 13-DOF NDT manipulator (Table I) with body points at joints 4–13.
+        """The paper's 13-DOF NDT manipulator (Table I) with body points at joints 4–13 and
+        its rail point (the carriage on the rail, radius ``L1``) at joint 2's output.
 
         Parameters
         ----------
@@ -192,9 +217,8 @@ class Robot:
         default_lo[0] = -np.inf
         lo = default_lo if q_min is None else q_min
         hi = -default_lo if q_max is None else q_max
-        return cls.from_dh(
-            table, tool, NDT13_POINT_JOINTS, q_min=lo, q_max=hi, qd_max=qd_max, name="ndt13"
-        )
+        return cls.from_dh(table, tool, NDT13_POINT_JOINTS, rail_joint=NDT13_RAIL_JOINT,
+                           q_min=lo, q_max=hi, qd_max=qd_max, name="ndt13")  # fmt: skip
 
     @classmethod
     def from_urdf(
@@ -203,11 +227,13 @@ class Robot:
         points: Sequence[str],
         tool: str,
         *,
+        rail: str | None = None,
         q_min: ArrayLike | None = None,
         q_max: ArrayLike | None = None,
         qd_max: ArrayLike | None = None,
     ) -> Robot:
-        """Load a serial arm from a URDF file; ``points`` and ``tool`` are frame (link) names.
+        """Load a serial arm from a URDF file; ``points``, ``tool`` and ``rail`` (optional: the
+        rail point, see :class:`Robot`) are frame (link) names.
 
         The URDF's base frame is the pipe's frame: its z axis is the pipe axis. ``continuous``
         joints become revolute joints without position limits (``±inf``); ``revolute`` and
@@ -227,4 +253,5 @@ class Robot:
         if qd_max is None:
             vel = np.asarray(model.velocityLimit, dtype=float)
             qd_max = np.where(np.isfinite(vel) & (vel > 0), vel, DEFAULT_QD_MAX)
-        return cls(model, points, tool, q_min=q_min, q_max=q_max, qd_max=qd_max, name=model.name)
+        return cls(model, points, tool, rail_frame=rail, q_min=q_min, q_max=q_max, qd_max=qd_max,
+                   name=model.name)  # fmt: skip

@@ -27,24 +27,27 @@ class KinematicState(StateBuffers):
     """Kinematics of one configuration in Cartesian and developed-view coordinates: the fields
     of :class:`~dvqp.workspace.StateBuffers` (``q``, ``origins``, ``axes``,
     ``frame_jacobians``, ``guarded``, ``guarded_jacobians``, ``tool``, ``tool_jacobian``) and
-    the pipe's ``radius`` (m).
+    the pipe's ``radius`` (m) and the number ``k`` of body points.
 
-    The guarded points are the k body points then the probe (the tool point); consecutive
-    points bound the guarded links: the k−1 body links, then the probe holder. With
-    ``frame_jacobians = [J_v; J_ω]`` (base orientation): ``ȯ = J_v Q̇``, ``ω = J_ω Q̇``.
+    The guarded points are the k body points, the probe (the tool point, index k) and, if the
+    arm has one, the rail point (index k + 1); the guarded links are the k−1 body links, the
+    probe holder and the carriage link (rail point to body point 1; see
+    :func:`dvqp.workspace.link_ends`). With ``frame_jacobians = [J_v; J_ω]`` (base
+    orientation): ``ȯ = J_v Q̇``, ``ω = J_ω Q̇``.
     """
 
     radius: float = 0.0
+    k: int = 0
 
     @property
     def points(self) -> NDArray[np.float64]:
-        """Body points ``[l, z, h]`` (m), shape (k, 3): ``guarded[:-1]``."""
-        return self.guarded[:-1]
+        """Body points ``[l, z, h]`` (m), shape (k, 3): ``guarded[:k]``."""
+        return self.guarded[: self.k]
 
     @property
     def point_jacobians(self) -> NDArray[np.float64]:
-        """Their ``∂[l, z, h]/∂Q``, shape (k, 3, n): ``guarded_jacobians[:-1]``."""
-        return self.guarded_jacobians[:-1]
+        """Their ``∂[l, z, h]/∂Q``, shape (k, 3, n): ``guarded_jacobians[:k]``."""
+        return self.guarded_jacobians[: self.k]
 
     @property
     def n(self) -> int:
@@ -52,17 +55,19 @@ class KinematicState(StateBuffers):
         return int(self.q.shape[0])
 
     @property
-    def k(self) -> int:
-        """Number of body points."""
-        return int(self.guarded.shape[0]) - 1
+    def rail(self) -> bool:
+        """Whether the rail point (and with it the carriage link) is guarded."""
+        return int(self.guarded.shape[0]) > self.k + 1
 
     @classmethod
-    def view(cls, buffers: StateBuffers, radius: float) -> KinematicState:
-        """Read-only views of ``buffers``: they show whatever state the buffers hold now."""
+    def view(cls, buffers: StateBuffers, radius: float, k: int | None = None) -> KinematicState:
+        """Read-only views of ``buffers`` (k body points; default: every guarded point but the
+        last, the tool): they show whatever state the buffers hold now."""
         views = {f.name: getattr(buffers, f.name).view() for f in dataclasses.fields(StateBuffers)}
         for view in views.values():
             view.flags.writeable = False
-        return cls(radius=float(radius), **views)
+        points = int(buffers.guarded.shape[0]) - 1 if k is None else int(k)
+        return cls(radius=float(radius), k=points, **views)
 
     @classmethod
     def compute(cls, robot: Robot, q: ArrayLike, radius: float) -> KinematicState:
@@ -75,13 +80,13 @@ class KinematicState(StateBuffers):
         SingularConfigurationError
             A body point or the tool lies on the pipe axis.
         """
-        buffers = StateBuffers.allocate(robot.n, robot.n_points)
+        buffers = StateBuffers.allocate(robot.n, robot.n_points, robot.has_rail)
         buffers.q[:] = robot.check_q(q)
         r = _validate.positive("radius", radius)
         singular = kinematics(as_struct(robot.model_arrays()), r, as_struct(buffers))
         if singular != -1:
             raise singular_frame(robot, int(singular), buffers.origins[singular], buffers.q.copy())
-        return cls.view(buffers, r)
+        return cls.view(buffers, r, robot.n_points)
 
 
 def singular_frame(

@@ -120,9 +120,9 @@ class VelocityDamper(Limit):
         """``d_safe`` of the distances of a damper with a kernel (m)."""
         raise NotImplementedError(f"{type(self).__name__} has no safe value")
 
-    def labels(self, k: int) -> tuple[str, ...]:
-        """What each distance is, for reports (``k``: the arm's body points); none by default
-        (a report then numbers them after :attr:`name`)."""
+    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
+        """What each distance is, for reports (``k``: the arm's body points; ``rail``: whether it
+        has a rail point); none by default (a report then numbers them after :attr:`name`)."""
         return ()
 
 

@@ -46,7 +46,7 @@ class SurfaceHeight(VelocityDamper):
         """``h_min``, m."""
         return self.min_height
 
-    def labels(self, k: int) -> tuple[str, ...]:
+    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
         """``"point1/height"``, ... one per body point."""
         return tuple(f"point{i + 1}/height" for i in range(k))
 
@@ -84,7 +84,7 @@ class ProbeHeight(VelocityDamper):
         """``floor``, m."""
         return self.floor
 
-    def labels(self, k: int) -> tuple[str, ...]:
+    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
         """``("probe/height",)``."""
         return ("probe/height",)
 

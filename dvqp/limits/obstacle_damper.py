@@ -22,7 +22,7 @@ from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
 
 class ObstacleDamper(VelocityDamper):
     """Keeps every guarded point and link at least ``margin`` from every obstacle (compiled:
-    :func:`obstacle_distances`, ``J (2k + 1)`` rows).
+    :func:`obstacle_distances`, ``J (m + L)`` rows: m guarded points, L guarded links).
 
     Parameters
     ----------
@@ -66,13 +66,14 @@ class ObstacleDamper(VelocityDamper):
         """``influence``, m."""
         return self.influence
 
-    def labels(self, k: int) -> tuple[str, ...]:
+    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
         """``"point3/obstacles[0]"`` (or ``"point3/<name>"``), ...: every point then every
-        link, obstacle-major."""
-        names = self.obstacles.labels
+        link, obstacle-major (k body points, and the rail point and carriage link if
+        ``rail``)."""
+        names, parts = self.obstacles.labels, range(k + 1 + rail)
         return (
-            *(f"{point_label(i, k)}/{name}" for name in names for i in range(k + 1)),
-            *(f"{link_label(i, k)}/{name}" for name in names for i in range(k)),
+            *(f"{point_label(i, k)}/{name}" for name in names for i in parts),
+            *(f"{link_label(i, k)}/{name}" for name in names for i in range(k + rail)),
         )
 
 
@@ -80,10 +81,10 @@ class ObstacleDamper(VelocityDamper):
 def obstacle_distances(near, jacobians, members, start, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
     """Clearances of every (point, obstacle) pair then every (link, obstacle) pair of the
     obstacles ``members`` (rows of ``near``, a packed ProximityBuffers), obstacle-major, from
-    row ``start``: ``d``, ``∂d/∂Q = n · ∂p/∂Q`` (a link: at its closest point
-    ``(1 − t) p_i + t p_{i+1}``, an envelope) and whether the normal is defined (a link's
-    closest point interior). ``jacobians`` (k+1, 3, n) are the guarded points'."""
-    r, points, n = start, near.point_distance.shape[1], gradient.shape[1]
+    row ``start``: ``d``, ``∂d/∂Q = n · ∂p/∂Q`` (a link ``a → b``: at its closest point
+    ``(1 − t) p_a + t p_b``, an envelope) and whether the normal is defined (a link's
+    closest point interior). ``jacobians`` (m, 3, n) are the guarded points'."""
+    r, points, n, ends = start, near.point_distance.shape[1], gradient.shape[1], near.ends
     for j in members:
         for i in range(points):
             nl, nz = near.point_normal[j, i, 0], near.point_normal[j, i, 1]
@@ -92,12 +93,13 @@ def obstacle_distances(near, jacobians, members, start, distance, gradient, usab
                 gradient[r, c] = nl * jacobians[i, 0, c] + nz * jacobians[i, 1, c]
             r += 1
     for j in members:
-        for i in range(points - 1):
+        for i in range(ends.shape[0]):
+            a, b = ends[i, 0], ends[i, 1]
             nl, nz, t = near.link_normal[j, i, 0], near.link_normal[j, i, 1], near.link_t[j, i]
             distance[r] = near.link_distance[j, i]
             usable[r] = (nl != 0.0 or nz != 0.0) and 0.0 < t < 1.0
             for c in range(n):
-                x = (1.0 - t) * jacobians[i, 0, c] + t * jacobians[i + 1, 0, c]
-                y = (1.0 - t) * jacobians[i, 1, c] + t * jacobians[i + 1, 1, c]
+                x = (1.0 - t) * jacobians[a, 0, c] + t * jacobians[b, 0, c]
+                y = (1.0 - t) * jacobians[a, 1, c] + t * jacobians[b, 1, c]
                 gradient[r, c] = nl * x + nz * y
             r += 1

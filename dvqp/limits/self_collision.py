@@ -1,9 +1,10 @@
 """Self-collision: non-adjacent links of the snake body kept apart, in 3-D.
 
-The guarded links (the body links and the probe holder) are segments in the base frame. Every
-pair of non-adjacent links ``(i, j)``, ``j ≥ i + 2``, keeps the distance between its segments
-``d = ‖c_i − c_j‖`` at least ``margin`` (``c_i = a_i + s (b_i − a_i)``, ``c_j`` likewise, the
-closest points; exact). With ``n = (c_i − c_j)/d`` and the frames' linear Jacobians ``J``::
+The guarded links (the body links, the probe holder and the carriage link) are segments in the
+base frame. Every pair of links ``(i, j)`` that share no point keeps the distance between its
+segments ``d = ‖c_i − c_j‖`` at least ``margin`` (``c_i = a_i + s (b_i − a_i)``, ``c_j``
+likewise, the closest points; exact). With ``n = (c_i − c_j)/d`` and the frames' linear
+Jacobians ``J``::
 
     ∂d/∂Q = nᵀ ((1 − s) J_{a_i} + s J_{b_i} − (1 − t) J_{a_j} − t J_{b_j})
 
@@ -67,21 +68,24 @@ class SelfCollision(VelocityDamper):
         """``margin + influence``, m."""
         return self.margin + self.influence
 
-    def labels(self, k: int) -> tuple[str, ...]:
-        """The pairs' names, e.g. ``"link1/link3"``, ``"link2/holder"``."""
-        i, j = np.triu_indices(k, 2)
-        return tuple(f"{link_label(a, k)}/{link_label(b, k)}" for a, b in zip(i, j, strict=True))
+    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
+        """The pairs' names, e.g. ``"link1/link3"``, ``"link2/holder"``, ``"link2/carriage"``
+        (k body points, the carriage link if ``rail``)."""
+        pairs = PairBuffers.allocate(k, rail)
+        return tuple(f"{link_label(a, k)}/{link_label(b, k)}"
+                     for a, b in zip(pairs.i, pairs.j, strict=True))  # fmt: skip
 
 
 @njit(cache=True)
 def pair_distances(o, pairs) -> None:  # type: ignore[no-untyped-def]
-    """Distance, unit normal ``c_i − c_j``, ``s`` and ``t`` of the link pairs of the chain of
-    points ``o`` (k+1, 3) into ``pairs`` (a packed PairBuffers): segment ``o[i] → o[i+1]``
-    against ``o[j] → o[j+1]``. Ericson's clamped closest points (*Real-Time Collision
-    Detection*, 5.1.9), exact for parallel and degenerate segments too."""
-    eps = 1e-18
+    """Distance, unit normal ``c_i − c_j``, ``s`` and ``t`` of the link pairs of the guarded
+    points ``o`` (m, 3) into ``pairs`` (a packed PairBuffers): link i's segment
+    ``o[ends[i, 0]] → o[ends[i, 1]]`` against link j's. Ericson's clamped closest points
+    (*Real-Time Collision Detection*, 5.1.9), exact for parallel and degenerate segments too."""
+    eps, ends = 1e-18, pairs.ends
     for m in range(pairs.i.shape[0]):
-        a, b, c, d = o[pairs.i[m]], o[pairs.i[m] + 1], o[pairs.j[m]], o[pairs.j[m] + 1]
+        i, j = pairs.i[m], pairs.j[m]
+        a, b, c, d = o[ends[i, 0]], o[ends[i, 1]], o[ends[j, 0]], o[ends[j, 1]]
         d1x, d1y, d1z = b[0] - a[0], b[1] - a[1], b[2] - a[2]
         d2x, d2y, d2z = d[0] - c[0], d[1] - c[1], d[2] - c[2]
         rx, ry, rz = a[0] - c[0], a[1] - c[1], a[2] - c[2]
@@ -117,15 +121,17 @@ def pair_distances(o, pairs) -> None:  # type: ignore[no-untyped-def]
 @njit(cache=True)
 def self_distances(pairs, jac, start, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
     """Every pair's distance (m) and ``∂d/∂Q`` (see the module docstring) from row ``start``
-    (``jac`` the frames' (k+1, 6, n) Jacobians)."""
+    (``jac`` the guarded frames' (m, 6, n) Jacobians)."""
+    e = pairs.ends
     for m in range(pairs.i.shape[0]):
         i, j, sm, tm, r = pairs.i[m], pairs.j[m], pairs.s[m], pairs.t[m], start + m
+        a, b, f, g = e[i, 0], e[i, 1], e[j, 0], e[j, 1]
         distance[r], usable[r] = pairs.distance[m], True
         for c in range(gradient.shape[1]):
             grad = 0.0
             for x in range(3):
-                moving = (1 - sm) * jac[i, x, c] + sm * jac[i + 1, x, c]
-                moving = moving - (1 - tm) * jac[j, x, c] - tm * jac[j + 1, x, c]
+                moving = (1 - sm) * jac[a, x, c] + sm * jac[b, x, c]
+                moving = moving - (1 - tm) * jac[f, x, c] - tm * jac[g, x, c]
                 grad += pairs.normal[m, x] * moving
             gradient[r, c] = grad
 
@@ -133,7 +139,7 @@ def self_distances(pairs, jac, start, distance, gradient, usable) -> None:  # ty
 def self_distance(state: KinematicState) -> tuple[float, str]:
     """The smallest distance (m) between non-adjacent guarded links of ``state``, and the
     pair's name (``inf`` and ``""`` without such pairs)."""
-    pairs = PairBuffers.allocate(state.k)
+    pairs = PairBuffers.allocate(state.k, state.rail)
     if pairs.i.shape[0] == 0:
         return math.inf, ""
     pair_distances(np.array(state.origins), as_struct(pairs))

@@ -60,15 +60,14 @@ class TiltLimit(VelocityDamper):
         """``sin θ_min``."""
         return math.sin(self.min_tilt)
 
-    def labels(self, k: int) -> tuple[str, ...]:
+    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
         """``("probe/tilt",)``."""
         return ("probe/tilt",)
 
 
 @njit(cache=True)
-def tilt_cosine(origins, axes, frame_jacobians, du) -> float:  # type: ignore[no-untyped-def]
-    """``u = cos θ`` of the probe (the last frame) and ``∂u/∂Q`` into ``du`` (n,)."""
-    m = origins.shape[0] - 1
+def tilt_cosine(origins, axes, frame_jacobians, m, du) -> float:  # type: ignore[no-untyped-def]
+    """``u = cos θ`` of the probe (guarded frame ``m``) and ``∂u/∂Q`` into ``du`` (n,)."""
     jac = frame_jacobians[m]
     rho = math.hypot(origins[m, 0], origins[m, 1])
     rx, ry = origins[m, 0] / rho, origins[m, 1] / rho
@@ -82,10 +81,11 @@ def tilt_cosine(origins, axes, frame_jacobians, du) -> float:  # type: ignore[no
 
 
 @njit(cache=True)
-def tilt_distance(origins, axes, frame_jacobians, row, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
-    """Row ``row``: ``d = sin θ`` of the probe and ``∂d/∂Q = −(u / max(d, ε)) ∂u/∂Q``."""
+def tilt_distance(origins, axes, frame_jacobians, m, row, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
+    """Row ``row``: ``d = sin θ`` of the probe (frame ``m``) and
+    ``∂d/∂Q = −(u / max(d, ε)) ∂u/∂Q``."""
     du = gradient[row]
-    u = tilt_cosine(origins, axes, frame_jacobians, du)
+    u = tilt_cosine(origins, axes, frame_jacobians, m, du)
     d = math.sqrt(max(1.0 - u * u, 0.0))
     scale = -u / max(d, SIN_FLOOR)
     for c in range(du.shape[0]):
@@ -94,9 +94,9 @@ def tilt_distance(origins, axes, frame_jacobians, row, distance, gradient, usabl
 
 
 @njit(cache=True)
-def tilt_angle(origins, axes) -> float:  # type: ignore[no-untyped-def]
-    """The probe's tilt θ from the radial direction, rad, in [0, π]."""
-    m = origins.shape[0] - 1
+def tilt_angle(origins, axes, m) -> float:  # type: ignore[no-untyped-def]
+    """The tilt θ of the probe (guarded frame ``m``) from the radial direction, rad, in
+    [0, π]."""
     ox, oy = origins[m, 0], origins[m, 1]
     u = (axes[m, 0] * ox + axes[m, 1] * oy) / math.hypot(ox, oy)
     return math.acos(max(-1.0, min(1.0, u)))

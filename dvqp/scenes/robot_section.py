@@ -18,8 +18,8 @@ ANGLE = Bound(-1000.0, 1000.0, "rad")
 """A joint angle or a finite joint limit (``±inf``: no limit)."""
 JOINT_SPEED = Bound(0.0, 1000.0, "rad/s", strict=True)
 JOINT_WEIGHT = Bound(1e-6, 1e6)
-ROBOT_KEYS = ("model", "link_lengths", "urdf", "points", "tool", "q0", "q_min", "q_max", "qd_max",
-              "qdd_max", "weights")  # fmt: skip
+ROBOT_KEYS = ("model", "link_lengths", "urdf", "points", "tool", "rail", "q0", "q_min", "q_max",
+              "qd_max", "qdd_max", "weights")  # fmt: skip
 MODELS = ("ndt13",)
 
 
@@ -44,7 +44,7 @@ def _arm(f: Fields, t: dict[str, Any], base_dir: Path) -> Robot:
         model = f.string(t, "model", "robot")
         if model not in MODELS:
             f.fail("robot.model", f"unknown model {model!r} (known: {', '.join(MODELS)})")
-        for key in ("points", "tool"):
+        for key in ("points", "tool", "rail"):
             if key in t:
                 f.fail(join("robot", key), "only with 'urdf'")
         lengths = f.vector(t, "link_lengths", "robot", 7, within=LINK_LENGTH)
@@ -55,12 +55,13 @@ def _arm(f: Fields, t: dict[str, Any], base_dir: Path) -> Robot:
         f.fail("robot.link_lengths", "only with model = 'ndt13'")
     urdf = base_dir / f.string(t, "urdf", "robot")
     points, tool = f.strings(t, "points", "robot"), f.string(t, "tool", "robot")
+    rail = f.string(t, "rail", "robot") if "rail" in t else None
     if not urdf.is_file():
         f.fail("robot.urdf", f"no such file: {urdf}")
     try:
-        loaded = Robot.from_urdf(urdf, points, tool)
+        loaded = Robot.from_urdf(urdf, points, tool, rail=rail)
     except ParameterError as exc:
-        _frame_error(f, exc, tool)
+        _frame_error(f, exc, tool, rail)
     except DvqpError as exc:
         f.fail("robot.urdf", str(exc))
     except (ArithmeticError, ValueError, RuntimeError) as exc:  # Pinocchio on a strange model
@@ -69,7 +70,7 @@ def _arm(f: Fields, t: dict[str, Any], base_dir: Path) -> Robot:
     if limits["qd_max"] is None:
         limits["qd_max"] = loaded.qd_max
     with f.mapped("robot"):
-        return Robot(loaded.model, points, tool, name=loaded.name, **limits)
+        return Robot(loaded.model, points, tool, rail_frame=rail, name=loaded.name, **limits)
 
 
 def _limits(f: Fields, t: dict[str, Any], n: int) -> dict[str, NDArray[np.float64] | None]:
@@ -83,11 +84,12 @@ def _limits(f: Fields, t: dict[str, Any], n: int) -> dict[str, NDArray[np.float6
     }
 
 
-def _frame_error(f: Fields, exc: ParameterError, tool: str) -> None:
+def _frame_error(f: Fields, exc: ParameterError, tool: str, rail: str | None) -> None:
     """A URDF robot's complaint, named by the scene key it is about (model: ``robot.urdf``)."""
     if exc.name in ("model", "urdf"):
         f.fail("robot.urdf", exc.reason)
     if exc.name != "frames":
         f.fail(join("robot", exc.name), exc.reason)
-    key = "tool" if exc.reason.startswith(f"no frame named {tool!r}") else "points"
+    named = {f"no frame named {name!r}": key for key, name in (("tool", tool), ("rail", rail))}
+    key = next((k for start, k in named.items() if exc.reason.startswith(start)), "points")
     f.fail(join("robot", key), exc.reason)

@@ -32,7 +32,7 @@ def check_start(
         f.fail("robot.q0", str(exc))
     tool = state.tool
     heights = [*state.points[:, 2], tool[2]]
-    for i, (frame, h) in enumerate(zip(robot.frame_names, heights, strict=True)):
+    for i, (frame, h) in enumerate(zip(robot.frame_names[: len(heights)], heights, strict=True)):
         if h < 0.0:
             part = "the tool" if i == robot.n_points else f"body point {i + 1}"
             f.fail("robot.q0", f"{part} (frame {frame!r}) starts inside the pipe: h = {h:.4g} m")

@@ -94,7 +94,7 @@ def build(robot: Robot, radius: float, spec: StepSpec, recorded: ObstacleSet, q0
     sets += [d.obstacles for d in limits if type(d) is ObstacleDamper]
     union = _Union([*sets, recorded])
     n, k = robot.n, robot.n_points
-    plan = StepPlan(n, k, radius, len(union.shapes))
+    plan = StepPlan(n, k, radius, len(union.shapes), robot.has_rail)
     state = KinematicState.compute(robot, q0, radius)
     hooks = Hooks(plan, state, dt)
     table: dict[str, list] = {key: [] for key in MeasureArrays.__dataclass_fields__}
@@ -171,7 +171,7 @@ def _dampers(limits: Sequence[object], union: _Union, plan: StepPlan, hooks: Hoo
             continue
         if type(limit) in DAMPERS:
             start, count = _measured(limit, union, plan, table)
-            safe, labels = limit.safe, limit.labels(plan.k)
+            safe, labels = limit.safe, limit.labels(plan.k, plan.rail)
         else:
             start, count, safe, labels = hooks.damper(limit)
         if count == 0:
@@ -191,7 +191,7 @@ def _measured(limit: object, union: _Union, plan: StepPlan,
     k, kind = plan.k, type(limit)
     if kind is ObstacleDamper:
         members = union.members(limit.obstacles).tolist()
-        count = len(members) * (2 * k + 1)
+        count = len(members) * (2 * k + 1 + 2 * plan.rail)
     else:
         count = {SurfaceHeight: k, ProbeHeight: 1, TiltLimit: 1,
                  SelfCollision: plan.pairs.i.shape[0]}[kind]  # fmt: skip

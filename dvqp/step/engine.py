@@ -88,7 +88,7 @@ class Stepper(Verification):
                        if isinstance(resolver, QPResolver) else None)  # fmt: skip
         self.hooks = self.layout.hooks
         self._prepare = stages.prepare_baseline if self.arrays.pinv.baseline else stages.prepare
-        self.state = KinematicState.view(plan.state, radius)
+        self.state = KinematicState.view(plan.state, radius, plan.k)
         self.x = self.arrays.x
         self.record_at = self.arrays.record.index
         """(1,) int64: row of the samples the next concluded state is written to (−1: none)."""

@@ -33,7 +33,7 @@ class Hooks:
 
     def __init__(self, plan: StepPlan, start: KinematicState, dt: float) -> None:
         self.plan, self.start, self.dt = plan, start, dt
-        self.view = KinematicState.view(plan.state, plan.radius)
+        self.view = KinematicState.view(plan.state, plan.radius, plan.k)
         self.measured: list[Hook] = []
         self.assessed: list[Hook] = []
         self.prepared: list[Hook] = []

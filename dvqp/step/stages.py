@@ -107,7 +107,7 @@ def _distances(s) -> None:  # type: ignore[no-untyped-def]
         start, first, count = m.heights[i, 0], m.heights[i, 1], m.heights[i, 2]
         height_distances(st.guarded, st.guarded_jacobians, first, count, start, *out)
     for i in range(m.tilts.shape[0]):
-        tilt_distance(st.origins, st.axes, st.frame_jacobians, m.tilts[i], *out)
+        tilt_distance(st.origins, st.axes, st.frame_jacobians, s.model.tool, m.tilts[i], *out)
     for i in range(m.selves.shape[0]):
         self_distances(s.pairs, st.frame_jacobians, m.selves[i], *out)
 
@@ -129,21 +129,21 @@ def _conclude(s) -> None:  # type: ignore[no-untyped-def]
 @njit(cache=True, inline="always")
 def _diagnostics(s) -> None:  # type: ignore[no-untyped-def]
     """``[tilt, self distance, min clearance, probe clearance, closest part]`` (rad, m, m, m,
-    index ``r (2k + 1) + i`` of recorded obstacle r's point i, or ``+ k + 1`` of its link i)."""
-    st, near, out = s.state, s.near, s.diagnostics
-    out[0] = tilt_angle(st.origins, st.axes)
+    index ``r (m + L) + i`` of recorded obstacle r's point i, or ``+ m`` of its link i)."""
+    st, near, out, k = s.state, s.near, s.diagnostics, s.model.tool
+    out[0] = tilt_angle(st.origins, st.axes, k)
     out[1] = math.inf
     for p in range(s.pairs.distance.shape[0]):
         out[1] = min(out[1], s.pairs.distance[p])
-    m = near.point_distance.shape[1]
+    m, parts = near.point_distance.shape[1], near.point_distance.shape[1] + near.ends.shape[0]
     out[2], out[3], out[4] = math.inf, math.inf, -1.0
     for r in range(s.recorded.shape[0]):
         j = s.recorded[r]
-        for i in range(2 * m - 1):
+        for i in range(parts):
             d = near.point_distance[j, i] if i < m else near.link_distance[j, i - m]
             if d < out[2]:
-                out[2], out[4] = d, r * (2 * m - 1) + i
-        out[3] = min(out[3], near.point_distance[j, m - 1], near.link_distance[j, m - 2])
+                out[2], out[4] = d, r * parts + i
+        out[3] = min(out[3], near.point_distance[j, k], near.link_distance[j, k - 1])
 
 
 @njit(cache=True, inline="always")

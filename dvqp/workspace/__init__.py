@@ -1,11 +1,11 @@
 """The compiled step's memory: buffers allocated once per run, the rows each part owns, and the
 packing of many arrays into one numba struct. It imports no domain module of dvqp."""
 
-from dvqp.workspace.buffers import PairBuffers, ProximityBuffers, StateBuffers
+from dvqp.workspace.buffers import PairBuffers, ProximityBuffers, StateBuffers, link_ends
 from dvqp.workspace.plan import CheckBuffers, DamperBuffers, Kernel, QPBuffers, Slot, StepPlan
 from dvqp.workspace.struct import as_struct
 
 __all__ = [
     "CheckBuffers", "DamperBuffers", "Kernel", "PairBuffers", "ProximityBuffers", "QPBuffers",
-    "Slot", "StateBuffers", "StepPlan", "as_struct",
+    "Slot", "StateBuffers", "StepPlan", "as_struct", "link_ends",
 ]  # fmt: skip

@@ -24,13 +24,14 @@ class StateBuffers:
     ----------
     q : (n,)
         rad.
-    origins, axes : (k+1, 3)
-        Frame origins (m) and unit z axes of the k body points then the tool, base frame.
-    frame_jacobians : (k+1, 6, n)
+    origins, axes : (m, 3)
+        Frame origins (m) and unit z axes of the guarded frames, base frame: the k body points,
+        the tool, then the rail point if the arm has one (``m = k + 1`` or ``k + 2``).
+    frame_jacobians : (m, 6, n)
         ``[J_v; J_ω]`` in the base orientation (Pinocchio's LOCAL_WORLD_ALIGNED).
-    guarded : (k+1, 3)
-        DV ``[l, z, h]`` (m) of the body points then the probe (the tool point).
-    guarded_jacobians : (k+1, 3, n)
+    guarded : (m, 3)
+        DV ``[l, z, h]`` (m) of the body points, the probe (the tool point), the rail point.
+    guarded_jacobians : (m, 3, n)
         Their ``∂[l, z, h]/∂Q``.
     tool : (4,)
         ``[l, z, h, α]``.
@@ -48,32 +49,43 @@ class StateBuffers:
     tool_jacobian: Array
 
     @classmethod
-    def allocate(cls, n: int, k: int) -> StateBuffers:
-        """Zeroed buffers for n joints and k body points."""
-        m = k + 1
+    def allocate(cls, n: int, k: int, rail: bool = False) -> StateBuffers:
+        """Zeroed buffers for n joints, k body points and the rail point if ``rail``."""
+        m = k + 1 + rail
         return cls(np.zeros(n), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 6, n)),
                    np.zeros((m, 3)), np.zeros((m, 3, n)), np.zeros(4),
                    np.zeros((4, n)))  # fmt: skip
 
 
+def link_ends(k: int, rail: bool = False) -> NDArray[np.int64]:
+    """The guarded links as guarded-point indices ``(L, 2)``: body link i (``i < k − 1``) and the
+    probe holder (``i = k − 1``) join points i and i+1; the carriage link (``i = k``, with a
+    rail point) joins the rail point (``k + 1``) to body point 1 (0)."""
+    ends = [(i, i + 1) for i in range(k)] + ([(k + 1, 0)] if rail else [])
+    return np.array(ends, dtype=np.int64).reshape(-1, 2)
+
+
 @dataclass(frozen=True)
 class ProximityBuffers:
-    """Signed distances of the k+1 guarded points and the k guarded links to J obstacles.
+    """Signed distances of the m guarded points and the L guarded links to J obstacles.
 
-    Index i < k is body point i+1, i = k the probe; link i < k−1 is body link i+1, link k−1 the
-    probe holder (last body point to the tool).
+    Point i < k is body point i+1, i = k the probe, i = k+1 the rail point (if any); the links
+    are :func:`link_ends`'s (``ends``): the body links, the probe holder, the carriage link.
 
     Attributes
     ----------
-    point_distance, point_penalty : (J, k+1)
+    ends : (L, 2) int64
+        The points each link joins (constant).
+    point_distance, point_penalty : (J, m)
         Signed distance ``d`` (m, negative inside) and the objective's penalty ``e`` (m²).
-    point_normal, point_penalty_gradient : (J, k+1, 2)
+    point_normal, point_penalty_gradient : (J, m, 2)
         ``∇d`` and ``∇e`` with respect to the point's ``[l, z]``.
-    link_distance, link_penalty, link_t : (J, k)
-        The same at each link's closest point ``p_i + t (p_{i+1} − p_i)``, and its ``t``.
-    link_normal, link_penalty_gradient : (J, k, 2)
+    link_distance, link_penalty, link_t : (J, L)
+        The same at each link's closest point ``p_a + t (p_b − p_a)``, and its ``t``.
+    link_normal, link_penalty_gradient : (J, L, 2)
     """
 
+    ends: NDArray[np.int64]
     point_distance: Array
     point_normal: Array
     point_penalty: Array
@@ -85,19 +97,28 @@ class ProximityBuffers:
     link_t: Array
 
     @classmethod
-    def allocate(cls, count: int, k: int) -> ProximityBuffers:
-        """Zeroed buffers for ``count`` obstacles and k body points."""
-        p, s = (count, k + 1), (count, k)
-        return cls(np.zeros(p), np.zeros((*p, 2)), np.zeros(p), np.zeros((*p, 2)), np.zeros(s),
-                   np.zeros((*s, 2)), np.zeros(s), np.zeros((*s, 2)), np.zeros(s))  # fmt: skip
+    def allocate(cls, count: int, k: int, rail: bool = False) -> ProximityBuffers:
+        """Zeroed buffers for ``count`` obstacles, k body points and the rail point if ``rail``."""
+        return cls.sized(count, k + 1 + rail, link_ends(k, rail))
+
+    @classmethod
+    def sized(cls, count: int, points: int, ends: NDArray[np.int64]) -> ProximityBuffers:
+        """Zeroed buffers for ``count`` obstacles, ``points`` points and the links ``ends``."""
+        p, s = (count, points), (count, ends.shape[0])
+        return cls(np.ascontiguousarray(ends, dtype=np.int64), np.zeros(p), np.zeros((*p, 2)),
+                   np.zeros(p), np.zeros((*p, 2)), np.zeros(s), np.zeros((*s, 2)), np.zeros(s),
+                   np.zeros((*s, 2)), np.zeros(s))  # fmt: skip
 
 
 @dataclass(frozen=True)
 class PairBuffers:
-    """The non-adjacent guarded link pairs ``(i, j)``, ``j ≥ i + 2``, and their closest points.
+    """The pairs ``(i, j)``, ``i < j``, of guarded links that share no point, and their closest
+    points.
 
     Attributes
     ----------
+    ends : (L, 2) int64
+        The points each link joins (:func:`link_ends`).
     i, j : (P,) int64
         Link indices (constant for a run).
     distance, s, t : (P,)
@@ -106,6 +127,7 @@ class PairBuffers:
         Unit ``c_i − c_j``.
     """
 
+    ends: NDArray[np.int64]
     i: NDArray[np.int64]
     j: NDArray[np.int64]
     distance: Array
@@ -114,9 +136,12 @@ class PairBuffers:
     t: Array
 
     @classmethod
-    def allocate(cls, k: int) -> PairBuffers:
-        """The pairs among the k guarded links, geometry zeroed."""
-        i, j = np.triu_indices(k, 2)
+    def allocate(cls, k: int, rail: bool = False) -> PairBuffers:
+        """The pairs among the guarded links of k body points (and the rail point if
+        ``rail``), geometry zeroed."""
+        ends = link_ends(k, rail)
+        pairs = [(a, b) for a in range(len(ends)) for b in range(a + 1, len(ends))
+                 if not set(ends[a]) & set(ends[b])]  # fmt: skip
+        i, j = np.array(pairs, dtype=np.int64).reshape(-1, 2).T.copy()
         p = i.shape[0]
-        return cls(i.astype(np.int64), j.astype(np.int64), np.zeros(p), np.zeros((p, 3)),
-                   np.zeros(p), np.zeros(p))  # fmt: skip
+        return cls(ends, i, j, np.zeros(p), np.zeros((p, 3)), np.zeros(p), np.zeros(p))

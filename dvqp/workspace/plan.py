@@ -112,6 +112,9 @@ class StepPlan:
         Pipe radius, m.
     obstacles
         Obstacles whose proximity every state computes (the union of the run's sets).
+    rail
+        Whether the arm has a rail point (a guarded point after the tool, and the carriage
+        link from it to body point 1).
 
     Attributes
     ----------
@@ -127,11 +130,12 @@ class StepPlan:
         The finalised arrays (None before :meth:`finalize`).
     """
 
-    def __init__(self, n: int, k: int, radius: float, obstacles: int = 0) -> None:
-        self.n, self.k, self.radius = n, k, float(radius)
-        self.state = StateBuffers.allocate(n, k)
-        self.proximity = ProximityBuffers.allocate(obstacles, k)
-        self.pairs = PairBuffers.allocate(k)
+    def __init__(self, n: int, k: int, radius: float, obstacles: int = 0,
+                 rail: bool = False) -> None:  # fmt: skip
+        self.n, self.k, self.radius, self.rail = n, k, float(radius), bool(rail)
+        self.state = StateBuffers.allocate(n, k, rail)
+        self.proximity = ProximityBuffers.allocate(obstacles, k, rail)
+        self.pairs = PairBuffers.allocate(k, rail)
         self.dt, self.command = np.zeros(1), np.zeros(4)
         self.objective_value, self.objective_gradient = np.zeros(1), np.zeros(n)
         self.lb, self.ub = np.full(n, -np.inf), np.full(n, np.inf)
