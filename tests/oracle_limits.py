@@ -206,13 +206,7 @@ def measure(limit: object, state: KinematicState) -> Measured:
     if type(limit) is ObstacleDamper:
         return _clearances(limit, state)
     if type(limit) in (SurfaceHeight, ProbeHeight):
-        rows = slice(0, k) if type(limit) is SurfaceHeight else slice(k, k + 1)
-        labels = (tuple(f"point{i + 1}/height" for i in range(k))
-                  if type(limit) is SurfaceHeight else ("probe/height",))  # fmt: skip
-        value = np.array(state.guarded[rows, 2])
-        gradient = np.array(state.guarded_jacobians[rows, 2, :])
-        return Measured(value, gradient, np.full(value.shape, limit.safe), labels,
-                        np.ones(value.shape, bool))  # fmt: skip
+        return _heights(limit, state)
     if type(limit) is TiltLimit:
         u, du = tilt_cosine(state)
         d = tilt_sine(state)
@@ -233,6 +227,51 @@ def measure(limit: object, state: KinematicState) -> Measured:
         return Measured(value, np.asarray(found.gradient).reshape(-1, n), safe, labels,
                         value < limit.reach)  # fmt: skip
     raise TypeError(f"{type(limit).__name__} keeps no distances")
+
+
+def chord_low(a: Array, b: Array, radius: float) -> tuple[float, float]:
+    """Height (m) of the lowest point of the 3-D segment ``a → b`` and its parameter, by a
+    ternary search of the convex ``‖xy(a + t (b − a))‖²`` (not dvqp's closed form)."""
+
+    def rho2(t: float) -> float:
+        p = a[:2] + t * (b[:2] - a[:2])
+        return float(p @ p)
+
+    lo, hi = 0.0, 1.0
+    for _ in range(200):
+        m1, m2 = lo + (hi - lo) / 3, hi - (hi - lo) / 3
+        lo, hi = (lo, m2) if rho2(m1) <= rho2(m2) else (m1, hi)
+    t = 0.5 * (lo + hi)
+    return math.sqrt(rho2(t)) - radius, t
+
+
+def _heights(limit: object, state: KinematicState) -> Measured:
+    """The points' heights (their DV rows' gradient), then the lowest point of each link chord
+    (body links and carriage for the body; the holder for the probe; gradient by differences)."""
+    k, o = state.k, np.asarray(state.origins)
+    body = type(limit) is SurfaceHeight
+    points = list(range(k)) if body else [k]
+    links = [*range(k - 1), *([k] if state.rail else [])] if body else [k - 1]
+    ends = guarded_links(k, state.rail)
+
+    def inside(a: Array, b: Array) -> bool:  # the lowest point inside the link: ρ² falls at a
+        e = b[:2] - a[:2]  # and rises at b (by more than round-off)
+        return bool(a[:2] @ e < -1e-9 * (e @ e) and b[:2] @ e > 1e-9 * (e @ e))
+
+    def low(i: int) -> float:  # at an end: that end's own height (its row's)
+        a, b = o[ends[i, 0]], o[ends[i, 1]]
+        if inside(a, b):
+            return chord_low(a, b, state.radius)[0]
+        e = b[:2] - a[:2]
+        return float(state.guarded[ends[i, 0] if a[:2] @ e >= -1e-9 * (e @ e) else ends[i, 1], 2])
+
+    value = np.array([*state.guarded[points, 2], *(low(i) for i in links)])
+    labels = (*(f"{point_name(i, k)}/height" for i in points),
+              *(f"{link_name(i, k)}/height" for i in links))  # fmt: skip
+
+    applies = [inside(o[ends[i, 0]], o[ends[i, 1]]) for i in links]
+    return Measured(value, None, np.full(value.shape, limit.safe), labels,  # type: ignore[attr-defined]
+                    np.array([True] * len(points) + applies))  # fmt: skip
 
 
 def _clearances(limit: ObstacleDamper, state: KinematicState) -> Measured:

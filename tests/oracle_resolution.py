@@ -35,7 +35,7 @@ from dvqp.limits import (
     SurfaceHeight,
     TiltLimit,
 )
-from tests.oracle_limits import guarded_links, link_pairs
+from tests.oracle_limits import chord_low, guarded_links, link_pairs
 
 Array = NDArray[np.float64]
 
@@ -77,6 +77,11 @@ class Frames:
     guarded: Array
     tool: Array
     k: int
+
+    @property
+    def rail(self) -> bool:
+        """Whether the arm's rail point is among the frames (after the tool)."""
+        return self.origins.shape[0] > self.k + 1
 
 
 def frames(robot: Robot, q: Array, radius: float) -> Frames:
@@ -238,11 +243,14 @@ def verified_values(limits: tuple, robot: Robot, q: Array, radius: float) -> lis
             links = link_distances(limit.obstacles, f.guarded, period, f.k)
             values = np.concatenate([points.ravel(), links.ravel()])
             out.append(Verified(values, limit.margin, limit.tolerance, limit.quantity))
-        elif kind is SurfaceHeight:
-            out.append(Verified(f.guarded[: f.k, 2], limit.min_height, limit.tolerance,
-                                limit.quantity))  # fmt: skip
-        elif kind is ProbeHeight:
-            out.append(Verified(f.guarded[f.k : f.k + 1, 2], limit.floor, limit.tolerance,
+        elif kind in (SurfaceHeight, ProbeHeight):
+            body = kind is SurfaceHeight
+            links = [*range(f.k - 1), *([f.k] if f.rail else [])] if body else [f.k - 1]
+            ends = guarded_links(f.k, f.rail)
+            lows = [chord_low(f.origins[ends[i, 0]], f.origins[ends[i, 1]], radius)[0]
+                    for i in links]  # fmt: skip
+            heights = f.guarded[: f.k, 2] if body else f.guarded[f.k : f.k + 1, 2]
+            out.append(Verified(np.concatenate([heights, lows]), limit.safe, limit.tolerance,
                                 limit.quantity))  # fmt: skip
         elif kind is TiltLimit and limit.min_tilt > 0.0:
             angle = tilt(f)

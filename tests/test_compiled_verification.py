@@ -101,7 +101,9 @@ def expected_rows(limit: object, k: int, pairs: int, rail: bool) -> int:
         return len(limit.obstacles) * (2 * k + 1 + 2 * rail)
     if isinstance(limit, TiltLimit):
         return int(limit.min_tilt > 0.0)
-    return {"SurfaceHeight": k, "ProbeHeight": 1, "SelfCollision": pairs}[type(limit).__name__]
+    # heights: the points, then the link chords (body links and carriage; the holder)
+    return {"SurfaceHeight": 2 * k - 1 + rail, "ProbeHeight": 2,
+            "SelfCollision": pairs}[type(limit).__name__]  # fmt: skip
 
 
 def test_every_bundled_scene_s_limits_are_in_its_step() -> None:

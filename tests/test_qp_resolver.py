@@ -166,7 +166,9 @@ def test_limits_hold_along_a_jog_that_breaks_them_with_the_pseudoinverse(q0: np.
     ]
     objective = objective_with(obstacles)
     obstacle_set = objective.terms[1].obstacles  # type: ignore[attr-defined]
-    spec = paper_spec(robot, objective, obstacle_set, 0.06, margin=0.005, influence=0.05)
+    # A floor of 0.06 m would hold the link chords so high that the last 40 ms of the command
+    # become infeasible (relaxed, with a reported task error): 0.055 m leaves room.
+    spec = paper_spec(robot, objective, obstacle_set, 0.055, margin=0.005, influence=0.05)
     cmd = jog_commands(
         [
             JogSegment(1.0, np.array([0.0, 0.06, 0, 0])),
@@ -186,7 +188,7 @@ def test_limits_hold_along_a_jog_that_breaks_them_with_the_pseudoinverse(q0: np.
     assert np.all(qp.q <= robot.q_max + 1e-9) and np.all(qp.q >= robot.q_min - 1e-9)
     assert np.all(np.abs(qp.qdot) <= robot.qd_max + 1e-6)  # solver tolerance
     # Height and clearance are linearised one step ahead: allow second-order overshoot only.
-    assert qp.points[:, :, 2].min() >= 0.06 - 1e-4
+    assert qp.points[:, :, 2].min() >= 0.055 - 1e-4
     assert qp.min_clearance.min() > 0.0
     start_outside = clearance_history(qp, obstacles)[0] > 0
     assert np.all(clearance_history(qp, obstacles)[:, start_outside] > 0)

@@ -1,11 +1,18 @@
-"""Heights over the pipe surface: the body points above a minimum, the probe out of the wall.
+"""Heights over the pipe surface: the body above a minimum, the probe out of the wall.
 
-Both are dampers of the guarded points' height ``h`` (m), ``∂h/∂Q`` the third row of their DV
-Jacobian (compiled: :func:`height_distances`).
+Both are dampers of heights ``h`` (m) over the surface: of guarded points (``∂h/∂Q`` the third
+row of their DV Jacobian, compiled: :func:`height_distances`) and of the lowest point of guarded
+links (:func:`chord_heights`). A link is a straight 3-D chord between its ends, which dips below
+them: with ``P(t) = A + t (B − A)`` its distance from the pipe axis ``ρ(t) = ‖a + t e‖``
+(``a``, ``e`` the xy parts of ``A``, ``B − A``) is least at ``t* = clamp(−a·e / e·e, 0, 1)``,
+so ``h = ρ(t*) − R`` exactly, and ``∂h/∂Q = (P_xy(t*)/ρ)ᵀ ((1 − t*) J_A + t* J_B)`` (the
+envelope theorem: moving ``t*`` does not change ``ρ`` to first order). A chord's row applies
+where ``t*`` is inside the link (by more than 1e-9); at an end, that point's own row holds.
 """
 
 from __future__ import annotations
 
+import math
 from typing import ClassVar
 
 import numpy as np
@@ -16,7 +23,9 @@ from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
 
 
 class SurfaceHeight(VelocityDamper):
-    """``h_i ≥ h_min`` for every body point, one damper row each (``"point3/height"``).
+    """``h ≥ h_min`` for every body point and the lowest point of every body link (and of the
+    carriage link), one damper row each (``"point3/height"``, ``"link2/height"``,
+    ``"carriage/height"``).
 
     Parameters
     ----------
@@ -47,12 +56,15 @@ class SurfaceHeight(VelocityDamper):
         return self.min_height
 
     def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
-        """``"point1/height"``, ... one per body point."""
-        return tuple(f"point{i + 1}/height" for i in range(k))
+        """``"point1/height"``, ... one per body point, then per body link (and the carriage
+        link if ``rail``)."""
+        links = (*(f"link{i + 1}" for i in range(k - 1)), *(("carriage",) if rail else ()))
+        return (*(f"point{i + 1}/height" for i in range(k)), *(f"{a}/height" for a in links))
 
 
 class ProbeHeight(VelocityDamper):
-    """``h_tool ≥ floor`` for the probe (the tool point), one damper row ``"probe/height"``.
+    """``h ≥ floor`` for the probe (the tool point) and the lowest point of its holder, two
+    damper rows (``"probe/height"``, ``"holder/height"``).
 
     The body points keep ``min_height`` (:class:`SurfaceHeight`); the probe, which inspects the
     surface, only has to stay out of the pipe wall.
@@ -85,8 +97,8 @@ class ProbeHeight(VelocityDamper):
         return self.floor
 
     def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
-        """``("probe/height",)``."""
-        return ("probe/height",)
+        """``("probe/height", "holder/height")``."""
+        return ("probe/height", "holder/height")
 
 
 def _finite(name: str, value: float) -> float:
@@ -104,3 +116,31 @@ def height_distances(guarded, jacobians, first, count, start, distance, gradient
         distance[r], usable[r] = guarded[p, 2], True
         for c in range(gradient.shape[1]):
             gradient[r, c] = jacobians[p, 2, c]
+
+
+@njit(cache=True)
+def chord_heights(
+    guarded, origins, frame_jacobians, ends, radius, chords, distance, gradient, usable
+) -> None:  # type: ignore[no-untyped-def]
+    """The height (m) of the lowest point of guarded link ``chords[c, 1]`` (joining guarded
+    frames ``ends[link]``; ``origins`` (m, 3), ``frame_jacobians`` (m, 6, n)) and its
+    ``∂h/∂Q`` (see the module docstring) into row ``chords[c, 0]``, for each row c of
+    ``chords`` (C, 2). Where the lowest point is an end, the height is that end's own
+    (``guarded`` (m, 3)), so that it ties exactly with the end's row."""
+    for c in range(chords.shape[0]):
+        r, a, b = chords[c, 0], ends[chords[c, 1], 0], ends[chords[c, 1], 1]
+        ax, ay = origins[a, 0], origins[a, 1]
+        ex, ey = origins[b, 0] - ax, origins[b, 1] - ay
+        length2 = ex * ex + ey * ey
+        t = min(max(-(ax * ex + ay * ey) / length2, 0.0), 1.0) if length2 > 0.0 else 0.0
+        px, py = ax + t * ex, ay + t * ey
+        rho = math.hypot(px, py)
+        # a row where t* is inside the link (not at an end, or within round-off of one: the
+        # carriage link of a rail arm lies in the tangent plane at the rail point, t* = 0)
+        usable[r] = 1e-9 < t < 1.0 - 1e-9 and rho > 0.0
+        distance[r] = rho - radius if usable[r] else guarded[a if t < 0.5 else b, 2]
+        ux, uy = px / max(rho, 1e-300), py / max(rho, 1e-300)
+        for q in range(gradient.shape[1]):
+            jx = (1.0 - t) * frame_jacobians[a, 0, q] + t * frame_jacobians[b, 0, q]
+            jy = (1.0 - t) * frame_jacobians[a, 1, q] + t * frame_jacobians[b, 1, q]
+            gradient[r, q] = ux * jx + uy * jy

@@ -140,6 +140,8 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
         dt, jog, path, ramp = sec.motion(f, doc)
     with f.guard("robot.q0"):
         start.check_start(f, robot, q0, radius, obstacles)
+    with f.guard("constraints"):
+        start.check_floor(f, robot, q0, radius, limits)
     stem = "scene" if source.startswith("<") else Path(source).stem
     return Scene(
         name=f.string(doc, "name", "", stem), description=f.string(doc, "description", "", ""),

@@ -3,7 +3,9 @@
 A start that puts a body point or the tool inside the pipe (h < 0), or the tool inside an
 obstacle, is refused. A body point below ``[constraints] min_height`` or within an obstacle's
 margin is allowed: the QP's dampers then forbid it to get worse and the objective pushes it
-out (``docs/scenes.md``).
+out (``docs/scenes.md``). But a ``min_height`` above the rail point, where the rail holds it at
+a fixed height, can never be met: the carriage link rises from that point, so its lowest point
+is at most that high. Such a scene is refused with both numbers.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.proximity import distances
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
+from dvqp.limits.height import SurfaceHeight
 from dvqp.scenes.fields import Fields, join
 
 
@@ -45,3 +48,34 @@ def check_start(
                 f"covers the tool's start point [l, z] = [{tool[0]:.4g}, {tool[1]:.4g}] m "
                 f"({-d * 1e3:.3g} mm inside the {o.kind})",
             )
+
+
+def check_floor(
+    f: Fields, robot: Robot, q0: NDArray[np.float64], radius: float, limits: tuple[object, ...]
+) -> None:
+    """Refuse a ``min_height`` above the height of a rail point that no joint can raise.
+
+    The rail point's height is fixed when it is the same (to 1e-9 m) at the start and at eight
+    configurations drawn within the joint limits (it depends analytically on the joints, so a
+    height that moves would not repeat by chance); a rail that moves is left to the run.
+    """
+    floors = [x.min_height for x in limits if isinstance(x, SurfaceHeight)]
+    if not floors or not robot.has_rail:
+        return
+    low = np.where(np.isfinite(robot.q_min), robot.q_min, -np.pi)
+    high = np.where(np.isfinite(robot.q_max), robot.q_max, np.pi)
+    draws = np.random.default_rng(0).uniform(low, high, size=(8, robot.n))
+    heights = []
+    for q in (q0, *draws):
+        try:
+            heights.append(float(KinematicState.compute(robot, q, radius).guarded[-1, 2]))
+        except DvqpError:  # a singular draw proves nothing either way
+            continue
+    rail = heights[0]
+    if max(floors) > rail and np.ptp(heights) <= 1e-9:
+        f.fail(
+            "constraints.min_height",
+            f"{max(floors):.4g} m is above the rail point (frame {robot.rail_frame!r}), which "
+            f"the rail holds at h = {rail:.4g} m: the carriage link rising from it can never "
+            "be that high",
+        )

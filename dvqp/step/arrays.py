@@ -64,14 +64,16 @@ class MeasureArrays:
     :class:`~dvqp.tasks.ToolTask` (``tool_rows``); each obstacle damper's first row
     (``obstacle_start`` (O,)) and obstacles ``members[offsets[o]:offsets[o+1]]``
     (``obstacle_members`` (M,), ``obstacle_offsets`` (O + 1,)); ``[first row, first guarded
-    point, count]`` of each height damper (``heights`` (H, 3)); the first row of each tilt and
-    self-collision damper (``tilts``, ``selves``)."""
+    point, count]`` of each height damper (``heights`` (H, 3)) and ``[row, link]`` of each of
+    their link chords (``chords`` (C, 2)); the first row of each tilt and self-collision damper
+    (``tilts``, ``selves``)."""
 
     tool_rows: Index
     obstacle_start: Index
     obstacle_offsets: Index
     obstacle_members: Index
     heights: Index
+    chords: Index
     tilts: Index
     selves: Index
 

@@ -110,7 +110,8 @@ def build(robot: Robot, radius: float, spec: StepSpec, recorded: ObstacleSet, q0
         if type(limit) not in BOUNDS and not isinstance(limit, VelocityDamper):
             hooks.limit(limit)
     measures = MeasureArrays(**{key: np.array(rows, dtype=np.int64) for key, rows in table.items()})
-    measures = replace(measures, heights=measures.heights.reshape(-1, 3))
+    measures = replace(measures, heights=measures.heights.reshape(-1, 3),
+                       chords=measures.chords.reshape(-1, 2))  # fmt: skip
     layout = Layout(plan, tuple(union.shapes), objective, _bounds(limits, n), measures, params,
                     hooks)  # fmt: skip
     _verified(layout, limits, blocks, n)
@@ -188,13 +189,15 @@ def _dampers(limits: Sequence[object], union: _Union, plan: StepPlan, hooks: Hoo
 def _measured(limit: object, union: _Union, plan: StepPlan,
               table: dict[str, list]) -> tuple[int, int]:  # fmt: skip
     """Rows of one of dvqp's dampers: ``(first row, count)``, its instance recorded."""
-    k, kind = plan.k, type(limit)
+    k, kind, members = plan.k, type(limit), []
+    # heights: (points, link chords): the body points, links and carriage; the probe, holder
+    points, chords = {SurfaceHeight: (k, [*range(k - 1), *([k] if plan.rail else [])]),
+                      ProbeHeight: (1, [k - 1])}.get(kind, (0, []))  # fmt: skip
     if kind is ObstacleDamper:
         members = union.members(limit.obstacles).tolist()
         count = len(members) * (2 * k + 1 + 2 * plan.rail)
     else:
-        count = {SurfaceHeight: k, ProbeHeight: 1, TiltLimit: 1,
-                 SelfCollision: plan.pairs.i.shape[0]}[kind]  # fmt: skip
+        count = points + len(chords) or {TiltLimit: 1, SelfCollision: plan.pairs.i.shape[0]}[kind]
     if count == 0:
         return 0, 0
     start = plan.damper_rows(count)[0].start
@@ -202,8 +205,9 @@ def _measured(limit: object, union: _Union, plan: StepPlan,
         table["obstacle_start"].append(start)
         table["obstacle_members"].extend(members)
         table["obstacle_offsets"].append(len(table["obstacle_members"]))
-    elif kind in (SurfaceHeight, ProbeHeight):
-        table["heights"].append((start, 0, k) if kind is SurfaceHeight else (start, k, 1))
+    elif points:
+        table["heights"].append((start, 0 if kind is SurfaceHeight else k, points))
+        table["chords"].extend((start + points + c, link) for c, link in enumerate(chords))
     else:
         table["tilts" if kind is TiltLimit else "selves"].append(start)
     return start, count

@@ -20,7 +20,7 @@ from dvqp.kinematics.model import kinematics
 from dvqp.limits.acceleration import acceleration_bounds
 from dvqp.limits.damper import damper_rows, damper_values
 from dvqp.limits.excess import worst_excess
-from dvqp.limits.height import height_distances
+from dvqp.limits.height import chord_heights, height_distances
 from dvqp.limits.joints import joint_room, position_bounds, velocity_bounds
 from dvqp.limits.obstacle_damper import obstacle_distances
 from dvqp.limits.self_collision import pair_distances, self_distances
@@ -106,6 +106,8 @@ def _distances(s) -> None:  # type: ignore[no-untyped-def]
     for i in range(m.heights.shape[0]):
         start, first, count = m.heights[i, 0], m.heights[i, 1], m.heights[i, 2]
         height_distances(st.guarded, st.guarded_jacobians, first, count, start, *out)
+    chord_heights(st.guarded, st.origins, st.frame_jacobians, s.near.ends, s.radius, m.chords,
+                  *out)  # fmt: skip
     for i in range(m.tilts.shape[0]):
         tilt_distance(st.origins, st.axes, st.frame_jacobians, s.model.tool, m.tilts[i], *out)
     for i in range(m.selves.shape[0]):

@@ -7,9 +7,12 @@ to pull a drift below their safe value back (QP runs moved by at most 2e-4 rad; 
 did not move). Rewritten again when runs began to end at rest: each run gained its braking
 steps (one, two on weld-circumference's QP runs, five on joint-limit's), the samples before
 them bit for bit those of the code before (the file then stored differed from them by up to
-2.1e-12 rad/s, from the code of its own time). ``tests/test_reference_runs.py`` checks that
-today's code reproduces it within 1e-9. Run ``python tests/data/make_reference_runs.py`` only
-when a change of results is intended, and say why in the commit.
+2.1e-12 rad/s, from the code of its own time). Rewritten when the link chords' lowest points
+joined the height floor: joint-limit's and narrow-passage's QP runs hold a chord at
+``min_height`` and moved by up to 0.099 and 0.068 rad; every other run is as it was.
+``tests/test_reference_runs.py`` checks that today's code reproduces it within 1e-9. Run
+``python tests/data/make_reference_runs.py`` only when a change of results is intended, and say
+why in the commit.
 """
 
 from __future__ import annotations
