@@ -274,6 +274,33 @@ def _heights(limit: object, state: KinematicState) -> Measured:
                     np.array([True] * len(points) + applies))  # fmt: skip
 
 
+def bend(a: Array, b: Array) -> tuple[float, float]:
+    """``(g, t*)``: the largest (signed) ``θ(t) − t Δφ`` (rad) of the 3-D link ``a → b`` (the
+    DV image's departure from the straight DV segment, over R) and where, by sampling then a
+    bisection of its slope (not dvqp's quadratic)."""
+    e = b[:2] - a[:2]
+    phi = math.atan2(a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1])
+    t = np.linspace(0.0, 1.0, 2001)
+    p = a[None, :2] + t[:, None] * e[None]
+    g = np.unwrap(np.arctan2(p[:, 1], p[:, 0]) - math.atan2(a[1], a[0])) - t * phi
+    g -= g[0]
+    i = int(np.argmax(np.abs(g)))
+    if abs(g[i]) < 1e-15 or i in (0, t.size - 1):
+        return 0.0, 0.0
+
+    def slope(u: float) -> float:  # θ'(u) − Δφ
+        x, y = a[0] + u * e[0], a[1] + u * e[1]
+        return (x * e[1] - y * e[0]) / (x * x + y * y) - phi
+
+    lo, hi = t[i - 1], t[i + 1]
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if (slope(mid) > 0) == (slope(lo) > 0) else (lo, mid)
+    u = 0.5 * (lo + hi)
+    x, y = a[0] + u * e[0], a[1] + u * e[1]
+    return math.atan2(a[0] * y - a[1] * x, a[0] * x + a[1] * y) - u * phi, u
+
+
 def _clearances(limit: ObstacleDamper, state: KinematicState) -> Measured:
     """Every (point, obstacle) then every (link, obstacle) clearance, obstacle-major, with the
     old NumPy gradient ``n · ∂p/∂Q`` (a link: at its closest point, an envelope)."""

@@ -1,10 +1,11 @@
 """Limits of a configuration recomputed independently of dvqp, for the tests.
 
 The frames come from Pinocchio, not dvqp's compiled kinematics; clearances from every shape's
-signed distance written in NumPy, each guarded link sampled densely in the developed view (not
-the closest-point computations the planner uses); heights and tilt from the frames' Cartesian
-positions; self distances from an exact closest-point formulation of its own
-(``tests/oracle_resolution.py``).
+signed distance written in NumPy, each guarded link taken as the real straight 3-D segment,
+sampled densely and each sample mapped to the developed view (not the closest-point
+computations the planner uses); heights of the points and of those sampled links (the body
+links' lowest points, the holder's) and the tilt from the frames' Cartesian positions; self
+distances from an exact closest-point formulation of its own (``tests/oracle_resolution.py``).
 """
 
 from __future__ import annotations
@@ -13,9 +14,11 @@ import math
 
 import numpy as np
 
-from dvqp import Scene
+from dvqp import KinematicState, Scene
+from dvqp.geometry import link_bends
 from dvqp.limits import ObstacleDamper, SurfaceHeight, TiltLimit
-from tests.oracle_resolution import Frames, frames, link_distances, point_distances
+from tests.oracle_limits import guarded_links
+from tests.oracle_resolution import Frames, frames, point_distances
 from tests.oracle_resolution import tilt as frame_tilt
 
 
@@ -32,18 +35,35 @@ def clearances(scene: Scene, q: np.ndarray) -> tuple[float, float]:
     if not len(scene.obstacles):
         return math.inf, math.inf
     f = _frames(scene, q)
-    g, k = f.guarded, f.k  # points 1..k, the tool, the rail point
-    period = 2.0 * math.pi * scene.pipe_radius
-    links = link_distances(scene.obstacles, g, period, k)  # the links' ends included
-    points = point_distances(scene.obstacles, g[:, :2], period)
+    k, radius = f.k, scene.pipe_radius
+    period = 2.0 * math.pi * radius
+    links = np.array([[*point_distances(scene.obstacles, _dv(p, radius), period).min(axis=1)]
+                      for p in _links(f)]).T  # (J, L), the links' ends included  # fmt: skip
+    points = point_distances(scene.obstacles, f.guarded[:, :2], period)
     return float(min(links.min(), points.min())), float(links[:, k - 1].min())
 
 
+def _links(f: Frames, samples: int = 801) -> list[np.ndarray]:
+    """Every guarded link as the real 3-D segment, ``samples`` points each (m, (samples, 3))."""
+    t = np.linspace(0.0, 1.0, samples)[:, None]
+    rail = f.origins.shape[0] > f.k + 1
+    return [f.origins[a] + t * (f.origins[b] - f.origins[a]) for a, b in guarded_links(f.k, rail)]
+
+
+def _dv(p: np.ndarray, radius: float) -> np.ndarray:
+    """``[l, z]`` of 3-D points (m): ``l = R atan2(y, x)``."""
+    return np.column_stack([radius * np.arctan2(p[:, 1], p[:, 0]), p[:, 2]])
+
+
 def heights(scene: Scene, q: np.ndarray) -> tuple[float, float]:
-    """Lowest body point height and the probe's height over the surface, m (from x, y)."""
+    """Lowest height over the surface (m, from x, y) of the body (its points and the sampled
+    body and carriage links) and of the probe with its holder."""
     f = _frames(scene, q)
-    rho = np.hypot(f.origins[:, 0], f.origins[:, 1]) - scene.pipe_radius
-    return float(rho[: f.k].min()), float(rho[f.k])
+    k, radius = f.k, scene.pipe_radius
+    links = [float(np.hypot(p[:, 0], p[:, 1]).min()) - radius for p in _links(f)]
+    rho = np.hypot(f.origins[:, 0], f.origins[:, 1]) - radius
+    body = min(rho[:k].min(), *links[: k - 1], *links[k:])
+    return float(body), float(min(rho[k], links[k - 1]))
 
 
 def tilt(scene: Scene, q: np.ndarray) -> float:
@@ -52,8 +72,22 @@ def tilt(scene: Scene, q: np.ndarray) -> float:
     return min(angle, math.pi - angle)
 
 
+def between(qs: np.ndarray, count: int) -> np.ndarray:
+    """The samples ``qs`` (N+1, n) and ``count`` configurations evenly between each two."""
+    s = np.linspace(0.0, 1.0, count + 2)[:-1, None, None]
+    inner = qs[:-1][None] + s * (qs[1:] - qs[:-1])[None]  # (count+1, N, n)
+    return np.concatenate([inner.transpose(1, 0, 2).reshape(-1, qs.shape[1]), qs[-1:]])
+
+
+def _bend(scene: Scene, q: np.ndarray) -> float:
+    """The largest bend (m) of the links at ``q``: how much closer than their straight DV
+    segments (which dvqp keeps) the real links may be (``dvqp.geometry.link_bends``)."""
+    return float(link_bends(KinematicState.compute(scene.robot, q, scene.pipe_radius)).max())
+
+
 def worst_breach(scene: Scene, qs: np.ndarray) -> dict[str, float]:
-    """For a run's samples ``qs`` (N+1, n): how far each limit was broken at worst (>0 broken).
+    """For a run's samples ``qs`` (N+1, n): how far each limit was broken at worst (>0 broken),
+    and the links' bend where the real clearance was worst (``"bend"``, m).
 
     A part that starts inside its margin counts from its start value (it may not get worse).
     """
@@ -63,12 +97,13 @@ def worst_breach(scene: Scene, qs: np.ndarray) -> dict[str, float]:
     c0, _ = clearances(scene, qs[0])
     h0, p0 = heights(scene, qs[0])
     t0 = tilt(scene, qs[0])
-    out = {"clearance": -math.inf, "height": -math.inf, "probe height": -math.inf,
+    out = {"clearance": -math.inf, "bend": 0.0, "height": -math.inf, "probe height": -math.inf,
            "tilt": -math.inf, "joint": -math.inf}  # fmt: skip
     for q in qs:
         if len(scene.obstacles):
             c, _ = clearances(scene, q)
-            out["clearance"] = max(out["clearance"], min(margin, c0) - c)
+            if min(margin, c0) - c > out["clearance"]:  # and the bend of the links there
+                out["clearance"], out["bend"] = min(margin, c0) - c, _bend(scene, q)
         h, p = heights(scene, q)
         out["height"] = max(out["height"], min(h_min, h0) - h)
         out["probe height"] = max(out["probe height"], min(0.0, p0) - p)
