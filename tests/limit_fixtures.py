@@ -109,7 +109,12 @@ def damper_rows(stepper: Stepper, limit: VelocityDamper, q: ArrayLike, dt: float
     assert stepper.load(q)
     stepper.prepare(np.zeros(4), dt)
     radius = stepper.state.radius
-    found = measure(limit, KinematicState.compute(stepper.robot, q, radius))
+    refine = None  # the links of an obstacle in several dampers: refined below the largest margin
+    if isinstance(limit, ObstacleDamper):
+        dampers = [d for d in stepper.resolver.spec.limits if type(d) is ObstacleDamper]
+        refine = np.array([max(d.margin for d in dampers if any(o is x for x in d.obstacles))
+                           for o in limit.obstacles])  # fmt: skip
+    found = measure(limit, KinematicState.compute(stepper.robot, q, radius), refine)
     if found.value.shape[0] == 0:  # a damper without distances (no obstacle) has no rows;
         return Constraint(np.zeros((0, q.shape[0])), np.zeros(0))  # (Stepper.rows: the box)
     rows = stepper.rows(limit)
@@ -122,7 +127,7 @@ def damper_rows(stepper: Stepper, limit: VelocityDamper, q: ArrayLike, dt: float
     if gradient and found.gradient is not None:
         np.testing.assert_allclose(rows.G, -found.gradient[on], rtol=0, atol=1e-12)
     if gradient and (fd or found.gradient is None):
-        numeric = distance_jacobian(limit, stepper.robot, q, radius)[on]
+        numeric = distance_jacobian(limit, stepper.robot, q, radius, refine=refine)[on]
         scale = max(float(np.abs(numeric).max(initial=0.0)), 1e-3)
         np.testing.assert_allclose(-rows.G, numeric, rtol=0, atol=2e-6 * scale)
     return rows

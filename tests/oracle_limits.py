@@ -19,7 +19,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp import KinematicState, Robot
-from dvqp.geometry import proximity
+from dvqp.geometry import proximity, segment_distances
+from dvqp.geometry.measure import OTHER, ShapeArrays
+from dvqp.geometry.proximity import measure as measure_chain
 from dvqp.limits import (
     NO_EXCESS,
     AccelerationLimit,
@@ -199,12 +201,13 @@ class Measured:
     applies: NDArray[np.bool_]
 
 
-def measure(limit: object, state: KinematicState) -> Measured:
+def measure(limit: object, state: KinematicState, refine: Array | None = None) -> Measured:
     """The distances of one of dvqp's dampers, or of a user's :class:`VelocityDamper` (its
-    own ``distances``), at ``state``."""
+    own ``distances``), at ``state``; an obstacle damper's links refined below ``refine`` (per
+    obstacle, m; default: its margin; see :func:`real_clearances`)."""
     k, n = state.k, state.n
     if type(limit) is ObstacleDamper:
-        return _clearances(limit, state)
+        return _clearances(limit, state, refine)
     if type(limit) in (SurfaceHeight, ProbeHeight):
         return _heights(limit, state)
     if type(limit) is TiltLimit:
@@ -301,24 +304,98 @@ def bend(a: Array, b: Array) -> tuple[float, float]:
     return math.atan2(a[0] * y - a[1] * x, a[0] * x + a[1] * y) - u * phi, u
 
 
-def _clearances(limit: ObstacleDamper, state: KinematicState) -> Measured:
+def _turn(o: Array, jac: Array, a: int, b: int, t: float) -> Array:
+    """``∂φ/∂Q`` (n,) of the point at ``t`` on the 3-D link from frame a to b, ``φ`` its angle
+    around the pipe axis: ``(x ∂y − y ∂x)/ρ²``."""
+    p, dp = (1 - t) * o[a] + t * o[b], (1 - t) * jac[a, :3] + t * jac[b, :3]
+    return (p[0] * dp[1] - p[1] * dp[0]) / (p[0] ** 2 + p[1] ** 2)  # type: ignore[no-any-return]
+
+
+def real_clearances(obstacles: Sequence[object], frames: object, radius: float, refine: Array,
+                    jac: Array | None = None) -> tuple[Array, Array, Array, Array]:  # fmt: skip
+    """Each link's clearance to each obstacle as dvqp defines it (``dvqp.geometry.real_links``),
+    rebuilt from other parts: the straight pieces' distances by
+    :func:`dvqp.geometry.segment_distances`, their bends by :func:`bend` (sampling and
+    bisection), the rule written out again (a pair in pieces where its bound is below
+    ``refine`` (J,) of its obstacle, m, the closest link to it, or the holder). Returns the
+    clearance (J, L), the link parameter of its closest point (J, L), whether its normal is
+    defined (J, L), and with ``jac`` (the frames' Jacobians (m, 6, n)) its gradient (J, L, n) by the
+    envelope formula written in NumPy. ``frames``: a state or Pinocchio's frames (``origins``,
+    ``guarded`` (m, 3), ``k``, ``rail``)."""
+    k, o = frames.k, np.asarray(frames.origins)  # type: ignore[attr-defined]
+    guarded, period = np.asarray(frames.guarded), 2.0 * math.pi * radius  # type: ignore[attr-defined]
+    ends = guarded_links(k, frames.rail)  # type: ignore[attr-defined]
+    shapes = tuple(obstacles)
+    own = ShapeArrays.of(shapes, period).code == OTHER  # shapes of your own: one piece
+    straight = measure_chain(shapes, guarded, period, ends)
+    whole = np.array([radius * abs(bend(o[a], o[b])[0]) for a, b in ends])
+    value = straight.link_distance - whole[None]
+    closest = (straight.link_distance + whole[None]).min(axis=1, initial=math.inf)  # (J,)
+    t, normal = straight.link_t.copy(), straight.link_normal.copy()
+    piece = np.zeros((*value.shape, 2))  # [t0, t1] of the closest piece
+    piece[..., 1] = 1.0
+    for i, (a, b) in enumerate(ends):
+        first = max(1, math.ceil(math.sqrt(2 * whole[i] / 1e-5)))
+        for j, shape in enumerate(shapes):
+            holder = b == k
+            if first == 1 or own[j]:
+                continue
+            if not (value[j, i] < refine[j] + 2 * whole[i] or value[j, i] < closest[j] or holder):
+                continue
+            count, bent = first, math.inf
+            while 2 * bent > 1e-5:  # until the closest piece bends by 5 µm at most
+                u = np.linspace(0.0, 1.0, count + 1)
+                p = o[a][None] + u[:, None] * (o[b] - o[a])[None]
+                x, y = o[a][0], o[a][1]
+                turn = np.arctan2(x * p[:, 1] - y * p[:, 0], x * p[:, 0] + y * p[:, 1])
+                lz = np.column_stack([guarded[a, 0] + radius * turn, p[:, 2]])
+                d, s, nn = segment_distances([shape], lz[:-1], lz[1:], period)
+                bends = radius * np.abs([bend(p[c], p[c + 1])[0] for c in range(count)])
+                c = int(np.argmin(d[0] - bends))
+                value[j, i], t[j, i], normal[j, i] = (
+                    d[0, c] - bends[c],
+                    (c + s[0, c]) / count,
+                    nn[0, c],
+                )
+                piece[j, i], bent, count = (u[c], u[c + 1]), bends[c], 2 * count
+    if jac is None:
+        return value, t, (normal != 0.0).any(axis=-1), np.zeros((*value.shape, 0))
+    gradient = np.zeros((*value.shape, jac.shape[2]))
+    for (j, i), _ in np.ndenumerate(value):
+        a, b = ends[i]
+        t0, t1 = piece[j, i]
+        s = (t[j, i] - t0) / (t1 - t0)
+        turn0, turn1 = _turn(o, jac, a, b, t0), _turn(o, jac, a, b, t1)
+        z0, z1 = ((1 - x) * jac[a, 2] + x * jac[b, 2] for x in (t0, t1))
+        gradient[j, i] = (normal[j, i, 0] * radius * ((1 - s) * turn0 + s * turn1)
+                          + normal[j, i, 1] * ((1 - s) * z0 + s * z1))  # fmt: skip
+        g, w = bend((1 - t0) * o[a] + t0 * o[b], (1 - t1) * o[a] + t1 * o[b])
+        if g != 0.0:
+            at = _turn(o, jac, a, b, t0 + w * (t1 - t0)) - (1 - w) * turn0 - w * turn1
+            gradient[j, i] -= radius * math.copysign(1.0, g) * at
+    return value, t, (normal != 0.0).any(axis=-1), gradient
+
+
+def _clearances(limit: ObstacleDamper, state: KinematicState, refine: Array | None) -> Measured:
     """Every (point, obstacle) then every (link, obstacle) clearance, obstacle-major, with the
-    old NumPy gradient ``n · ∂p/∂Q`` (a link: at its closest point, an envelope)."""
+    old NumPy gradient ``n · ∂p/∂Q`` for the points; the links' real clearances
+    (:func:`real_clearances`, refined below the damper's margin)."""
     k, n = state.k, state.n
     count = len(limit.obstacles)
     if count == 0:
         return Measured(np.zeros(0), np.zeros((0, n)), np.zeros(0), (), np.zeros(0, bool))
-    near = proximity(state, limit.obstacles)
+    points = proximity(state, limit.obstacles).points
     jac = np.array(state.guarded_jacobians[:, :2, :])  # (m, 2, n)
-    points, links = near.points, near.links
     point_rows = np.einsum("jpc,pcn->jpn", points.normal, jac)  # (J, m, n)
-    t = links.t[..., None, None]
+    if refine is None:
+        refine = np.full(count, limit.margin)
+    links, t, normal_ok, link_rows = real_clearances(
+        limit.obstacles, state, state.radius, refine, np.asarray(state.frame_jacobians)
+    )
     ends = guarded_links(k, state.rail)
-    between = (1.0 - t) * jac[None, ends[:, 0]] + t * jac[None, ends[:, 1]]  # (J, L, 2, n)
-    link_rows = np.einsum("jlc,jlcn->jln", links.normal, between)
     point_ok = (points.normal != 0.0).any(axis=-1)
-    link_ok = (links.normal != 0.0).any(axis=-1) & (links.t > 0.0) & (links.t < 1.0)
-    value = np.concatenate([points.distance.ravel(), links.distance.ravel()])
+    link_ok = normal_ok & (t > 0.0) & (t < 1.0)
+    value = np.concatenate([points.distance.ravel(), links.ravel()])
     gradient = np.concatenate([point_rows.reshape(-1, n), link_rows.reshape(-1, n)])
     usable = np.concatenate([point_ok.ravel(), link_ok.ravel()])
     labels = (
@@ -330,11 +407,11 @@ def _clearances(limit: ObstacleDamper, state: KinematicState) -> Measured:
 
 
 def distance_jacobian(limit: object, robot: Robot, q: Array, radius: float,
-                      eps: float = 1e-7) -> Array:  # fmt: skip
+                      eps: float = 1e-7, refine: Array | None = None) -> Array:  # fmt: skip
     """Central differences of every distance of ``limit`` at ``q`` (p, n)."""
 
     def values(v: Array) -> Array:
-        return measure(limit, KinematicState.compute(robot, v, radius)).value
+        return measure(limit, KinematicState.compute(robot, v, radius), refine).value
 
     return central_difference(values, np.asarray(q, dtype=float), eps)  # type: ignore[no-any-return]
 

@@ -35,7 +35,7 @@ from dvqp.limits import (
     SurfaceHeight,
     TiltLimit,
 )
-from tests.oracle_limits import chord_low, guarded_links, link_pairs
+from tests.oracle_limits import chord_low, guarded_links, link_pairs, real_clearances
 
 Array = NDArray[np.float64]
 
@@ -240,7 +240,10 @@ def verified_values(limits: tuple, robot: Robot, q: Array, radius: float) -> lis
             out.append(Verified(values, 0.0, limit.tolerance, "joint position"))
         elif kind is ObstacleDamper and len(limit.obstacles):
             points = point_distances(limit.obstacles, f.guarded[:, :2], period)
-            links = link_distances(limit.obstacles, f.guarded, period, f.k)
+            dampers = [d for d in limits if type(d) is ObstacleDamper]
+            refine = np.array([max(d.margin for d in dampers if any(o is x for x in d.obstacles))
+                               for o in limit.obstacles])  # fmt: skip
+            links = real_clearances(limit.obstacles, f, radius, refine)[0]
             values = np.concatenate([points.ravel(), links.ravel()])
             out.append(Verified(values, limit.margin, limit.tolerance, limit.quantity))
         elif kind in (SurfaceHeight, ProbeHeight):

@@ -11,11 +11,13 @@ distances from an exact closest-point formulation of its own (``tests/oracle_res
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
 from dvqp import KinematicState, Scene
 from dvqp.geometry import link_bends
+from dvqp.geometry.shapes import Shape
 from dvqp.limits import ObstacleDamper, SurfaceHeight, TiltLimit
 from tests.oracle_limits import guarded_links
 from tests.oracle_resolution import Frames, frames, point_distances
@@ -37,10 +39,30 @@ def clearances(scene: Scene, q: np.ndarray) -> tuple[float, float]:
     f = _frames(scene, q)
     k, radius = f.k, scene.pipe_radius
     period = 2.0 * math.pi * radius
-    links = np.array([[*point_distances(scene.obstacles, _dv(p, radius), period).min(axis=1)]
-                      for p in _links(f)]).T  # (J, L), the links' ends included  # fmt: skip
+    links = real_link_distances(scene.obstacles, f, radius)
     points = point_distances(scene.obstacles, f.guarded[:, :2], period)
     return float(min(links.min(), points.min())), float(links[:, k - 1].min())
+
+
+def real_link_distances(obstacles: Sequence[Shape], f: Frames, radius: float,
+                        samples: int = 401) -> np.ndarray:  # fmt: skip
+    """Signed distance (m) of every real link (the straight 3-D segment, each sample mapped to
+    the developed view) to every obstacle, (J, L): ``samples`` samples, then ``samples`` more
+    between the neighbours of each obstacle's closest one."""
+    coarse = np.linspace(0.0, 1.0, samples)
+    period, step = 2.0 * math.pi * radius, coarse[1]
+    rail = f.origins.shape[0] > f.k + 1
+    ends = guarded_links(f.k, rail)
+    out = np.zeros((len(obstacles), len(ends)))
+    for i, (a, b) in enumerate(ends):
+        pa, pb = f.origins[a], f.origins[b]
+        d = point_distances(obstacles, _dv(pa + coarse[:, None] * (pb - pa), radius), period)
+        for j, shape in enumerate(obstacles):
+            t = coarse[np.argmin(d[j])]
+            fine = np.linspace(max(t - step, 0.0), min(t + step, 1.0), samples)[:, None]
+            near = point_distances([shape], _dv(pa + fine * (pb - pa), radius), period)
+            out[j, i] = min(d[j].min(), near.min())
+    return out
 
 
 def _links(f: Frames, samples: int = 801) -> list[np.ndarray]:

@@ -9,6 +9,7 @@ own (their NumPy methods), and :func:`penalties` every row's objective penalty
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -48,6 +49,10 @@ class ShapeArrays:
         Every polygon's vertices, l measured from its ``l_ref``.
     size : (J,)
         ``ρ`` of each obstacle's penalty, m.
+    refine : (J,)
+        Below what clearance (m) a link's to each obstacle is measured on its real DV image to
+        the last :data:`~dvqp.geometry.real_links.PRECISION` (its obstacle damper's margin,
+        0 if none: ``inf`` until set; see :func:`~dvqp.geometry.real_links.real_links`).
     """
 
     period: float
@@ -58,6 +63,7 @@ class ShapeArrays:
     vl: Array
     vz: Array
     size: Array
+    refine: Array
 
     @classmethod
     def of(cls, shapes: Sequence[Shape], period: float) -> ShapeArrays:
@@ -83,7 +89,7 @@ class ShapeArrays:
         packed = np.concatenate(vertices) if vertices else np.zeros((0, 2))
         vl, vz = np.ascontiguousarray(packed[:, 0]), np.ascontiguousarray(packed[:, 1])
         return cls(float(period), code, data, start, stop, vl, vz,
-                   np.array([s.size for s in shapes], float))  # fmt: skip
+                   np.array([s.size for s in shapes], float), np.full(count, math.inf))  # fmt: skip
 
 
 @njit(cache=True)
@@ -100,7 +106,7 @@ def _point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def _segment(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
+def shape_segment(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
     """``(d, t, ∂d/∂l, ∂d/∂z)`` of a segment to obstacle j."""
     code, data, period = shapes.code[j], shapes.data[j], shapes.period
     if code == CIRCLE:
@@ -129,7 +135,8 @@ def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
             near.point_normal[j, i, 0], near.point_normal[j, i, 1] = nl, nz
         for i in range(ends.shape[0]):
             a, b = ends[i, 0], ends[i, 1]
-            d, t, nl, nz = _segment(shapes, j, chain[a, 0], chain[a, 1], chain[b, 0], chain[b, 1])
+            al, az, bl, bz = chain[a, 0], chain[a, 1], chain[b, 0], chain[b, 1]
+            d, t, nl, nz = shape_segment(shapes, j, al, az, bl, bz)
             near.link_distance[j, i], near.link_t[j, i] = d, t
             near.link_normal[j, i, 0], near.link_normal[j, i, 1] = nl, nz
 

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from dvqp.geometry.measure import ShapeArrays, measure_chain, penalties, user_rows
 from dvqp.geometry.obstacle import ObstacleSet
+from dvqp.geometry.real_links import real_links
 from dvqp.geometry.shapes import Shape
 from dvqp.kinematics.state import KinematicState
 from dvqp.workspace import ProximityBuffers, as_struct, link_ends
@@ -63,13 +64,18 @@ class Proximity:
     points : ShapeDistances
         Arrays (J, m, ...).
     links : ShapeDistances
-        Arrays (J, L, ...), at each link's closest point.
+        Arrays (J, L, ...) of the straight DV segments between the links' ends, at each one's
+        closest point (the objective's).
+    real : ShapeDistances
+        Of the links' real DV images (``dvqp.geometry.real_links``): distance, normal, link
+        parameter ``t`` (no penalty: zeros). The limits keep these, and reports show them.
     k : int
         Number of body points.
     """
 
     points: ShapeDistances
     links: ShapeDistances
+    real: ShapeDistances
     k: int
 
     @classmethod
@@ -80,7 +86,10 @@ class Proximity:
                                 np.zeros_like(near.point_distance))  # fmt: skip
         links = ShapeDistances(near.link_distance, near.link_normal, near.link_penalty,
                                near.link_penalty_gradient, near.link_t)  # fmt: skip
-        return cls(points, links, int(k))
+        none = np.zeros_like(near.real_distance)
+        real = ShapeDistances(near.real_distance, near.real_normal, none,
+                              np.zeros_like(near.real_normal), near.real_at)  # fmt: skip
+        return cls(points, links, real, int(k))
 
     @property
     def point_clearance(self) -> Array:
@@ -89,13 +98,14 @@ class Proximity:
 
     @property
     def link_clearance(self) -> Array:
-        """Signed clearance of each guarded link to each obstacle, m, shape (J, L)."""
-        return self.links.distance
+        """Signed clearance of each guarded link (its real DV image) to each obstacle, m,
+        shape (J, L)."""
+        return self.real.distance
 
     @property
     def link_t(self) -> Array:
         """Parameter in [0, 1] of each link's closest point, shape (J, L)."""
-        return self.links.t
+        return self.real.t
 
     def min_clearance(self) -> float:
         """Smallest clearance of any guarded point or link, m (``inf`` with no obstacle)."""
@@ -135,23 +145,32 @@ def link_label(i: int, k: int) -> str:
     return f"link{i + 1}" if i < k - 1 else ("holder", "carriage")[i - k + 1]
 
 
-def measure(shapes: Sequence[Shape], chain: Array, period: float,
-            ends: NDArray[np.int64]) -> ProximityBuffers:  # fmt: skip
+def measure(shapes: Sequence[Shape], chain: Array, period: float, ends: NDArray[np.int64],
+            real: tuple[Array, float, int] | None = None) -> ProximityBuffers:  # fmt: skip
     """Every distance of the points ``chain`` (m) and of the links ``ends`` (L, 2) between them
-    to ``shapes``, penalties included, in new buffers (J, m) and (J, L)."""
+    to ``shapes``, penalties included, in new buffers (J, m) and (J, L); with ``real`` (the
+    points' 3-D origins (m, 3), the pipe's radius, m, and the probe's index), also the links'
+    real clearances."""
     packed = ShapeArrays.of(shapes, period)
     near = ProximityBuffers.sized(len(shapes), chain.shape[0], ends)
     points = np.ascontiguousarray(chain, dtype=np.float64)
     measure_chain(as_struct(packed), points, as_struct(near))
     user_rows(shapes, packed.code, points, period, near)
     penalties(packed.size, as_struct(near))
+    if real is not None:
+        real_links(as_struct(packed), points, *real, as_struct(near))
     return near
 
 
 def proximity(state: KinematicState, obstacles: ObstacleSet | Sequence[Shape]) -> Proximity:
     """The :class:`Proximity` of ``state``'s guarded parts to ``obstacles``."""
-    near = measure(tuple(obstacles), np.array(state.guarded), 2.0 * np.pi * state.radius,
-                   link_ends(state.k, state.rail))  # fmt: skip
+    near = measure(
+        tuple(obstacles),
+        np.array(state.guarded),
+        2.0 * np.pi * state.radius,
+        link_ends(state.k, state.rail),
+        (np.array(state.origins), state.radius, state.k),
+    )
     return Proximity.of(near, state.k)
 
 

@@ -17,6 +17,7 @@ from dvqp import _validate
 from dvqp.errors import ParameterError
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.proximity import link_label, point_label
+from dvqp.geometry.real_links import real_link_gradient
 from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
 
 
@@ -78,12 +79,16 @@ class ObstacleDamper(VelocityDamper):
 
 
 @njit(cache=True)
-def obstacle_distances(near, jacobians, members, start, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
+def obstacle_distances(near, jacobians, origins, frame_jacobians, radius, reach, members,
+                       start, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]  # fmt: skip
     """Clearances of every (point, obstacle) pair then every (link, obstacle) pair of the
     obstacles ``members`` (rows of ``near``, a packed ProximityBuffers), obstacle-major, from
-    row ``start``: ``d``, ``∂d/∂Q = n · ∂p/∂Q`` (a link ``a → b``: at its closest point
-    ``(1 − t) p_a + t p_b``, an envelope) and whether the normal is defined (a link's
-    closest point interior). ``jacobians`` (m, 3, n) are the guarded points'."""
+    row ``start``: ``d``, ``∂d/∂Q = n · ∂p/∂Q`` and whether the normal is defined. A link's
+    is its real clearance (:func:`~dvqp.geometry.real_links.real_links`, its gradient an
+    envelope), defined where its closest point is inside it. ``jacobians`` (m, 3, n) are the
+    guarded points' DV Jacobians, ``origins`` (m, 3) and ``frame_jacobians`` (m, 6, n) their
+    3-D ones, ``radius`` the pipe's (m); a link row's gradient is written only below its
+    ``reach`` (m, per row), where the row applies."""
     r, points, n, ends = start, near.point_distance.shape[1], gradient.shape[1], near.ends
     for j in members:
         for i in range(points):
@@ -94,12 +99,9 @@ def obstacle_distances(near, jacobians, members, start, distance, gradient, usab
             r += 1
     for j in members:
         for i in range(ends.shape[0]):
-            a, b = ends[i, 0], ends[i, 1]
-            nl, nz, t = near.link_normal[j, i, 0], near.link_normal[j, i, 1], near.link_t[j, i]
-            distance[r] = near.link_distance[j, i]
+            nl, nz, t = near.real_normal[j, i, 0], near.real_normal[j, i, 1], near.real_at[j, i]
+            distance[r] = near.real_distance[j, i]
             usable[r] = (nl != 0.0 or nz != 0.0) and 0.0 < t < 1.0
-            for c in range(n):
-                x = (1.0 - t) * jacobians[a, 0, c] + t * jacobians[b, 0, c]
-                y = (1.0 - t) * jacobians[a, 1, c] + t * jacobians[b, 1, c]
-                gradient[r, c] = nl * x + nz * y
+            if usable[r] and distance[r] < reach[r]:
+                real_link_gradient(near, origins, frame_jacobians, radius, j, i, gradient[r])
             r += 1

@@ -251,6 +251,12 @@ def lay_out(robot: Robot, radius: float, resolver: Resolver, q0: ArrayLike, dt: 
     if damping > 0.0 and layout.hooks.soft:
         raise ParameterError("damping", "the damped inverse takes no soft tasks")
     shapes = ShapeArrays.of(layout.shapes, plan.period)
+    m = layout.measures  # each obstacle's links measured to the last precision below its margin
+    dampers = [d for d in spec.limits if type(d) is ObstacleDamper and len(d.obstacles)]
+    shapes.refine[:] = 0.0
+    for o, damper in enumerate(dampers):
+        rows = m.obstacle_members[m.obstacle_offsets[o] : m.obstacle_offsets[o + 1]]
+        shapes.refine[rows] = np.maximum(shapes.refine[rows], damper.safe)
     layout.hooks.finalize(layout.shapes, shapes.code, layout.params, layout.damper_values)
     fields = [f for f in RecordArrays.__dataclass_fields__ if f != "index"]
     record = (RecordArrays.none(n, k) if samples is None else

@@ -16,6 +16,7 @@ import math
 from numba import njit
 
 from dvqp.geometry.measure import measure_chain, penalties
+from dvqp.geometry.real_links import real_links
 from dvqp.kinematics.model import kinematics
 from dvqp.limits.acceleration import acceleration_bounds
 from dvqp.limits.damper import damper_rows, damper_values
@@ -53,7 +54,8 @@ def evaluate(s, integrate, first, last) -> int:  # type: ignore[no-untyped-def]
         measure_chain(s.shapes, s.state.guarded, s.near)
         pair_distances(s.state.origins, s.pairs)
     if first <= ASSESS <= last:
-        penalties(s.shapes.size, s.near)
+        penalties(s.shapes.size, s.near)  # the paper's w: of the straight DV links
+        real_links(s.shapes, s.state.guarded, s.state.origins, s.radius, s.model.tool, s.near)
         _objective(s)
         _distances(s)
     if first <= CONCLUDE <= last:
@@ -102,7 +104,8 @@ def _distances(s) -> None:  # type: ignore[no-untyped-def]
     out = (d.distance, d.gradient, d.usable)
     for o in range(m.obstacle_start.shape[0]):
         members = m.obstacle_members[m.obstacle_offsets[o] : m.obstacle_offsets[o + 1]]
-        obstacle_distances(s.near, st.guarded_jacobians, members, m.obstacle_start[o], *out)
+        obstacle_distances(s.near, st.guarded_jacobians, st.origins, st.frame_jacobians, s.radius,
+                           s.params.reach, members, m.obstacle_start[o], *out)  # fmt: skip
     for i in range(m.heights.shape[0]):
         start, first, count = m.heights[i, 0], m.heights[i, 1], m.heights[i, 2]
         height_distances(st.guarded, st.guarded_jacobians, first, count, start, *out)
@@ -142,10 +145,10 @@ def _diagnostics(s) -> None:  # type: ignore[no-untyped-def]
     for r in range(s.recorded.shape[0]):
         j = s.recorded[r]
         for i in range(parts):
-            d = near.point_distance[j, i] if i < m else near.link_distance[j, i - m]
+            d = near.point_distance[j, i] if i < m else near.real_distance[j, i - m]
             if d < out[2]:
                 out[2], out[4] = d, r * parts + i
-        out[3] = min(out[3], near.point_distance[j, k], near.link_distance[j, k - 1])
+        out[3] = min(out[3], near.point_distance[j, k], near.real_distance[j, k - 1])
 
 
 @njit(cache=True, inline="always")

@@ -83,6 +83,15 @@ class ProximityBuffers:
     link_distance, link_penalty, link_t : (J, L)
         The same at each link's closest point ``p_a + t (p_b − p_a)``, and its ``t``.
     link_normal, link_penalty_gradient : (J, L, 2)
+    real_distance, real_at : (J, L)
+        The clearance (m) of each link's real DV image (the straight 3-D link mapped to the
+        DV; ``dvqp.geometry.real_links``), and the link parameter of its closest point.
+    real_normal : (J, L, 2)
+        ``∇d`` there, with respect to the point's ``[l, z]``.
+    real_piece, real_pieces : (J, L)
+        The piece of the link that has it, of how many.
+    bends : (L,)
+        How far each link's real DV image strays from its straight DV segment, m.
     """
 
     ends: NDArray[np.int64]
@@ -95,6 +104,12 @@ class ProximityBuffers:
     link_penalty: Array
     link_penalty_gradient: Array
     link_t: Array
+    real_distance: Array
+    real_normal: Array
+    real_at: Array
+    real_piece: Array
+    real_pieces: Array
+    bends: Array
 
     @classmethod
     def allocate(cls, count: int, k: int, rail: bool = False) -> ProximityBuffers:
@@ -107,7 +122,8 @@ class ProximityBuffers:
         p, s = (count, points), (count, ends.shape[0])
         return cls(np.ascontiguousarray(ends, dtype=np.int64), np.zeros(p), np.zeros((*p, 2)),
                    np.zeros(p), np.zeros((*p, 2)), np.zeros(s), np.zeros((*s, 2)), np.zeros(s),
-                   np.zeros((*s, 2)), np.zeros(s))  # fmt: skip
+                   np.zeros((*s, 2)), np.zeros(s), np.zeros(s), np.zeros((*s, 2)), np.zeros(s),
+                   np.zeros(s), np.ones(s), np.zeros(ends.shape[0]))  # fmt: skip
 
 
 @dataclass(frozen=True)

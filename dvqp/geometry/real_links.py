@@ -1,0 +1,175 @@
+"""How far a link's true developed-view image strays from the straight DV segment.
+
+A link is a straight 3-D segment ``P(t) = A + t (B − A)``, ``t ∈ [0, 1]``. Its DV image is not
+straight: ``z`` is linear in ``t`` (``z(t) = z_A + t Δz``) but ``l = R θ(t)``, with ``θ`` the
+angle of ``P(t)`` around the pipe axis, is not. In the frame of ``A``'s angle, with ``ρ_A``,
+``ρ_B`` the distances from the axis and ``Δφ`` the angle from ``A`` to ``B``,
+
+    θ(t) = atan2(t c, ρ_A² + t d),   c = ρ_A ρ_B sin Δφ,   d = ρ_A ρ_B cos Δφ − ρ_A².
+
+The straight DV segment's point at the same ``t`` is ``(l_A + R t Δφ, z(t))``, so every point
+of the true image lies within ``δ = R max_t |θ(t) − t Δφ|`` of the straight segment. The
+extremes of ``g(t) = θ(t) − t Δφ`` (zero at both ends) are where ``θ'(t) = Δφ``:
+
+    (d² + c²) t² + 2 ρ_A² d t + ρ_A⁴ − ρ_A² c / Δφ = 0.
+
+A signed distance to an obstacle is 1-Lipschitz, so a piece of the link keeps at least the
+clearance of its straight DV segment less its own ``δ``. The clearance dvqp keeps, checks and
+reports for a link (:func:`real_links`) is the least of that over ``N`` equal pieces of the
+link, ``N = ceil(sqrt(2 δ / PRECISION))`` (a piece's ``δ`` shrinks as the square of its
+length), doubled until the closest piece's ``δ`` is at most ``PRECISION / 2``: never above
+the real link's clearance (every piece keeps its straight clearance less its ``δ``), and below
+it by at most ``PRECISION`` (the closest piece's real image is within its ``δ`` of it). A link
+that spans no angle (``Δφ = 0``) is straight in the DV too.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from dvqp.geometry.measure import OTHER, shape_segment
+from dvqp.kinematics.state import KinematicState
+from dvqp.workspace import link_ends
+
+PRECISION = 1e-5
+"""m: the most a link's clearance, where measured in pieces, may be below its real one."""
+
+
+@njit(cache=True)
+def link_bend(ax, ay, bx, by):  # type: ignore[no-untyped-def]
+    """``(g, t)``: the signed largest ``g(t) = θ(t) − t Δφ`` (rad) of the link from
+    ``(ax, ay)`` to ``(bx, by)`` (the xy parts of its ends, m) and where it is (``t`` in
+    (0, 1); ``(0.0, 0.0)`` for a link that spans no angle). ``δ = R |g|``."""
+    ra2 = ax * ax + ay * ay
+    cross, dot = ax * by - ay * bx, ax * bx + ay * by
+    phi = math.atan2(cross, dot)
+    if phi == 0.0 or ra2 == 0.0:
+        return 0.0, 0.0
+    c, d = cross, dot - ra2  # ρ_A ρ_B sin Δφ and ρ_A ρ_B cos Δφ − ρ_A²
+    qa, qb, qc = d * d + c * c, 2.0 * ra2 * d, ra2 * ra2 - ra2 * c / phi
+    worst, at = 0.0, 0.0
+    disc = qb * qb - 4.0 * qa * qc
+    if qa > 0.0 and disc >= 0.0:
+        root = math.sqrt(disc)
+        for t in ((-qb - root) / (2.0 * qa), (-qb + root) / (2.0 * qa)):
+            if 0.0 < t < 1.0:
+                g = math.atan2(t * c, ra2 + t * d) - t * phi
+                if abs(g) > abs(worst):
+                    worst, at = g, t
+    return worst, at
+
+
+def link_bends(state: KinematicState) -> NDArray[np.float64]:
+    """``δ`` (m) of each guarded link of ``state`` (L,), in :func:`link_ends` order: the
+    farthest its real DV image strays from its straight DV segment."""
+    o, ends = np.asarray(state.origins), link_ends(state.k, state.rail)
+    return np.array([state.radius * abs(link_bend(o[a, 0], o[a, 1], o[b, 0], o[b, 1])[0])
+                     for a, b in ends])  # fmt: skip
+
+
+@njit(cache=True, inline="always")
+def _at(a, b, t):  # type: ignore[no-untyped-def]
+    """The point ``a + t (b − a)`` of a 3-D link: ``(x, y, z)``, m."""
+    return a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])
+
+
+@njit(cache=True)
+def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ignore[no-untyped-def]
+    """The clearance of every guarded link's real DV image to every obstacle, into ``near``'s
+    ``real_*`` rows: the least over the link's pieces of the straight piece's clearance less
+    the piece's ``δ``, its normal, the link parameter of its closest point, the piece and the
+    number of pieces. ``chain`` (m, 3) the guarded points' DV ``[l, z, h]``, ``origins``
+    (m, 3) their 3-D positions, m; ``tool`` the probe's index among them.
+
+    A pair is cut into pieces only where it matters: where the real link may be below
+    ``shapes.refine`` (its damper's margin), the closest link to the obstacle, or the probe's
+    holder (its clearance is reported on its own); elsewhere,
+    and for shapes of your own (:data:`OTHER`), the whole link is one piece (the straight
+    row less the link's ``δ``, in ``near.bends``: a bound below the truth by at most
+    ``2 δ``), farther than the margin and than the closest link."""
+    ends, bends = near.ends, near.bends
+    for i in range(ends.shape[0]):
+        a, b = origins[ends[i, 0]], origins[ends[i, 1]]
+        bends[i] = radius * abs(link_bend(a[0], a[1], b[0], b[1])[0])
+    for j in range(near.real_distance.shape[0]):
+        closest = math.inf  # above the real link closest to obstacle j
+        for i in range(ends.shape[0]):
+            near.real_distance[j, i] = near.link_distance[j, i] - bends[i]
+            near.real_normal[j, i, 0] = near.link_normal[j, i, 0]
+            near.real_normal[j, i, 1] = near.link_normal[j, i, 1]
+            near.real_at[j, i], near.real_piece[j, i], near.real_pieces[j, i] = (
+                near.link_t[j, i], 0.0, 1.0)  # fmt: skip
+            closest = min(closest, near.link_distance[j, i] + bends[i])
+        if shapes.code[j] == OTHER:
+            continue
+        for i in range(ends.shape[0]):
+            pieces = max(1, math.ceil(math.sqrt(2.0 * bends[i] / PRECISION)))
+            d = near.real_distance[j, i]
+            near_safe = d < shapes.refine[j] + 2.0 * bends[i]
+            if pieces > 1 and (near_safe or d < closest or ends[i, 1] == tool):
+                a, b = origins[ends[i, 0]], origins[ends[i, 1]]
+                _pieces(shapes, j, i, a, b, chain[ends[i, 0], 0], radius, pieces, near)
+
+
+@njit(cache=True)
+def _pieces(shapes, j, i, a, b, la, radius, pieces, near) -> None:  # type: ignore[no-untyped-def]
+    """Link i's clearance to obstacle j over ``pieces`` pieces, twice as many until the
+    closest piece's own ``δ`` is at most ``PRECISION / 2`` (see :func:`real_links`)."""
+    while True:
+        best, bend = math.inf, 0.0
+        for k in range(pieces):
+            x0, y0, z0 = _at(a, b, k / pieces)
+            x1, y1, z1 = _at(a, b, (k + 1) / pieces)
+            l0 = la + radius * math.atan2(a[0] * y0 - a[1] * x0, a[0] * x0 + a[1] * y0)
+            l1 = la + radius * math.atan2(a[0] * y1 - a[1] * x1, a[0] * x1 + a[1] * y1)
+            d, s, nl, nz = shape_segment(shapes, j, l0, z0, l1, z1)
+            piece = radius * abs(link_bend(x0, y0, x1, y1)[0])
+            if d - piece < best:
+                best, bend = d - piece, piece
+                near.real_distance[j, i] = d - piece
+                near.real_normal[j, i, 0], near.real_normal[j, i, 1] = nl, nz
+                near.real_at[j, i] = (k + s) / pieces
+                near.real_piece[j, i], near.real_pieces[j, i] = k, pieces
+        if 2.0 * bend <= PRECISION:
+            return
+        pieces *= 2
+
+
+@njit(cache=True, inline="always")
+def _turn(a, b, ja, jb, t, c):  # type: ignore[no-untyped-def]
+    """``∂φ/∂Q_c`` (rad/rad) of the link's point at ``t``, ``φ = atan2(y, x)``:
+    ``(x ∂y − y ∂x)/ρ²``; ``ja``, ``jb`` the ends' positional Jacobians (rows x, y, z)."""
+    x, y, _ = _at(a, b, t)
+    dx = (1.0 - t) * ja[0, c] + t * jb[0, c]
+    dy = (1.0 - t) * ja[1, c] + t * jb[1, c]
+    return (x * dy - y * dx) / (x * x + y * y)
+
+
+@njit(cache=True)
+def real_link_gradient(near, origins, frame_jacobians, radius, j, i, out) -> None:  # type: ignore[no-untyped-def]
+    """``∂d/∂Q`` (m/rad, (n,)) of link i's real clearance to obstacle j (as :func:`real_links`
+    measured it) into ``out``: ``n · ∂p/∂Q`` at the closest point ``p`` of its piece, less the
+    piece's ``∂δ/∂Q = R sign(g) (∂φ(P(τ)) − (1 − u) ∂φ(P_0) − u ∂φ(P_1))`` at the piece's
+    extreme ``u`` (``τ`` on the link): envelopes, the closest point and the extreme held."""
+    ea, eb = near.ends[i, 0], near.ends[i, 1]
+    a, b, ja, jb = origins[ea], origins[eb], frame_jacobians[ea], frame_jacobians[eb]
+    count, k = near.real_pieces[j, i], near.real_piece[j, i]
+    t0, t1 = k / count, (k + 1.0) / count
+    s = near.real_at[j, i] * count - k
+    nl, nz = near.real_normal[j, i, 0], near.real_normal[j, i, 1]
+    x0, y0, _ = _at(a, b, t0)
+    x1, y1, _ = _at(a, b, t1)
+    g, u = link_bend(x0, y0, x1, y1)
+    sign = radius if g > 0.0 else (-radius if g < 0.0 else 0.0)
+    tau = t0 + u * (t1 - t0)
+    for c in range(out.shape[0]):
+        turn0, turn1 = _turn(a, b, ja, jb, t0, c), _turn(a, b, ja, jb, t1, c)
+        z0 = (1.0 - t0) * ja[2, c] + t0 * jb[2, c]
+        z1 = (1.0 - t1) * ja[2, c] + t1 * jb[2, c]
+        out[c] = nl * radius * ((1.0 - s) * turn0 + s * turn1) + nz * ((1.0 - s) * z0 + s * z1)
+        if sign != 0.0:
+            out[c] -= sign * (_turn(a, b, ja, jb, tau, c) - (1.0 - u) * turn0 - u * turn1)
