@@ -15,8 +15,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from dvqp import KinematicState, Scene
-from dvqp.geometry import link_bends
+from dvqp import Scene
 from dvqp.geometry.shapes import Shape
 from dvqp.limits import ObstacleDamper, SurfaceHeight, TiltLimit
 from tests.oracle_limits import guarded_links
@@ -101,15 +100,8 @@ def between(qs: np.ndarray, count: int) -> np.ndarray:
     return np.concatenate([inner.transpose(1, 0, 2).reshape(-1, qs.shape[1]), qs[-1:]])
 
 
-def _bend(scene: Scene, q: np.ndarray) -> float:
-    """The largest bend (m) of the links at ``q``: how much closer than their straight DV
-    segments (which dvqp keeps) the real links may be (``dvqp.geometry.link_bends``)."""
-    return float(link_bends(KinematicState.compute(scene.robot, q, scene.pipe_radius)).max())
-
-
 def worst_breach(scene: Scene, qs: np.ndarray) -> dict[str, float]:
-    """For a run's samples ``qs`` (N+1, n): how far each limit was broken at worst (>0 broken),
-    and the links' bend where the real clearance was worst (``"bend"``, m).
+    """For a run's samples ``qs`` (N+1, n): how far each limit was broken at worst (>0 broken).
 
     A part that starts inside its margin counts from its start value (it may not get worse).
     """
@@ -119,13 +111,12 @@ def worst_breach(scene: Scene, qs: np.ndarray) -> dict[str, float]:
     c0, _ = clearances(scene, qs[0])
     h0, p0 = heights(scene, qs[0])
     t0 = tilt(scene, qs[0])
-    out = {"clearance": -math.inf, "bend": 0.0, "height": -math.inf, "probe height": -math.inf,
+    out = {"clearance": -math.inf, "height": -math.inf, "probe height": -math.inf,
            "tilt": -math.inf, "joint": -math.inf}  # fmt: skip
     for q in qs:
         if len(scene.obstacles):
             c, _ = clearances(scene, q)
-            if min(margin, c0) - c > out["clearance"]:  # and the bend of the links there
-                out["clearance"], out["bend"] = min(margin, c0) - c, _bend(scene, q)
+            out["clearance"] = max(out["clearance"], min(margin, c0) - c)
         h, p = heights(scene, q)
         out["height"] = max(out["height"], min(h_min, h0) - h)
         out["probe height"] = max(out["probe height"], min(0.0, p0) - p)
