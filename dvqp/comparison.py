@@ -23,7 +23,7 @@ from dvqp import load_scene, plan
 from dvqp.errors import DvqpError
 from dvqp.geometry import proximity
 from dvqp.kinematics import KinematicState
-from dvqp.limits import self_distance, start_broken_lines
+from dvqp.limits import lowest_link, self_distance, start_broken_lines
 from dvqp.planning import check_run, final_errors, worst_sample_excess
 from dvqp.resolution.registry import PINV
 
@@ -33,8 +33,8 @@ if TYPE_CHECKING:
 FIELDS = (
     "scene", "file", "backend", "success", "steps", "failures", "relaxed", "braking", "substepped",
     "median_step_us", "p95_step_us", "median_solver_us", "median_rest_us", "median_iterations",
-    "ratio_to_pinv", "max_task_error", "min_clearance",
-    "closest", "min_probe_clearance", "min_tilt", "min_self_distance", "closest_pair",
+    "ratio_to_pinv", "max_task_error", "min_clearance", "closest", "min_probe_clearance",
+    "min_tilt", "min_self_distance", "closest_pair", "min_link_height", "lowest_link",
     "max_joint_acceleration", "max_limit_excess", "worst_limit", "start_broken",
     "max_joint_limit_violation", "max_velocity_limit_violation", "final_tracking_error",
     "final_joint_speed", "braking_time", "error",
@@ -46,8 +46,7 @@ Row = dict[str, Any]
 
 def _finite(value: float) -> float | None:
     """``value`` as a float, or None if it is NaN or infinite (JSON has no NaN)."""
-    v = float(value)
-    return v if np.isfinite(v) else None
+    return v if np.isfinite(v := float(value)) else None
 
 
 def _least(values: NDArray[np.float64]) -> float | None:
@@ -67,8 +66,9 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
     ``‖J̄Q̇ − ẋ‖∞`` of the succeeded steps; the smallest clearance of any guarded part (m) and
     the part and obstacle that have it (``closest``); the probe's own smallest clearance (m);
     the smallest probe tilt from radial (rad); the smallest distance between non-adjacent
-    links (m) and that pair (``closest_pair``); the largest joint acceleration (rad/s²);
-    ``max_limit_excess`` of the worst limit past its true bound (in its unit, see
+    links (m) and that pair (``closest_pair``); the lowest height of the body and carriage
+    links' chords (m) and that link (``lowest_link``); the largest joint acceleration
+    (rad/s²); ``max_limit_excess`` of the worst limit past its true bound (in its unit, see
     ``worst_limit``), also of a limit the start broke, which ``start_broken`` names (a line
     per limit of :func:`dvqp.limits.start_broken_lines`, ``"; "``-joined; None if none); the
     largest joint-limit violation (rad) of ``q`` and velocity-limit violation (rad/s) of
@@ -125,16 +125,17 @@ def _solver_figures(traj: Trajectory) -> Row:
 
 
 def _clearances(scene: Scene, traj: Trajectory) -> Row:
-    """Clearances (and their closest pairs), tilt and the largest joint acceleration."""
-    closest = pair = None
+    """Clearances, self distance, lowest link chord (and where), tilt, largest acceleration."""
+    closest = None
+
+    def at(values: NDArray[np.float64]) -> KinematicState:  # the state of the lowest sample
+        return KinematicState.compute(scene.robot, traj.q[np.argmin(values)], scene.pipe_radius)
+
     if len(scene.obstacles) and np.isfinite(traj.min_clearance).any():
-        k = int(np.argmin(traj.min_clearance))
-        state = KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius)
-        _, part, j = proximity(state, scene.obstacles).closest()
+        _, part, j = proximity(at(traj.min_clearance), scene.obstacles).closest()
         closest = f"{part}/{scene.obstacles.labels[j]}"
-    if traj.self_distance.size:
-        k = int(np.argmin(traj.self_distance))
-        _, pair = self_distance(KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius))
+    pair = self_distance(at(traj.self_distance))[1] if traj.self_distance.size else None
+    link = lowest_link(at(traj.link_height))[1] if traj.link_height.size else None
     return {
         "min_clearance": _finite(np.min(traj.min_clearance)),
         "closest": closest,
@@ -142,15 +143,16 @@ def _clearances(scene: Scene, traj: Trajectory) -> Row:
         "min_tilt": _least(traj.tilt),
         "min_self_distance": _least(traj.self_distance),
         "closest_pair": pair or None,
+        "min_link_height": _least(traj.link_height),
+        "lowest_link": link or None,
         "max_joint_acceleration": _finite(np.abs(traj.qddot).max()) if traj.qddot.size else None,
     }
 
 
 def _limit_figures(scene: Scene, traj: Trajectory) -> Row:
     """The worst exact limit excess, and the joint position and velocity violations."""
-    robot = scene.robot
-    q_out = np.maximum(robot.q_min - traj.q, traj.q - robot.q_max)
-    qd_out = np.abs(traj.qdot) - robot.qd_max
+    q_out = np.maximum(scene.robot.q_min - traj.q, traj.q - scene.robot.q_max)
+    qd_out = np.abs(traj.qdot) - scene.robot.qd_max
     worst = worst_sample_excess(scene, traj)
     found = [b.excess for b in traj.start_broken]  # past their true bounds, not their starts'
     if worst is not None and not worst[1].value <= 0.0:  # else kept

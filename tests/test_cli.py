@@ -319,12 +319,15 @@ def test_plot_of_a_missing_or_foreign_file_says_so_in_one_line(
     with np.load(shapes) as data:
         arrays = {key: data[key] for key in data.files}
     np.savez(shapes, **{**arrays, "tool": arrays["tool"][:, :2]})
+    heights = tmp_path / "heights.npz"  # the link chords' heights without the holder's
+    np.savez(heights, **{**arrays, "holder_height": np.zeros(0)})
     capsys.readouterr()
     cases = {
         tmp_path / "missing.npz": "cannot read: No such file or directory",
         tmp_path / "small.toml": "not a dvqp trajectory (not an .npz file)",
         pickled: "not a dvqp trajectory (not written by 'dvqp plan')",
         shapes: "not a dvqp trajectory (arrays of unexpected shapes)",
+        heights: "not a dvqp trajectory (arrays of unexpected shapes)",
     }
     for path, reason in cases.items():
         assert main(["plot", str(path), "-o", str(png)]) == 2

@@ -178,6 +178,8 @@ def test_bad_arguments_raise_parameter_errors(plain: Trajectory, tmp_path: Path)
         plot.plot_trajectory(plain, png, orbital_level=float("nan"))
     with pytest.raises(ParameterError, match="weld_z"):
         plot.plot_trajectory(plain, png, weld_z="0.3")  # type: ignore[arg-type]
+    with pytest.raises(ParameterError, match="min_height"):
+        plot.plot_trajectory(plain, png, min_height=float("inf"))
     with pytest.raises(ParameterError, match="pipe_radius"):
         plot.plot_trajectory(dataclasses.replace(plain, pipe_radius=0.0), png)
     with pytest.raises(ParameterError, match="fps"):
@@ -185,6 +187,26 @@ def test_bad_arguments_raise_parameter_errors(plain: Trajectory, tmp_path: Path)
     with pytest.raises(ParameterError, match="max_frames"):
         plot.animate_trajectory(plain, gif, max_frames=1)
     assert os.listdir(tmp_path) == []
+
+
+def test_the_heights_panel_draws_the_lowest_link_chord_the_holder_and_min_height(
+    plain: Trajectory,
+) -> None:
+    from matplotlib.figure import Figure
+
+    ax = Figure().add_subplot()
+    plot._draw_heights(ax, drawing.make_view(plain, orbital_level=0.08, min_height=0.02))
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    np.testing.assert_array_equal(lines["lowest link chord"].get_xdata(), plain.t)
+    np.testing.assert_array_equal(lines["lowest link chord"].get_ydata(), plain.link_height)
+    np.testing.assert_array_equal(lines["holder, lowest"].get_ydata(), plain.holder_height)
+    assert list(lines["min_height = 0.02 m"].get_ydata()) == [0.02, 0.02]
+    assert (plain.link_height < plain.points[:, :, 2].min(axis=1)).any()  # a chord dips
+    # a file written before the heights were recorded: drawn without them
+    old = dataclasses.replace(plain, link_height=np.zeros(0), holder_height=np.zeros(0))
+    ax = Figure().add_subplot()
+    plot._draw_heights(ax, drawing.make_view(old, orbital_level=0.08))
+    assert [line.get_label() for line in ax.get_lines()][-2:] == ["tool", "h* = 0.08 m"]
 
 
 def test_missing_matplotlib_is_a_clear_error(

@@ -380,6 +380,9 @@ def test_environment_reads_what_a_plot_needs_without_building_the_robot() -> Non
     env = environment(text)
     assert (env.pipe_radius, env.orbital_level, env.weld) == (0.254, 0.08, 0.35)
     assert [o.radius for o in env.obstacles] == [0.06, 0.05]
+    assert env.min_height is None  # not set: no line is drawn
+    floored = edit(text, "margin = 0.01", "min_height = 0.03\nmargin = 0.01")
+    assert environment(floored).min_height == 0.03
 
 
 def _write_urdf_scene(folder: Path, urdf: str) -> Path:

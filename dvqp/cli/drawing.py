@@ -31,8 +31,9 @@ SHIFTS = (-1, 0, 1)
 
 class View(NamedTuple):
     """A trajectory with what is drawn around it, checked by :func:`make_view`: the pipe
-    ``radius``, orbital level ``h_star`` and ``weld`` z (None: not drawn), and the
-    developed-view axes' ``limits`` ``(l_min, l_max, z_min, z_max)``, all in m."""
+    ``radius``, orbital level ``h_star``, ``weld`` z and the body's ``min_height`` (None: not
+    drawn), and the developed-view axes' ``limits`` ``(l_min, l_max, z_min, z_max)``, all in
+    m."""
 
     traj: Trajectory
     radius: float
@@ -40,6 +41,7 @@ class View(NamedTuple):
     h_star: float | None
     weld: float | None
     limits: tuple[float, float, float, float]
+    min_height: float | None = None
 
     @property
     def aspect(self) -> float:
@@ -52,6 +54,7 @@ def make_view(
     obstacles: Sequence[Shape] = (),
     orbital_level: float | None = None,
     weld_z: float | None = None,
+    min_height: float | None = None,
 ) -> View:
     """Check the inputs and fix the developed-view limits (z: everything drawn, padded).
 
@@ -66,7 +69,8 @@ def make_view(
     finite = np.all(np.isfinite(traj.points)) and np.all(np.isfinite(traj.tool))
     if traj.t.shape[0] < 1 or not finite:
         raise ParameterError("trajectory", "needs at least one sample and finite points")
-    for name, value in (("orbital_level", orbital_level), ("weld_z", weld_z)):
+    for name, value in (("orbital_level", orbital_level), ("weld_z", weld_z),
+                        ("min_height", min_height)):  # fmt: skip
         if value is not None and not (isinstance(value, Real) and math.isfinite(value)):
             raise ParameterError(name, f"must be a finite number, got {value!r}")
     h = None if orbital_level is None else float(orbital_level)
@@ -75,7 +79,8 @@ def make_view(
     zs = np.concatenate([*z, [] if weld is None else [weld]])
     pad, edge = 0.08 * float(np.ptp(zs)) + 0.03, 1.12 * np.pi * radius  # l: beyond the seams
     limits = (-edge, edge, float(zs.min()) - pad, float(zs.max()) + pad)
-    return View(traj, radius, tuple(obstacles), h, weld, limits)
+    floor = None if min_height is None else float(min_height)
+    return View(traj, radius, tuple(obstacles), h, weld, limits, floor)
 
 
 def wrap_arc(l: NDArray[np.float64] | float, radius: float) -> NDArray[np.float64]:

@@ -172,10 +172,10 @@ def _compare(args: argparse.Namespace) -> int:
 def _plot(args: argparse.Namespace) -> int:
     traj = _load_trajectory(args.trajectory)
     drawn_with: dict[str, Any] = {}
-    if traj.scene_text:  # draw the stored scene's obstacles, orbital level and weld
+    if traj.scene_text:  # draw the stored scene's obstacles, levels and weld
         env = environment(traj.scene_text, f"{args.trajectory} (stored scene)")
         drawn_with = {"obstacles": env.obstacles, "orbital_level": env.orbital_level,
-                      "weld_z": env.weld}  # fmt: skip
+                      "weld_z": env.weld, "min_height": env.min_height}  # fmt: skip
     from dvqp.cli import plot
 
     draw = plot.animate_trajectory if args.gif else plot.plot_trajectory
@@ -205,7 +205,8 @@ def _load_trajectory(path: str) -> Trajectory:
 def _drawable(traj: Trajectory) -> bool:
     """The arrays a plot reads are float arrays of consistent shapes."""
     t, q, qdot, tool, points = traj.t, traj.q, traj.qdot, traj.tool, traj.points
-    arrays = (t, q, qdot, tool, points, traj.w, traj.min_clearance)
+    low, holder = traj.link_height, traj.holder_height  # both, or neither (older files)
+    arrays = (t, q, qdot, tool, points, traj.w, traj.min_clearance, low, holder)
     if not all(np.asarray(a).dtype.kind == "f" for a in arrays) or t.ndim != 1 or q.ndim != 2:
         return False
     n1 = t.shape[0]
@@ -213,6 +214,7 @@ def _drawable(traj: Trajectory) -> bool:
         n1 >= 1 and q.shape[0] == n1 and qdot.shape == (n1 - 1, q.shape[1])
         and tool.shape == (n1, 4) and points.ndim == 3 and points.shape[0] == n1
         and points.shape[2] == 3 and traj.w.shape == (n1,) and traj.min_clearance.shape == (n1,)
+        and low.shape == holder.shape in ((n1,), (0,))
     )  # fmt: skip
 
 

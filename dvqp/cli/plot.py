@@ -46,14 +46,16 @@ def plot_trajectory(
     obstacles: Sequence[Shape] = (),
     orbital_level: float | None = None,
     weld_z: float | None = None,
+    min_height: float | None = None,
     instants: int = 6,
 ) -> Path:
     """Draw a trajectory in three panels and save it (format from the suffix).
 
     Panels: (1) the developed view (l, z): seam, weld, obstacles, tool path and the body
     (points 1..k, then the tool) at ``instants`` evenly spaced times, coloured by time;
-    (2) the heights h of the body points and the tool against time; (3) the pipe
-    cross-section (x, y) with the body at the same instants.
+    (2) the heights h of the body points and the tool against time, and (dashed) the lowest
+    point of the body's link chords and of the probe holder (if the trajectory has them);
+    (3) the pipe cross-section (x, y) with the body at the same instants.
 
     Parameters
     ----------
@@ -63,9 +65,9 @@ def plot_trajectory(
         Output file, ``.png``, ``.svg`` or ``.pdf``; its folder must exist. Returned.
     obstacles
         Obstacle shapes (l, z) to draw.
-    orbital_level, weld_z
-        ``h*`` (m, a dashed line and circle) and the axial position of a circumferential weld
-        (m, dashed), drawn if given.
+    orbital_level, weld_z, min_height
+        ``h*`` (m, a dashed line and circle), the axial position of a circumferential weld
+        (m, dashed) and the body's lowest allowed height (m, a dotted line), drawn if given.
     instants
         Number of times at which the body is drawn, >= 1.
 
@@ -77,7 +79,7 @@ def plot_trajectory(
         matplotlib is not installed.
     """
     target = output_path(path, FIGURE_FORMATS)
-    view = make_view(traj, obstacles, orbital_level, weld_z)
+    view = make_view(traj, obstacles, orbital_level, weld_z, min_height)
     _check_count("instants", instants, 1)
     top = float(np.clip(7.6 * view.aspect + 1.1, 2.2, 8.0))
     fig = new_figure((11.0, top + 4.6))
@@ -104,6 +106,7 @@ def animate_trajectory(
     obstacles: Sequence[Shape] = (),
     orbital_level: float | None = None,
     weld_z: float | None = None,
+    min_height: float | None = None,
     fps: int = 20,
     max_frames: int = 120,
 ) -> Path:
@@ -115,7 +118,7 @@ def animate_trajectory(
     :func:`plot_trajectory`.
     """
     target = output_path(path, (".gif",))
-    view = make_view(traj, obstacles, orbital_level, weld_z)
+    view = make_view(traj, obstacles, orbital_level, weld_z, min_height)
     if isinstance(fps, bool) or not isinstance(fps, Real) or not 0 < fps < math.inf:
         raise ParameterError("fps", f"must be > 0, got {fps!r}")
     _check_count("max_frames", max_frames, 2)
@@ -152,13 +155,20 @@ def _draw_developed_panel(
 
 
 def _draw_heights(ax: Axes, view: View) -> None:
-    """Heights h (m) of the body points and the tool against time, and ``h*``."""
+    """Heights h (m) of the body points, the tool, the lowest link chord and the holder's
+    lowest point against time, ``h*`` and ``min_height``."""
     traj = view.traj
     for j in range(traj.points.shape[1]):
         ax.plot(traj.t, traj.points[:, j, 2], lw=1.2, label=f"point {j + 1}")
     ax.plot(traj.t, traj.tool[:, 2], "k-", lw=1.6, label="tool")
+    if traj.link_height.size:  # absent from files written before they were recorded
+        ax.plot(traj.t, traj.link_height, "m--", lw=1.2, label="lowest link chord")
+        ax.plot(traj.t, traj.holder_height, "k--", lw=1.2, label="holder, lowest")
     if view.h_star is not None:
         ax.axhline(view.h_star, color="0.3", ls="--", lw=1.2, label=f"h* = {view.h_star:.3g} m")
+    if view.min_height is not None:
+        ax.axhline(view.min_height, color="tab:red", ls=":", lw=1.4,
+                   label=f"min_height = {view.min_height:.3g} m")  # fmt: skip
     ax.set(xlabel="t (s)", ylabel="h (m)", title="heights above the pipe surface")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small", ncol=2)

@@ -57,6 +57,7 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         f"tilt from radial >= {cell(row['min_tilt'], '{:.3f} rad')}",
         f"self distance   {cell(row['min_self_distance'], '{:.4f} m')}"
         + (f" ({row['closest_pair']})" if row["closest_pair"] else ""),
+        *([_heights(row, traj)] if traj.link_height.size else []),  # absent in old files
         f"acceleration    max |qdd| {cell(row['max_joint_acceleration'], '{:.3g} rad/s^2')}",
         f"limits          {_limits(row, traj)}",
         f"step time       median {cell(row['median_step_us'], '{:.0f}')} us, "
@@ -75,6 +76,15 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
     if output is not None:
         lines.append(f"saved           {output}")
     return "\n".join(lines)
+
+
+def _heights(row: Row, traj: Trajectory) -> str:
+    """``link heights    lowest +0.0500 m (link4), holder +0.0417 m``: the lowest point of the
+    body and carriage links' chords (and that link) and of the probe holder."""
+    where = f" ({row['lowest_link']})" if row["lowest_link"] else ""
+    holder = cell(min(traj.holder_height, default=None), "{:+.4f} m")
+    low = cell(row["min_link_height"], "{:+.4f} m")
+    return f"link heights    lowest {low}{where}, holder {holder}"
 
 
 def _result(row: Row) -> str:

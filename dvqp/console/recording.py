@@ -49,12 +49,14 @@ class Sample:
     self_distance: float
     limit_excess: float
     limits_kept: bool
+    link_height: float
+    holder_height: float
 
     @classmethod
     def of(cls, stepper: Stepper) -> Sample:
         """The state ``stepper`` has loaded (copied)."""
         a, k = stepper.arrays, stepper.robot.n_points
-        tilt, apart, clearance, probe, closest = (float(v) for v in a.diagnostics)
+        tilt, apart, clearance, probe, closest, low, holder = (float(v) for v in a.diagnostics)
         where = None
         if closest >= 0:
             m = a.near.point_distance.shape[1]
@@ -64,7 +66,7 @@ class Sample:
         excess = stepper.excess_now
         return cls(a.state.q.copy(), a.state.tool.copy(), a.state.guarded[:k].copy(),
                    float(a.objective.value[0]), clearance, probe, where, tilt, apart,
-                   max(float(excess[0]), 0.0), bool(excess[1] <= 1.0))  # fmt: skip
+                   max(float(excess[0]), 0.0), bool(excess[1] <= 1.0), low, holder)  # fmt: skip
 
 
 class Recording:

@@ -8,7 +8,7 @@ and the exact verification of its distances.
 from dvqp.limits.acceleration import DEFAULT_QDD_MAX, AccelerationLimit
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, damper_value
 from dvqp.limits.excess import NO_EXCESS, Excess, StartBroken, start_broken_lines
-from dvqp.limits.height import ProbeHeight, SurfaceHeight
+from dvqp.limits.height import ProbeHeight, SurfaceHeight, lowest_link
 from dvqp.limits.joints import JointPositionLimit, JointVelocityLimit
 from dvqp.limits.limit import Bounds, Constraint, Limit
 from dvqp.limits.obstacle_damper import ObstacleDamper
@@ -19,5 +19,6 @@ __all__ = [
     "DEFAULT_DECELERATION", "DEFAULT_QDD_MAX", "NO_EXCESS", "AccelerationLimit", "Bounds",
     "Constraint", "Distances", "Excess", "JointPositionLimit", "JointVelocityLimit", "Limit",
     "ObstacleDamper", "ProbeHeight", "SelfCollision", "StartBroken", "SurfaceHeight",
-    "TiltLimit", "VelocityDamper", "damper_value", "self_distance", "start_broken_lines",
+    "TiltLimit", "VelocityDamper", "damper_value", "lowest_link", "self_distance",
+    "start_broken_lines",
 ]  # fmt: skip

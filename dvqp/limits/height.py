@@ -8,6 +8,8 @@ them: with ``P(t) = A + t (B − A)`` its distance from the pipe axis ``ρ(t) = 
 so ``h = ρ(t*) − R`` exactly, and ``∂h/∂Q = (P_xy(t*)/ρ)ᵀ ((1 − t*) J_A + t* J_B)`` (the
 envelope theorem: moving ``t*`` does not change ``ρ`` to first order). A chord's row applies
 where ``t*`` is inside the link (by more than 1e-9); at an end, that point's own row holds.
+The same lowest points are a run's recorded ``link_height`` and ``holder_height``
+(:func:`lowest_chords`, in the compiled step's diagnostics).
 """
 
 from __future__ import annotations
@@ -19,7 +21,10 @@ import numpy as np
 from numba import njit
 
 from dvqp.errors import ParameterError
+from dvqp.geometry.proximity import link_label
+from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
+from dvqp.workspace import link_ends
 
 
 class SurfaceHeight(VelocityDamper):
@@ -119,28 +124,62 @@ def height_distances(guarded, jacobians, first, count, start, distance, gradient
 
 
 @njit(cache=True)
+def chord_low(guarded, origins, a, b, radius):  # type: ignore[no-untyped-def]
+    """``(h, t*, inside, u_x, u_y)`` of the lowest point of the chord joining guarded frames
+    ``a`` and ``b`` (``origins`` (m, 3), m): its height (m; where the lowest point is an end,
+    that end's own, ``guarded[., 2]``, so that it ties exactly with the end's row), its
+    parameter, whether it lies inside the link (by more than 1e-9: not at an end, nor within
+    round-off of one; the carriage link of a rail arm lies in the tangent plane at the rail
+    point, t* = 0) and the unit xy direction from the pipe axis to it."""
+    ax, ay = origins[a, 0], origins[a, 1]
+    ex, ey = origins[b, 0] - ax, origins[b, 1] - ay
+    length2 = ex * ex + ey * ey
+    t = min(max(-(ax * ex + ay * ey) / length2, 0.0), 1.0) if length2 > 0.0 else 0.0
+    px, py = ax + t * ex, ay + t * ey
+    rho = math.hypot(px, py)
+    inside = 1e-9 < t < 1.0 - 1e-9 and rho > 0.0
+    h = rho - radius if inside else guarded[a if t < 0.5 else b, 2]
+    return h, t, inside, px / max(rho, 1e-300), py / max(rho, 1e-300)
+
+
+@njit(cache=True)
 def chord_heights(
     guarded, origins, frame_jacobians, ends, radius, chords, distance, gradient, usable
 ) -> None:  # type: ignore[no-untyped-def]
     """The height (m) of the lowest point of guarded link ``chords[c, 1]`` (joining guarded
-    frames ``ends[link]``; ``origins`` (m, 3), ``frame_jacobians`` (m, 6, n)) and its
-    ``∂h/∂Q`` (see the module docstring) into row ``chords[c, 0]``, for each row c of
-    ``chords`` (C, 2). Where the lowest point is an end, the height is that end's own
-    (``guarded`` (m, 3)), so that it ties exactly with the end's row."""
+    frames ``ends[link]``; ``frame_jacobians`` (m, 6, n)) and its ``∂h/∂Q`` (see the module
+    docstring) into row ``chords[c, 0]``, for each row c of ``chords`` (C, 2); a row applies
+    where the lowest point is inside the link (:func:`chord_low`)."""
     for c in range(chords.shape[0]):
         r, a, b = chords[c, 0], ends[chords[c, 1], 0], ends[chords[c, 1], 1]
-        ax, ay = origins[a, 0], origins[a, 1]
-        ex, ey = origins[b, 0] - ax, origins[b, 1] - ay
-        length2 = ex * ex + ey * ey
-        t = min(max(-(ax * ex + ay * ey) / length2, 0.0), 1.0) if length2 > 0.0 else 0.0
-        px, py = ax + t * ex, ay + t * ey
-        rho = math.hypot(px, py)
-        # a row where t* is inside the link (not at an end, or within round-off of one: the
-        # carriage link of a rail arm lies in the tangent plane at the rail point, t* = 0)
-        usable[r] = 1e-9 < t < 1.0 - 1e-9 and rho > 0.0
-        distance[r] = rho - radius if usable[r] else guarded[a if t < 0.5 else b, 2]
-        ux, uy = px / max(rho, 1e-300), py / max(rho, 1e-300)
+        distance[r], t, usable[r], ux, uy = chord_low(guarded, origins, a, b, radius)
         for q in range(gradient.shape[1]):
             jx = (1.0 - t) * frame_jacobians[a, 0, q] + t * frame_jacobians[b, 0, q]
             jy = (1.0 - t) * frame_jacobians[a, 1, q] + t * frame_jacobians[b, 1, q]
             gradient[r, q] = ux * jx + uy * jy
+
+
+@njit(cache=True)
+def lowest_chords(guarded, origins, ends, k, radius):  # type: ignore[no-untyped-def]
+    """``(h, i, h_holder)``: the lowest height (m) of the chords of the guarded links ``ends``
+    (L, 2) other than the probe holder (link ``k − 1``): the body links and the carriage link,
+    each at its lowest point (:func:`chord_low`); the link i that has it (−1: none); and the
+    holder's lowest height (m; inf: none)."""
+    low, which, holder = math.inf, -1, math.inf
+    for i in range(ends.shape[0]):
+        h = chord_low(guarded, origins, ends[i, 0], ends[i, 1], radius)[0]
+        if i == k - 1:
+            holder = h
+        elif h < low:
+            low, which = h, i
+    return low, which, holder
+
+
+def lowest_link(state: KinematicState) -> tuple[float, str]:
+    """The lowest height (m) of the body links' and the carriage link's chords at ``state``
+    (:func:`lowest_chords`) and that link's name (``"link2"``, ``"carriage"``; inf and ``""``
+    without links)."""
+    ends = link_ends(state.k, state.rail)
+    low, which, _ = lowest_chords(np.array(state.guarded), np.array(state.origins), ends,
+                                  state.k, state.radius)  # fmt: skip
+    return float(low), link_label(int(which), state.k) if which >= 0 else ""

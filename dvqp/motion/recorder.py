@@ -1,8 +1,9 @@
 """Collects the samples and steps of a run into preallocated arrays, then a Trajectory.
 
-The samples (configuration, tool, body points, objective, clearances, tilt, the worst exact
-limit excess) are written by the compiled step as it concludes each state it reaches
-(:class:`~dvqp.step.arrays.RecordArrays`); the steps (velocity, status, times) here.
+The samples (configuration, tool, body points, objective, clearances, tilt, the lowest link
+chords, the worst exact limit excess) are written by the compiled step as it concludes each
+state it reaches (:class:`~dvqp.step.arrays.RecordArrays`); the steps (velocity, status,
+times) here.
 """
 
 from __future__ import annotations
@@ -13,7 +14,8 @@ from dvqp.limits.excess import StartBroken
 from dvqp.motion.trajectory import Trajectory
 from dvqp.step import Advance
 
-PER_SAMPLE = ("w", "min_clearance", "probe_clearance", "tilt", "self_distance", "limit_excess")
+PER_SAMPLE = ("w", "min_clearance", "probe_clearance", "tilt", "self_distance", "limit_excess",
+              "link_height", "holder_height")  # fmt: skip
 PER_STEP = ("solve_time", "solver_time", "step_time", "task_error")
 
 

@@ -22,8 +22,8 @@ ARRAYS = ("t", "q", "qdot", "tool", "points", "w", "min_clearance", "solve_time"
 """The arrays every trajectory file holds."""
 
 DIAGNOSTICS = ("probe_clearance", "tilt", "self_distance", "limit_excess", "limits_kept",
-               "substeps", "qddot", "solver_time")  # fmt: skip
-"""Arrays added in dvqp 0.2; files written before hold none of them (loaded as empty)."""
+               "substeps", "qddot", "solver_time", "link_height", "holder_height")  # fmt: skip
+"""Arrays added since dvqp 0.2; a file written before one was added lacks it (loaded empty)."""
 
 CONVENTIONS = {
     "failed_steps": (
@@ -87,6 +87,11 @@ class Trajectory:
     self_distance : ndarray, shape (N+1,)
         Smallest 3-D distance between two non-adjacent links of the arm (the probe holder
         included), m.
+    link_height, holder_height : ndarray, shape (N+1,) or (0,)
+        The lowest height over the pipe surface (m) of the body links and the carriage link,
+        and of the probe holder (last body point to the tool): each link the lowest point of
+        its real straight 3-D chord (an end's own height where that is lowest). Empty in a
+        file written before they were recorded (the reports and plots then leave them out).
     qddot : ndarray, shape (N, n)
         Joint acceleration at the start of each step, ``(qdot[k] − qdot[k−1]) / dt`` with the
         run starting at rest, rad/s².
@@ -126,6 +131,8 @@ class Trajectory:
     self_distance: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     qddot: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 0)))
     solver_time: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    link_height: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    holder_height: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     start_broken: tuple[StartBroken, ...] = ()
     brake_start: int = -1
 

@@ -153,16 +153,19 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
 
 @dataclass(frozen=True)
 class Environment:
-    """What a plot needs of a scene: the pipe, the orbital level, the weld and the obstacles."""
+    """What a plot needs of a scene: the pipe, the orbital level, the weld, the obstacles and
+    ``min_height`` (None: not set)."""
 
     pipe_radius: float
     orbital_level: float
     weld: float | None
     obstacles: ObstacleSet
+    min_height: float | None = None
 
 
 def environment(text: str, source: str = "<string>") -> Environment:
-    """Read only the pipe, objective and obstacles of scene text (no robot is built).
+    """Read only the pipe, objective, obstacles and ``min_height`` of scene text (no robot is
+    built).
 
     For a trajectory's stored scene, whose URDF may no longer be where it was.
     """
@@ -172,8 +175,10 @@ def environment(text: str, source: str = "<string>") -> Environment:
         radius, weld = sec.pipe(f, doc)
     with f.guard("objective"):
         level = sec.orbital_level(f, doc)
+    with f.guard("constraints"):
+        floor = sec.min_height(f, doc)
     with f.guard("obstacles"):
-        return Environment(radius, level, weld, obstacle_section.obstacles(f, doc, radius))
+        return Environment(radius, level, weld, obstacle_section.obstacles(f, doc, radius), floor)
 
 
 def _parse(f: Fields, text: str) -> dict[str, Any]:

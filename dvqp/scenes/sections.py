@@ -70,6 +70,12 @@ def orbital_level(f: Fields, doc: dict[str, Any]) -> float:
     return f.number(t, "orbital_level", "objective", within=HEIGHT)
 
 
+def min_height(f: Fields, doc: dict[str, Any]) -> float | None:
+    """``constraints.min_height``, m (None: the scene does not set it)."""
+    t = f.table(doc, "constraints", "", CONSTRAINT_KEYS, required=False)
+    return f.number(t, "min_height", "constraints") if "min_height" in t else None
+
+
 def objective(f: Fields, doc: dict[str, Any], k: int, obstacles: ObstacleSet) -> Objective:
     """``[objective]`` for ``k`` body points: the paper's three terms with the obstacles."""
     t = f.table(doc, "objective", "", OBJECTIVE_KEYS)

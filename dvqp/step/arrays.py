@@ -108,14 +108,16 @@ class RecordArrays:
     self_distance: Array
     min_clearance: Array
     probe_clearance: Array
+    link_height: Array
+    holder_height: Array
 
     @classmethod
     def none(cls, n: int, k: int) -> RecordArrays:
         """Nothing recorded."""
         z = np.zeros(0)
         return cls(np.full(1, -1, np.int64), np.zeros((0, n)), np.zeros((0, 4)),
-                   np.zeros((0, k, 3)), z, z.copy(), np.zeros(0, np.bool_), z.copy(), z.copy(),
-                   z.copy(), z.copy())  # fmt: skip
+                   np.zeros((0, k, 3)), z, z.copy(), np.zeros(0, np.bool_),
+                   *(z.copy() for _ in range(6)))  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -126,8 +128,9 @@ class Pipeline:
     integrates, ``motion`` (2,) the integrated step's ``[‖A x − b‖∞, largest joint motion]``;
     ``joint_values`` and ``damper_values`` where the joint room and the damper rows start
     among the verified values (−1: none);
-    ``diagnostics`` (5,) the state's ``[tilt, self distance, min clearance, probe clearance,
-    index of the closest part]`` over the ``recorded`` obstacle rows.
+    ``diagnostics`` (7,) the state's ``[tilt, self distance, min clearance, probe clearance,
+    index of the closest part]`` over the ``recorded`` obstacle rows, and the lowest height of
+    the body and carriage links' chords and of the probe holder's.
     """
 
     radius: float

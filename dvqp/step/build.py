@@ -267,5 +267,5 @@ def lay_out(robot: Robot, radius: float, resolver: Resolver, q0: ArrayLike, dt: 
         plan.state, shapes, plan.proximity, plan.pairs, layout.objective, layout.bounds,
         layout.measures, layout.params, plan.dampers, plan.qp,
         PinvArrays(baseline, weights, layout.hooks.soft, damping, np.zeros(2), x),
-        plan.checks, layout.joint_values, layout.damper_values, rows, np.zeros(5), record,
+        plan.checks, layout.joint_values, layout.damper_values, rows, np.zeros(7), record,
     )  # fmt: skip

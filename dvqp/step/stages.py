@@ -21,7 +21,7 @@ from dvqp.kinematics.model import kinematics
 from dvqp.limits.acceleration import acceleration_bounds
 from dvqp.limits.damper import damper_rows, damper_values
 from dvqp.limits.excess import worst_excess
-from dvqp.limits.height import chord_heights, height_distances
+from dvqp.limits.height import chord_heights, height_distances, lowest_chords
 from dvqp.limits.joints import joint_room, position_bounds, velocity_bounds
 from dvqp.limits.obstacle_damper import obstacle_distances
 from dvqp.limits.self_collision import pair_distances, self_distances
@@ -133,10 +133,12 @@ def _conclude(s) -> None:  # type: ignore[no-untyped-def]
 
 @njit(cache=True, inline="always")
 def _diagnostics(s) -> None:  # type: ignore[no-untyped-def]
-    """``[tilt, self distance, min clearance, probe clearance, closest part]`` (rad, m, m, m,
-    index ``r (m + L) + i`` of recorded obstacle r's point i, or ``+ m`` of its link i)."""
+    """``[tilt, self distance, min clearance, probe clearance, closest part, lowest link
+    chord, lowest holder point]`` (rad, m, m, m, index ``r (m + L) + i`` of recorded obstacle
+    r's point i, or ``+ m`` of its link i, m, m)."""
     st, near, out, k = s.state, s.near, s.diagnostics, s.model.tool
     out[0] = tilt_angle(st.origins, st.axes, k)
+    out[5], _, out[6] = lowest_chords(st.guarded, st.origins, near.ends, k, s.radius)
     out[1] = math.inf
     for p in range(s.pairs.distance.shape[0]):
         out[1] = min(out[1], s.pairs.distance[p])
@@ -168,6 +170,7 @@ def _sample(s) -> None:  # type: ignore[no-untyped-def]
     r.limit_excess[at], r.limits_kept[at] = max(c.excess[0], 0.0), c.excess[1] <= 1.0
     d = s.diagnostics
     r.tilt[at], r.self_distance[at], r.min_clearance[at], r.probe_clearance[at] = d[:4]
+    r.link_height[at], r.holder_height[at] = d[5], d[6]
     if c.row[0] != at:  # a new sample: those before it are final
         c.row[0] = at
         for i in range(c.lowest.shape[0]):
