@@ -277,31 +277,44 @@ def _heights(limit: object, state: KinematicState) -> Measured:
                     np.array([True] * len(points) + applies))  # fmt: skip
 
 
-def bend(a: Array, b: Array) -> tuple[float, float]:
-    """``(g, t*)``: the largest (signed) ``θ(t) − t Δφ`` (rad) of the 3-D link ``a → b`` (the
-    DV image's departure from the straight DV segment, over R) and where, by sampling then a
-    bisection of its slope (not dvqp's quadratic)."""
-    e = b[:2] - a[:2]
-    phi = math.atan2(a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1])
-    t = np.linspace(0.0, 1.0, 2001)
-    p = a[None, :2] + t[:, None] * e[None]
-    g = np.unwrap(np.arctan2(p[:, 1], p[:, 0]) - math.atan2(a[1], a[0])) - t * phi
-    g -= g[0]
-    i = int(np.argmax(np.abs(g)))
-    if abs(g[i]) < 1e-15 or i in (0, t.size - 1):
-        return 0.0, 0.0
+def bends(a: Array, b: Array) -> tuple[Array, Array]:
+    """``(g, t*)`` of P 3-D links ``a → b`` (each (P, 3)): the largest (signed)
+    ``θ(t) − t Δφ`` (rad; the DV image's departure from the straight DV segment, over R) and
+    where, by sampling each link at 257 points, then bisecting its slope between the best
+    sample's neighbours (not dvqp's quadratic). ``(0, 0)`` for a link that does not bend."""
+    a, b = np.atleast_2d(a)[:, :2], np.atleast_2d(b)[:, :2]
+    e = b - a
+    cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    phi = np.arctan2(cross, (a * b).sum(axis=1))
 
-    def slope(u: float) -> float:  # θ'(u) − Δφ
-        x, y = a[0] + u * e[0], a[1] + u * e[1]
-        return (x * e[1] - y * e[0]) / (x * x + y * y) - phi
+    def g(u: Array) -> Array:  # (P, S) at parameters u (P, S)
+        x, y = a[:, :1] + u * e[:, :1], a[:, 1:] + u * e[:, 1:]
+        turn = np.arctan2(a[:, :1] * y - a[:, 1:] * x, a[:, :1] * x + a[:, 1:] * y)
+        return turn - u * phi[:, None]  # type: ignore[no-any-return]
 
-    lo, hi = t[i - 1], t[i + 1]
-    for _ in range(200):
+    def slope(u: Array) -> Array:  # θ'(u) − Δφ, (P,)
+        x, y = a[:, 0] + u * e[:, 0], a[:, 1] + u * e[:, 1]
+        return (x * e[:, 1] - y * e[:, 0]) / (x * x + y * y) - phi  # type: ignore[no-any-return]
+
+    t = np.broadcast_to(np.linspace(0.0, 1.0, 257), (a.shape[0], 257))
+    sampled = g(t)
+    i = np.clip(np.argmax(np.abs(sampled), axis=1), 1, 255)
+    lo, hi = t[0, i - 1], t[0, i + 1]
+    rising = slope(lo) > 0
+    for _ in range(60):
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if (slope(mid) > 0) == (slope(lo) > 0) else (lo, mid)
+        same = (slope(mid) > 0) == rising
+        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
     u = 0.5 * (lo + hi)
-    x, y = a[0] + u * e[0], a[1] + u * e[1]
-    return math.atan2(a[0] * y - a[1] * x, a[0] * x + a[1] * y) - u * phi, u
+    found = g(u[:, None])[:, 0]
+    flat = np.abs(sampled).max(axis=1) < 1e-15
+    return np.where(flat, 0.0, found), np.where(flat, 0.0, u)
+
+
+def bend(a: Array, b: Array) -> tuple[float, float]:
+    """:func:`bends` of one link."""
+    g, t = bends(a, b)
+    return float(g[0]), float(t[0])
 
 
 def _turn(o: Array, jac: Array, a: int, b: int, t: float) -> Array:
@@ -328,7 +341,7 @@ def real_clearances(obstacles: Sequence[object], frames: object, radius: float, 
     shapes = tuple(obstacles)
     own = ShapeArrays.of(shapes, period).code == OTHER  # shapes of your own: one piece
     straight = measure_chain(shapes, guarded, period, ends)
-    whole = np.array([radius * abs(bend(o[a], o[b])[0]) for a, b in ends])
+    whole = radius * np.abs(bends(o[ends[:, 0]], o[ends[:, 1]])[0])
     value = straight.link_distance - whole[None]
     closest = (straight.link_distance + whole[None]).min(axis=1, initial=math.inf)  # (J,)
     t, normal = straight.link_t.copy(), straight.link_normal.copy()
@@ -350,18 +363,24 @@ def real_clearances(obstacles: Sequence[object], frames: object, radius: float, 
                 turn = np.arctan2(x * p[:, 1] - y * p[:, 0], x * p[:, 0] + y * p[:, 1])
                 lz = np.column_stack([guarded[a, 0] + radius * turn, p[:, 2]])
                 d, s, nn = segment_distances([shape], lz[:-1], lz[1:], period)
-                bends = radius * np.abs([bend(p[c], p[c + 1])[0] for c in range(count)])
-                c = int(np.argmin(d[0] - bends))
+                bent_by = radius * np.abs(bends(p[:-1], p[1:])[0])
+                c = int(np.argmin(d[0] - bent_by))
                 value[j, i], t[j, i], normal[j, i] = (
-                    d[0, c] - bends[c],
+                    d[0, c] - bent_by[c],
                     (c + s[0, c]) / count,
                     nn[0, c],
                 )
-                piece[j, i], bent, count = (u[c], u[c + 1]), bends[c], 2 * count
+                piece[j, i], bent, count = (u[c], u[c + 1]), bent_by[c], 2 * count
     if jac is None:
         return value, t, (normal != 0.0).any(axis=-1), np.zeros((*value.shape, 0))
     gradient = np.zeros((*value.shape, jac.shape[2]))
-    for (j, i), _ in np.ndenumerate(value):
+    pairs = list(np.ndindex(value.shape))
+    start = np.array([(1 - piece[j, i, 0]) * o[ends[i, 0]] + piece[j, i, 0] * o[ends[i, 1]]
+                      for j, i in pairs]).reshape(-1, 3)  # fmt: skip
+    stop = np.array([(1 - piece[j, i, 1]) * o[ends[i, 0]] + piece[j, i, 1] * o[ends[i, 1]]
+                     for j, i in pairs]).reshape(-1, 3)  # fmt: skip
+    piece_bends = bends(start, stop) if pairs else (np.zeros(0), np.zeros(0))
+    for r, (j, i) in enumerate(pairs):
         a, b = ends[i]
         t0, t1 = piece[j, i]
         s = (t[j, i] - t0) / (t1 - t0)
@@ -369,7 +388,7 @@ def real_clearances(obstacles: Sequence[object], frames: object, radius: float, 
         z0, z1 = ((1 - x) * jac[a, 2] + x * jac[b, 2] for x in (t0, t1))
         gradient[j, i] = (normal[j, i, 0] * radius * ((1 - s) * turn0 + s * turn1)
                           + normal[j, i, 1] * ((1 - s) * z0 + s * z1))  # fmt: skip
-        g, w = bend((1 - t0) * o[a] + t0 * o[b], (1 - t1) * o[a] + t1 * o[b])
+        g, w = piece_bends[0][r], piece_bends[1][r]
         if g != 0.0:
             at = _turn(o, jac, a, b, t0 + w * (t1 - t0)) - (1 - w) * turn0 - w * turn1
             gradient[j, i] -= radius * math.copysign(1.0, g) * at
