@@ -29,7 +29,7 @@ from dvqp.limits import (
     VelocityDamper,
 )
 from tests.common import PIPE_RADIUS
-from tests.oracle_limits import damper_rhs, distance_jacobian, measure
+from tests.oracle_limits import closest_parts, damper_rhs, distance_jacobian, measure
 
 DT = 0.005
 ROOT = Path(__file__).resolve().parent.parent
@@ -114,7 +114,9 @@ def damper_rows(stepper: Stepper, limit: VelocityDamper, q: ArrayLike, dt: float
         dampers = [d for d in stepper.resolver.spec.limits if type(d) is ObstacleDamper]
         refine = np.array([max(d.margin for d in dampers if any(o is x for x in d.obstacles))
                            for o in limit.obstacles])  # fmt: skip
-    found = measure(limit, KinematicState.compute(stepper.robot, q, radius), refine)
+    union, state = stepper.layout.shapes, KinematicState.compute(stepper.robot, q, radius)
+    closest = closest_parts(union, state, radius) if union else None  # over the step's obstacles
+    found = measure(limit, state, refine, closest)
     if found.value.shape[0] == 0:  # a damper without distances (no obstacle) has no rows;
         return Constraint(np.zeros((0, q.shape[0])), np.zeros(0))  # (Stepper.rows: the box)
     rows = stepper.rows(limit)
@@ -127,7 +129,8 @@ def damper_rows(stepper: Stepper, limit: VelocityDamper, q: ArrayLike, dt: float
     if gradient and found.gradient is not None:
         np.testing.assert_allclose(rows.G, -found.gradient[on], rtol=0, atol=1e-12)
     if gradient and (fd or found.gradient is None):
-        numeric = distance_jacobian(limit, stepper.robot, q, radius, refine=refine)[on]
+        numeric = distance_jacobian(limit, stepper.robot, q, radius, refine=refine,
+                                    union=union or None)[on]  # fmt: skip
         scale = max(float(np.abs(numeric).max(initial=0.0)), 1e-3)
         np.testing.assert_allclose(-rows.G, numeric, rtol=0, atol=2e-6 * scale)
     return rows

@@ -201,13 +201,18 @@ class Measured:
     applies: NDArray[np.bool_]
 
 
-def measure(limit: object, state: KinematicState, refine: Array | None = None) -> Measured:
+def measure(
+    limit: object,
+    state: KinematicState,
+    refine: Array | None = None,
+    closest: tuple[float, float] | None = None,
+) -> Measured:
     """The distances of one of dvqp's dampers, or of a user's :class:`VelocityDamper` (its
     own ``distances``), at ``state``; an obstacle damper's links refined below ``refine`` (per
-    obstacle, m; default: its margin; see :func:`real_clearances`)."""
+    obstacle, m; default: its margin) and ``closest`` (see :func:`real_clearances`)."""
     k, n = state.k, state.n
     if type(limit) is ObstacleDamper:
-        return _clearances(limit, state, refine)
+        return _clearances(limit, state, refine, closest)
     if type(limit) in (SurfaceHeight, ProbeHeight):
         return _heights(limit, state)
     if type(limit) is TiltLimit:
@@ -324,13 +329,39 @@ def _turn(o: Array, jac: Array, a: int, b: int, t: float) -> Array:
     return (p[0] * dp[1] - p[1] * dp[0]) / (p[0] ** 2 + p[1] ** 2)  # type: ignore[no-any-return]
 
 
+def dv_from(a: Array, la: float, p: Array, radius: float) -> Array:
+    """``[l, z]`` (m) of 3-D points ``p`` (P, 3), ``l`` continued from ``a``'s (``la``)."""
+    x, y = a[0], a[1]
+    turn = np.arctan2(x * p[:, 1] - y * p[:, 0], x * p[:, 0] + y * p[:, 1])
+    return np.column_stack([la + radius * turn, p[:, 2]])
+
+
+def closest_parts(
+    obstacles: Sequence[object], frames: object, radius: float
+) -> tuple[float, float]:
+    """Above the arm's closest part to any of ``obstacles``, and above the probe's or its
+    holder's (m): points exactly, links as their straight DV segments plus their bend."""
+    k, o = frames.k, np.asarray(frames.origins)  # type: ignore[attr-defined]
+    ends = guarded_links(k, frames.rail)  # type: ignore[attr-defined]
+    near = measure_chain(tuple(obstacles), np.asarray(frames.guarded), 2 * math.pi * radius, ends)  # type: ignore[attr-defined]
+    upper = near.link_distance + radius * np.abs(bends(o[ends[:, 0]], o[ends[:, 1]])[0])[None]
+    holder = int(np.flatnonzero(ends[:, 1] == k)[0])
+    arm = min(near.point_distance.min(initial=math.inf), upper.min(initial=math.inf))
+    probe = min(
+        near.point_distance[:, k].min(initial=math.inf), upper[:, holder].min(initial=math.inf)
+    )
+    return float(arm), float(probe)
+
+
 def real_clearances(obstacles: Sequence[object], frames: object, radius: float, refine: Array,
+                    closest: tuple[float, float] | None = None,
                     jac: Array | None = None) -> tuple[Array, Array, Array, Array]:  # fmt: skip
     """Each link's clearance to each obstacle as dvqp defines it (``dvqp.geometry.real_links``),
     rebuilt from other parts: the straight pieces' distances by
     :func:`dvqp.geometry.segment_distances`, their bends by :func:`bend` (sampling and
-    bisection), the rule written out again (a pair in pieces where its bound is below
-    ``refine`` (J,) of its obstacle, m, the closest link to it, or the holder). Returns the
+    bisection), the rule written out again: a pair in pieces where its bound is below
+    ``refine`` (J,) of its obstacle, m, or below ``closest`` (:func:`closest_parts` of every
+    obstacle of the step; default: of these), halved as dvqp halves them. Returns the
     clearance (J, L), the link parameter of its closest point (J, L), whether its normal is
     defined (J, L), and with ``jac`` (the frames' Jacobians (m, 6, n)) its gradient (J, L, n) by the
     envelope formula written in NumPy. ``frames``: a state or Pinocchio's frames (``origins``,
@@ -343,34 +374,38 @@ def real_clearances(obstacles: Sequence[object], frames: object, radius: float, 
     straight = measure_chain(shapes, guarded, period, ends)
     whole = radius * np.abs(bends(o[ends[:, 0]], o[ends[:, 1]])[0])
     value = straight.link_distance - whole[None]
-    closest = (straight.link_distance + whole[None]).min(axis=1, initial=math.inf)  # (J,)
+    arm, probe = closest_parts(shapes, frames, radius) if closest is None else closest
     t, normal = straight.link_t.copy(), straight.link_normal.copy()
     piece = np.zeros((*value.shape, 2))  # [t0, t1] of the closest piece
     piece[..., 1] = 1.0
     for i, (a, b) in enumerate(ends):
-        first = max(1, math.ceil(math.sqrt(2 * whole[i] / 1e-5)))
         for j, shape in enumerate(shapes):
-            holder = b == k
-            if first == 1 or own[j]:
+            reported = probe if b == k else arm
+            if 2 * whole[i] <= 1e-5 or own[j]:
                 continue
-            if not (value[j, i] < refine[j] + 2 * whole[i] or value[j, i] < closest[j] or holder):
+            if not (value[j, i] < refine[j] + 2 * whole[i] or value[j, i] < reported):
                 continue
-            count, bent = first, math.inf
-            while 2 * bent > 1e-5:  # until the closest piece bends by 5 µm at most
-                u = np.linspace(0.0, 1.0, count + 1)
-                p = o[a][None] + u[:, None] * (o[b] - o[a])[None]
-                x, y = o[a][0], o[a][1]
-                turn = np.arctan2(x * p[:, 1] - y * p[:, 0], x * p[:, 0] + y * p[:, 1])
-                lz = np.column_stack([guarded[a, 0] + radius * turn, p[:, 2]])
-                d, s, nn = segment_distances([shape], lz[:-1], lz[1:], period)
-                bent_by = radius * np.abs(bends(p[:-1], p[1:])[0])
-                c = int(np.argmin(d[0] - bent_by))
-                value[j, i], t[j, i], normal[j, i] = (
-                    d[0, c] - bent_by[c],
-                    (c + s[0, c]) / count,
-                    nn[0, c],
-                )
-                piece[j, i], bent, count = (u[c], u[c + 1]), bent_by[c], 2 * count
+            live, upper, best = np.array([[0.0, 1.0]]), math.inf, math.inf
+            while live.size:  # the pieces, halved a level at a time (branch and bound)
+                p0 = o[a][None] + live[:, :1] * (o[b] - o[a])[None]
+                p1 = o[a][None] + live[:, 1:] * (o[b] - o[a])[None]
+                lz0 = dv_from(o[a], guarded[a, 0], p0, radius)
+                lz1 = dv_from(o[a], guarded[a, 0], p1, radius)
+                d, s, nn = segment_distances([shape], lz0, lz1, period)
+                d, s, nn = d[0], s[0], nn[0]
+                bent = radius * np.abs(bends(p0, p1)[0])
+                upper = min(upper, float((d + bent).min()))
+                final = 2 * bent <= 1e-5
+                for c in np.flatnonzero(final):
+                    if d[c] - bent[c] < best:
+                        best = d[c] - bent[c]
+                        t0, t1 = live[c]
+                        value[j, i], normal[j, i] = best, nn[c]
+                        t[j, i], piece[j, i] = t0 + s[c] * (t1 - t0), (t0, t1)
+                halve = ~final & (d - bent < min(upper, best))
+                middle = live[halve].mean(axis=1)
+                live = np.stack([live[halve, 0], middle, middle, live[halve, 1]], axis=1)
+                live = live.reshape(-1, 2)
     if jac is None:
         return value, t, (normal != 0.0).any(axis=-1), np.zeros((*value.shape, 0))
     gradient = np.zeros((*value.shape, jac.shape[2]))
@@ -395,7 +430,12 @@ def real_clearances(obstacles: Sequence[object], frames: object, radius: float, 
     return value, t, (normal != 0.0).any(axis=-1), gradient
 
 
-def _clearances(limit: ObstacleDamper, state: KinematicState, refine: Array | None) -> Measured:
+def _clearances(
+    limit: ObstacleDamper,
+    state: KinematicState,
+    refine: Array | None,
+    closest: tuple[float, float] | None = None,
+) -> Measured:
     """Every (point, obstacle) then every (link, obstacle) clearance, obstacle-major, with the
     old NumPy gradient ``n · ∂p/∂Q`` for the points; the links' real clearances
     (:func:`real_clearances`, refined below the damper's margin)."""
@@ -409,7 +449,7 @@ def _clearances(limit: ObstacleDamper, state: KinematicState, refine: Array | No
     if refine is None:
         refine = np.full(count, limit.margin)
     links, t, normal_ok, link_rows = real_clearances(
-        limit.obstacles, state, state.radius, refine, np.asarray(state.frame_jacobians)
+        limit.obstacles, state, state.radius, refine, closest, np.asarray(state.frame_jacobians)
     )
     ends = guarded_links(k, state.rail)
     point_ok = (points.normal != 0.0).any(axis=-1)
@@ -426,11 +466,14 @@ def _clearances(limit: ObstacleDamper, state: KinematicState, refine: Array | No
 
 
 def distance_jacobian(limit: object, robot: Robot, q: Array, radius: float,
-                      eps: float = 1e-7, refine: Array | None = None) -> Array:  # fmt: skip
+                      eps: float = 1e-7, refine: Array | None = None,
+                      union: Sequence[object] | None = None) -> Array:  # fmt: skip
     """Central differences of every distance of ``limit`` at ``q`` (p, n)."""
 
     def values(v: Array) -> Array:
-        return measure(limit, KinematicState.compute(robot, v, radius), refine).value
+        state = KinematicState.compute(robot, v, radius)
+        closest = None if union is None else closest_parts(union, state, radius)
+        return measure(limit, state, refine, closest).value
 
     return central_difference(values, np.asarray(q, dtype=float), eps)  # type: ignore[no-any-return]
 

@@ -35,7 +35,13 @@ from dvqp.limits import (
     SurfaceHeight,
     TiltLimit,
 )
-from tests.oracle_limits import chord_low, guarded_links, link_pairs, real_clearances
+from tests.oracle_limits import (
+    chord_low,
+    closest_parts,
+    guarded_links,
+    link_pairs,
+    real_clearances,
+)
 
 Array = NDArray[np.float64]
 
@@ -243,7 +249,9 @@ def verified_values(limits: tuple, robot: Robot, q: Array, radius: float) -> lis
             dampers = [d for d in limits if type(d) is ObstacleDamper]
             refine = np.array([max(d.margin for d in dampers if any(o is x for x in d.obstacles))
                                for o in limit.obstacles])  # fmt: skip
-            links = real_clearances(limit.obstacles, f, radius, refine)[0]
+            union = list({id(x): x for d in dampers for x in d.obstacles}.values())
+            links = real_clearances(limit.obstacles, f, radius, refine,
+                                    closest_parts(union, f, radius))[0]  # fmt: skip
             values = np.concatenate([points.ravel(), links.ravel()])
             out.append(Verified(values, limit.margin, limit.tolerance, limit.quantity))
         elif kind in (SurfaceHeight, ProbeHeight):

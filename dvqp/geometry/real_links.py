@@ -13,14 +13,13 @@ extremes of ``g(t) = θ(t) − t Δφ`` (zero at both ends) are where ``θ'(t) =
 
     (d² + c²) t² + 2 ρ_A² d t + ρ_A⁴ − ρ_A² c / Δφ = 0.
 
-A signed distance to an obstacle is 1-Lipschitz, so a piece of the link keeps at least the
-clearance of its straight DV segment less its own ``δ``. The clearance dvqp keeps, checks and
-reports for a link (:func:`real_links`) is the least of that over ``N`` equal pieces of the
-link, ``N = ceil(sqrt(2 δ / PRECISION))`` (a piece's ``δ`` shrinks as the square of its
-length), doubled until the closest piece's ``δ`` is at most ``PRECISION / 2``: never above
-the real link's clearance (every piece keeps its straight clearance less its ``δ``), and below
-it by at most ``PRECISION`` (the closest piece's real image is within its ``δ`` of it). A link
-that spans no angle (``Δφ = 0``) is straight in the DV too.
+A signed distance to an obstacle is 1-Lipschitz, so a piece of the link keeps a clearance
+within its own ``δ`` of its straight DV piece's ``d``: in ``[d − δ, d + δ]``. The clearance
+dvqp keeps, checks and reports for a link (:func:`real_links`) is the least ``d − δ`` over
+pieces found by halving (a piece's ``δ`` shrinks as the square of its length) until the pieces
+that may hold the minimum bend by at most ``PRECISION / 2``: never above the real link's
+clearance, and below it by at most ``PRECISION``. A link that spans no angle (``Δφ = 0``) is
+straight in the DV too.
 """
 
 from __future__ import annotations
@@ -37,6 +36,8 @@ from dvqp.workspace import link_ends
 
 PRECISION = 1e-5
 """m: the most a link's clearance, where measured in pieces, may be below its real one."""
+MAX_PIECES = 256
+"""Pieces waiting at once in the halving of one link (:func:`real_links`)."""
 
 
 @njit(cache=True)
@@ -81,62 +82,102 @@ def _at(a, b, t):  # type: ignore[no-untyped-def]
 def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ignore[no-untyped-def]
     """The clearance of every guarded link's real DV image to every obstacle, into ``near``'s
     ``real_*`` rows: the least over the link's pieces of the straight piece's clearance less
-    the piece's ``δ``, its normal, the link parameter of its closest point, the piece and the
-    number of pieces. ``chain`` (m, 3) the guarded points' DV ``[l, z, h]``, ``origins``
-    (m, 3) their 3-D positions, m; ``tool`` the probe's index among them.
+    the piece's ``δ``, its normal, the link parameter of its closest point and the piece.
+    ``chain`` (m, 3) the guarded points' DV ``[l, z, h]``, ``origins`` (m, 3) their 3-D
+    positions, m; ``tool`` the probe's index among them.
 
     A pair is cut into pieces only where it matters: where the real link may be below
-    ``shapes.refine`` (its damper's margin), the closest link to the obstacle, or the probe's
-    holder (its clearance is reported on its own); elsewhere,
-    and for shapes of your own (:data:`OTHER`), the whole link is one piece (the straight
-    row less the link's ``δ``, in ``near.bends``: a bound below the truth by at most
-    ``2 δ``), farther than the margin and than the closest link."""
-    ends, bends = near.ends, near.bends
+    ``shapes.refine`` (its damper's margin) or be the closest part of the arm to any obstacle
+    (or, the probe's holder, of the probe and its holder: both are reported). Elsewhere, and
+    for shapes of your own (:data:`OTHER`), the whole link is one piece: the straight row less
+    the link's ``δ`` (in ``near.bends``), a bound below the truth by at most ``2 δ``, above
+    the margin and above the arm's closest part."""
+    ends, bends, points = near.ends, near.bends, near.point_distance
     for i in range(ends.shape[0]):
         a, b = origins[ends[i, 0]], origins[ends[i, 1]]
         bends[i] = radius * abs(link_bend(a[0], a[1], b[0], b[1])[0])
+    arm, probe = math.inf, math.inf  # above the closest part (the probe's), and its holder
     for j in range(near.real_distance.shape[0]):
-        closest = math.inf  # above the real link closest to obstacle j
+        probe = min(probe, points[j, tool])
+        for p in range(points.shape[1]):
+            arm = min(arm, points[j, p])
         for i in range(ends.shape[0]):
             near.real_distance[j, i] = near.link_distance[j, i] - bends[i]
             near.real_normal[j, i, 0] = near.link_normal[j, i, 0]
             near.real_normal[j, i, 1] = near.link_normal[j, i, 1]
-            near.real_at[j, i], near.real_piece[j, i], near.real_pieces[j, i] = (
+            near.real_at[j, i], near.real_t0[j, i], near.real_t1[j, i] = (
                 near.link_t[j, i], 0.0, 1.0)  # fmt: skip
-            closest = min(closest, near.link_distance[j, i] + bends[i])
+            arm = min(arm, near.link_distance[j, i] + bends[i])
+            if ends[i, 1] == tool:
+                probe = min(probe, near.link_distance[j, i] + bends[i])
+    for j in range(near.real_distance.shape[0]):
         if shapes.code[j] == OTHER:
             continue
         for i in range(ends.shape[0]):
-            pieces = max(1, math.ceil(math.sqrt(2.0 * bends[i] / PRECISION)))
-            d = near.real_distance[j, i]
-            near_safe = d < shapes.refine[j] + 2.0 * bends[i]
-            if pieces > 1 and (near_safe or d < closest or ends[i, 1] == tool):
+            d, reported = near.real_distance[j, i], probe if ends[i, 1] == tool else arm
+            if 2.0 * bends[i] > PRECISION and (
+                d < shapes.refine[j] + 2.0 * bends[i] or d < reported
+            ):
                 a, b = origins[ends[i, 0]], origins[ends[i, 1]]
-                _pieces(shapes, j, i, a, b, chain[ends[i, 0], 0], radius, pieces, near)
+                _pieces(shapes, j, i, a, b, chain[ends[i, 0], 0], radius, near)
 
 
 @njit(cache=True)
-def _pieces(shapes, j, i, a, b, la, radius, pieces, near) -> None:  # type: ignore[no-untyped-def]
-    """Link i's clearance to obstacle j over ``pieces`` pieces, twice as many until the
-    closest piece's own ``δ`` is at most ``PRECISION / 2`` (see :func:`real_links`)."""
-    while True:
-        best, bend = math.inf, 0.0
-        for k in range(pieces):
-            x0, y0, z0 = _at(a, b, k / pieces)
-            x1, y1, z1 = _at(a, b, (k + 1) / pieces)
-            l0 = la + radius * math.atan2(a[0] * y0 - a[1] * x0, a[0] * x0 + a[1] * y0)
-            l1 = la + radius * math.atan2(a[0] * y1 - a[1] * x1, a[0] * x1 + a[1] * y1)
-            d, s, nl, nz = shape_segment(shapes, j, l0, z0, l1, z1)
-            piece = radius * abs(link_bend(x0, y0, x1, y1)[0])
-            if d - piece < best:
-                best, bend = d - piece, piece
-                near.real_distance[j, i] = d - piece
-                near.real_normal[j, i, 0], near.real_normal[j, i, 1] = nl, nz
-                near.real_at[j, i] = (k + s) / pieces
-                near.real_piece[j, i], near.real_pieces[j, i] = k, pieces
-        if 2.0 * bend <= PRECISION:
-            return
-        pieces *= 2
+def _piece(shapes, j, a, b, la, radius, t0, t1):  # type: ignore[no-untyped-def]
+    """``(d, δ, s, ∂d/∂l, ∂d/∂z)`` of the piece ``[t0, t1]`` of the link ``a → b`` to obstacle
+    j: its straight DV piece's clearance, its bend, its closest point's parameter and normal."""
+    x0, y0, z0 = _at(a, b, t0)
+    x1, y1, z1 = _at(a, b, t1)
+    l0 = la + radius * math.atan2(a[0] * y0 - a[1] * x0, a[0] * x0 + a[1] * y0)
+    l1 = la + radius * math.atan2(a[0] * y1 - a[1] * x1, a[0] * x1 + a[1] * y1)
+    d, s, nl, nz = shape_segment(shapes, j, l0, z0, l1, z1)
+    return d, radius * abs(link_bend(x0, y0, x1, y1)[0]), s, nl, nz
+
+
+@njit(cache=True)
+def _pieces(shapes, j, i, a, b, la, radius, near) -> None:  # type: ignore[no-untyped-def]
+    """Link i's clearance to obstacle j by halving its pieces, a level at a time (branch and
+    bound). Each piece has its straight DV piece's clearance ``d`` and bend ``δ``: its real
+    image's clearance lies in ``[d − δ, d + δ]``. A piece bent by at most ``PRECISION / 2`` is
+    final (its ``d − δ`` a candidate); another is halved if ``d − δ`` is below both the least
+    ``d + δ`` seen and the least candidate, else dropped (it cannot hold the minimum). The
+    least candidate is the clearance (a piece that finds no room among ``MAX_PIECES`` is a
+    candidate as it is)."""
+    live, halves = np.empty((MAX_PIECES, 2)), np.empty((MAX_PIECES, 2))
+    out = np.empty((MAX_PIECES, 5))
+    live[0, 0], live[0, 1], count, upper, best = 0.0, 1.0, 1, math.inf, math.inf
+    while count > 0:
+        for p in range(count):
+            out[p, 0], out[p, 1], out[p, 2], out[p, 3], out[p, 4] = _piece(
+                shapes, j, a, b, la, radius, live[p, 0], live[p, 1])  # fmt: skip
+            upper = min(upper, out[p, 0] + out[p, 1])
+        for p in range(count):  # the final pieces
+            if 2.0 * out[p, 1] <= PRECISION and out[p, 0] - out[p, 1] < best:
+                best = _candidate(near, j, i, live[p], out[p])
+        n = 0
+        for p in range(count):  # the others, halved where they may hold the minimum
+            if 2.0 * out[p, 1] > PRECISION and out[p, 0] - out[p, 1] < min(upper, best):
+                if n + 2 > MAX_PIECES:
+                    if out[p, 0] - out[p, 1] < best:
+                        best = _candidate(near, j, i, live[p], out[p])
+                    continue
+                middle = 0.5 * (live[p, 0] + live[p, 1])
+                halves[n, 0], halves[n, 1] = live[p, 0], middle
+                halves[n + 1, 0], halves[n + 1, 1] = middle, live[p, 1]
+                n += 2
+        live, halves, count = halves, live, n
+
+
+@njit(cache=True, inline="always")
+def _candidate(near, j, i, piece, found):  # type: ignore[no-untyped-def]
+    """Write the piece ``[t0, t1]`` with ``(d, δ, s, n_l, n_z)`` as link i's clearance to
+    obstacle j; return it, ``d − δ``."""
+    t0, t1 = piece[0], piece[1]
+    near.real_distance[j, i] = found[0] - found[1]
+    near.real_normal[j, i, 0], near.real_normal[j, i, 1] = found[3], found[4]
+    near.real_at[j, i] = t0 + found[2] * (t1 - t0)
+    near.real_t0[j, i], near.real_t1[j, i] = t0, t1
+    return found[0] - found[1]
 
 
 @njit(cache=True, inline="always")
@@ -157,9 +198,8 @@ def real_link_gradient(near, origins, frame_jacobians, radius, j, i, out) -> Non
     extreme ``u`` (``τ`` on the link): envelopes, the closest point and the extreme held."""
     ea, eb = near.ends[i, 0], near.ends[i, 1]
     a, b, ja, jb = origins[ea], origins[eb], frame_jacobians[ea], frame_jacobians[eb]
-    count, k = near.real_pieces[j, i], near.real_piece[j, i]
-    t0, t1 = k / count, (k + 1.0) / count
-    s = near.real_at[j, i] * count - k
+    t0, t1 = near.real_t0[j, i], near.real_t1[j, i]
+    s = (near.real_at[j, i] - t0) / (t1 - t0)
     nl, nz = near.real_normal[j, i, 0], near.real_normal[j, i, 1]
     x0, y0, _ = _at(a, b, t0)
     x1, y1, _ = _at(a, b, t1)

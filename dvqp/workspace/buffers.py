@@ -88,8 +88,8 @@ class ProximityBuffers:
         DV; ``dvqp.geometry.real_links``), and the link parameter of its closest point.
     real_normal : (J, L, 2)
         ``∇d`` there, with respect to the point's ``[l, z]``.
-    real_piece, real_pieces : (J, L)
-        The piece of the link that has it, of how many.
+    real_t0, real_t1 : (J, L)
+        The piece ``[t0, t1]`` of the link that has it.
     bends : (L,)
         How far each link's real DV image strays from its straight DV segment, m.
     """
@@ -107,8 +107,8 @@ class ProximityBuffers:
     real_distance: Array
     real_normal: Array
     real_at: Array
-    real_piece: Array
-    real_pieces: Array
+    real_t0: Array
+    real_t1: Array
     bends: Array
 
     @classmethod
