@@ -4,6 +4,7 @@ guarded like every other link of the arm."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,6 +12,7 @@ import pytest
 import dvqp
 from dvqp import KinematicState, Robot
 from dvqp.cli import main
+from dvqp.cli.drawing import body_at
 from dvqp.limits import ObstacleDamper
 from tests.common import LINK_LENGTHS, PIPE_RADIUS, random_configurations
 from tests.limit_fixtures import ROOT, damper_rows, scene
@@ -70,3 +72,22 @@ def test_the_carriage_link_s_rows_are_minus_the_gradient_of_its_clearance() -> N
     stepper.start(s.q0)
     rows = damper_rows(stepper, limit, s.q0, fd=True)
     assert any(label.startswith("carriage/") for label in rows.labels)
+
+
+def test_the_rail_point_is_recorded_and_the_carriage_link_drawn(tmp_path: Path) -> None:
+    s = dvqp.load_scene(CLAMP)
+    traj = dvqp.plan(s, "daqp")
+    assert traj.rail.shape == (traj.t.shape[0], 3)
+    for i in range(0, traj.t.shape[0], 50):  # Pinocchio's rail frame, in the developed view
+        rail = frames(s.robot, traj.q[i], s.pipe_radius).guarded[-1]
+        np.testing.assert_allclose(traj.rail[i], rail, rtol=0, atol=1e-12)
+    body = body_at(traj, 10)  # the rail point first: the carriage link is drawn
+    assert body.shape == (s.robot.n_points + 2, 3)
+    assert math.dist(body[0, :2], traj.rail[10, :2]) < 1e-12
+    saved = traj.save(tmp_path / "clamp.npz")
+    np.testing.assert_array_equal(dvqp.Trajectory.load(saved).rail, traj.rail)
+    with np.load(saved) as data:  # a file written before the rail was recorded: none drawn
+        arrays = {k: data[k] for k in data.files if k != "rail"}
+    np.savez(tmp_path / "old.npz", **arrays)
+    old = dvqp.Trajectory.load(tmp_path / "old.npz")
+    assert old.rail.shape[0] == 0 and body_at(old, 10).shape == (s.robot.n_points + 1, 3)

@@ -89,9 +89,11 @@ def wrap_arc(l: NDArray[np.float64] | float, radius: float) -> NDArray[np.float6
 
 
 def body_at(traj: Trajectory, i: int) -> NDArray[np.float64]:
-    """Body points then the tool at sample i, shape (k+1, 3), ``[l, z, h]`` (m); l is
-    continuous along the body and starts in ``(−πR, πR]``."""
-    body = np.vstack([traj.points[i], traj.tool[i, :3]])
+    """The rail point (if recorded: the carriage link is then drawn too), the body points and
+    the tool at sample i, shape (k+1, 3) or (k+2, 3), ``[l, z, h]`` (m); l is continuous along
+    the body and starts in ``(−πR, πR]``."""
+    rail = traj.rail[i : i + 1] if traj.rail.shape[0] == traj.t.shape[0] else np.zeros((0, 3))
+    body = np.vstack([rail, traj.points[i], traj.tool[i, :3]])
     body[:, 0] = unwrap(body[:, 0], 2.0 * np.pi * traj.pipe_radius)
     body[:, 0] += wrap_arc(body[0, 0], traj.pipe_radius) - body[0, 0]
     return body
@@ -149,17 +151,22 @@ def _draw_tool_path(ax: Axes, view: View) -> None:
 
 
 def draw_body(
-    ax: Axes, body: NDArray[np.float64], radius: float, color: Any, legend: bool = True
+    ax: Axes,
+    body: NDArray[np.float64],
+    radius: float,
+    color: Any,
+    legend: bool = True,
+    rail: bool = False,
 ) -> list[Any]:
-    """The body polyline (points, then tool ▲) and its copies, in ``color``; the middle copy
-    labelled for the legend if ``legend``.
+    """The body polyline (the rail point first if ``rail``, points, then tool ▲) and its
+    copies, in ``color``; the middle copy labelled for the legend if ``legend``.
 
     ``body`` is :func:`body_at`'s, ``radius`` the pipe's (m). Returns ``[line, tool marker]``
     per copy, in :data:`SHIFTS` order.
     """
-    artists = []
+    artists, parts = [], "rail, " if rail else ""
     for s, (lb, zb) in zip(SHIFTS, body_copies(body, radius), strict=True):
-        label = "body (points 1..k, tool ▲)" if s == 0 and legend else None
+        label = f"body ({parts}points 1..k, tool ▲)" if s == 0 and legend else None
         artists += ax.plot(lb, zb, "-o", color=color, lw=1.8, ms=3.5, label=label)
         artists += ax.plot(lb[-1:], zb[-1:], "^", color=color, ms=7)
     return artists
@@ -185,8 +192,8 @@ def draw_section(ax: Axes, view: View, instants: Sequence[tuple[int, Any]]) -> N
         label = "obstacle (l extent)" if j == 0 else None
         xy = radius * np.cos(arc), radius * np.sin(arc)
         ax.plot(*xy, color="tab:red", lw=5, alpha=0.5, solid_capstyle="butt", label=label)
-    for i, color in instants:  # the body at sample i, tool ▲ at its end
-        body = np.vstack([view.traj.points[i], view.traj.tool[i, :3]])
+    for i, color in instants:  # the body at sample i (from the rail point), tool ▲ at its end
+        body = body_at(view.traj, i)
         rho, angle = radius + body[:, 2], body[:, 0] / radius
         x, y = rho * np.cos(angle), rho * np.sin(angle)
         ax.plot(x, y, "-o", color=color, lw=1.5, ms=3)

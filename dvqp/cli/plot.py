@@ -147,7 +147,8 @@ def _draw_developed_panel(
     draw_developed_view(ax, view)
     for n, i in enumerate(idx):
         colour = times.to_rgba(view.traj.t[i])
-        draw_body(ax, body_at(view.traj, i), view.radius, colour, legend=n == 0)
+        rail = view.traj.rail.shape[0] > 0
+        draw_body(ax, body_at(view.traj, i), view.radius, colour, legend=n == 0, rail=rail)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     cax = ax.inset_axes((1.03, 0.06, 0.24, 0.07))
     bar = fig.colorbar(times, cax=cax, orientation="horizontal")
@@ -178,7 +179,8 @@ def _animation_axes(fig: Figure, view: View) -> Callable[[int], None]:
     """Draw the first frame; return ``show(i)``, which moves the body to sample i."""
     ax = fig.add_subplot()
     draw_developed_view(ax, view)
-    artists = draw_body(ax, body_at(view.traj, 0), view.radius, "tab:red")
+    rail = view.traj.rail.shape[0] > 0
+    artists = draw_body(ax, body_at(view.traj, 0), view.radius, "tab:red", rail=rail)
     stamp = ax.text(0.01, 0.97, "", transform=ax.transAxes, va="top", fontsize="small")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     level = "" if view.h_star is None else f", h* = {view.h_star:.3g} m"

@@ -21,14 +21,16 @@ PER_STEP = ("solve_time", "solver_time", "step_time", "task_error")
 
 class TrajectoryRecorder:
     """Storage for ``N + 1`` samples and the ``N = n_steps`` steps between them, of an arm of
-    ``n_joints`` joints and ``n_points`` body points."""
+    ``n_joints`` joints and ``n_points`` body points (and its rail point's ``[l, z, h]`` if
+    ``rail``)."""
 
-    def __init__(self, n_steps: int, n_joints: int, n_points: int) -> None:
+    def __init__(self, n_steps: int, n_joints: int, n_points: int, rail: bool = False) -> None:
         self.arrays: dict[str, np.ndarray] = {
             "q": np.zeros((n_steps + 1, n_joints)),
             "qdot": np.zeros((n_steps, n_joints)),
             "tool": np.zeros((n_steps + 1, 4)),
             "points": np.zeros((n_steps + 1, n_points, 3)),
+            "rail": np.zeros((n_steps + 1 if rail else 0, 3)),
             **{name: np.zeros(n_steps + 1) for name in PER_SAMPLE},
             **{name: np.zeros(n_steps) for name in PER_STEP},
             "iterations": np.full(n_steps, -1, dtype=np.int64),
@@ -54,6 +56,8 @@ class TrajectoryRecorder:
         """Room for ``steps`` more steps and their samples, those recorded kept (new arrays:
         hand them to the stepper, :meth:`~dvqp.step.Stepper.record_into`)."""
         for name, a in self.arrays.items():
+            if a.shape[0] == 0:  # not recorded (no rail point)
+                continue
             room = np.zeros((steps, *a.shape[1:]), dtype=a.dtype)
             self.arrays[name] = np.concatenate([a, room])
         self.status = np.concatenate([self.status, np.full(steps, "", dtype=object)])
@@ -67,7 +71,7 @@ class TrajectoryRecorder:
         the limits the start broke (:meth:`dvqp.step.Stepper.start_broken`)."""
         n = self.arrays["qdot"].shape[0]
         steps = n if steps is None else steps
-        kept = {name: a[: steps + a.shape[0] - n] for name, a in self.arrays.items()}
+        kept = {name: a[: max(steps + a.shape[0] - n, 0)] for name, a in self.arrays.items()}
         qdot = kept["qdot"]
         before = np.vstack([np.zeros((1, qdot.shape[1])), qdot[:-1]])
         return Trajectory.from_samples(

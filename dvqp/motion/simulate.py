@@ -143,7 +143,7 @@ def simulate(
     check = resolver.holds_limits if verify is None else verify
     q_start = robot.check_q(q0, "q0")
     reserved = room(robot, resolver, dt) if stop else 0  # the stop's samples, in advance
-    record = TrajectoryRecorder(cmd.shape[0] + reserved, robot.n, robot.n_points)
+    record = TrajectoryRecorder(cmd.shape[0] + reserved, robot.n, robot.n_points, robot.has_rail)
     with _noticed(notice):
         stepper = Stepper(robot, radius, resolver, q_start, dt, obstacles, record.arrays)
         stepper.start(q_start)

@@ -22,7 +22,8 @@ ARRAYS = ("t", "q", "qdot", "tool", "points", "w", "min_clearance", "solve_time"
 """The arrays every trajectory file holds."""
 
 DIAGNOSTICS = ("probe_clearance", "tilt", "self_distance", "limit_excess", "limits_kept",
-               "substeps", "qddot", "solver_time", "link_height", "holder_height")  # fmt: skip
+               "substeps", "qddot", "solver_time", "link_height", "holder_height",
+               "rail")  # fmt: skip
 """Arrays added since dvqp 0.2; a file written before one was added lacks it (loaded empty)."""
 
 CONVENTIONS = {
@@ -92,6 +93,10 @@ class Trajectory:
         and of the probe holder (last body point to the tool): each link the lowest point of
         its real straight 3-D chord (an end's own height where that is lowest). Empty in a
         file written before they were recorded (the reports and plots then leave them out).
+    rail : ndarray, shape (N+1, 3) or (0, 3)
+        ``[l, z, h]`` of the rail point (where the carriage rides its rail; the carriage link
+        runs from it to body point 1), m, l as recorded (in ``(−πR, πR]``); empty for an arm
+        without one, a console recording, or a file written before it was recorded.
     qddot : ndarray, shape (N, n)
         Joint acceleration at the start of each step, ``(qdot[k] − qdot[k−1]) / dt`` with the
         run starting at rest, rad/s².
@@ -133,6 +138,7 @@ class Trajectory:
     solver_time: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     link_height: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     holder_height: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    rail: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 3)))
     start_broken: tuple[StartBroken, ...] = ()
     brake_start: int = -1
 

@@ -110,6 +110,7 @@ class RecordArrays:
     probe_clearance: Array
     link_height: Array
     holder_height: Array
+    rail: Array
 
     @classmethod
     def none(cls, n: int, k: int) -> RecordArrays:
@@ -117,7 +118,7 @@ class RecordArrays:
         z = np.zeros(0)
         return cls(np.full(1, -1, np.int64), np.zeros((0, n)), np.zeros((0, 4)),
                    np.zeros((0, k, 3)), z, z.copy(), np.zeros(0, np.bool_),
-                   *(z.copy() for _ in range(6)))  # fmt: skip
+                   *(z.copy() for _ in range(6)), np.zeros((0, 3)))  # fmt: skip
 
 
 @dataclass(frozen=True)

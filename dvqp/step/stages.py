@@ -171,6 +171,9 @@ def _sample(s) -> None:  # type: ignore[no-untyped-def]
     d = s.diagnostics
     r.tilt[at], r.self_distance[at], r.min_clearance[at], r.probe_clearance[at] = d[:4]
     r.link_height[at], r.holder_height[at] = d[5], d[6]
+    if r.rail.shape[0] > 0:  # the rail point's [l, z, h], when recorded (the arm has one)
+        for i in range(3):
+            r.rail[at, i] = st.guarded[st.guarded.shape[0] - 1, i]
     if c.row[0] != at:  # a new sample: those before it are final
         c.row[0] = at
         for i in range(c.lowest.shape[0]):
