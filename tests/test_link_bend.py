@@ -69,7 +69,7 @@ def test_the_real_link_keeps_the_straight_clearance_less_its_bend() -> None:
     radius, period = s.pipe_radius, 2 * math.pi * s.pipe_radius
     for q in random_configurations(6, seed=11, spread=0.3):
         state = KinematicState.compute(s.robot, s.q0 + 0.3 * (q - s.q0), radius)
-        straight = proximity(state, s.obstacles).link_clearance  # (J, L)
+        straight = proximity(state, s.obstacles).links.distance  # the straight DV segments (J, L)
         delta, o = link_bends(state), np.asarray(state.origins)
         for i, (a, b) in enumerate(link_ends(state.k, state.rail)):
             true = point_distances(s.obstacles, real_image(o[a], o[b], radius), period)

@@ -31,7 +31,7 @@ def succeeded(s: dvqp.Scene, traj: dvqp.Trajectory) -> bool:
     return True
 
 
-def within_bend(s: dvqp.Scene, q: np.ndarray, reported: float, true: float) -> bool:
+def reported_is_real(s: dvqp.Scene, q: np.ndarray, reported: float, true: float) -> bool:
     """The reported clearance is the real links' (never above it, at most PRECISION below),
     however much the links bend in the DV (``link_bends``)."""
     assert link_bends(dvqp.KinematicState.compute(s.robot, q, s.pipe_radius)).max() > 1e-4
@@ -46,7 +46,7 @@ def test_the_probe_stops_at_the_clamp_and_the_reported_clearance_is_true(backend
     assert min(probe) >= 0.01 - 0.002
     worst = int(np.argmin(traj.min_clearance))
     true, _ = safety.clearances(s, traj.q[worst])
-    assert within_bend(s, traj.q[worst], traj.min_clearance[worst], true)
+    assert reported_is_real(s, traj.q[worst], traj.min_clearance[worst], true)
     assert traj.probe_clearance.min() >= 0.01 - 1e-4
     assert traj.task_error.max() > 0.05  # the task gave way, and says so
 
@@ -66,7 +66,7 @@ def test_no_part_enters_an_inlet_a_band_or_a_pad(backend: str) -> None:
     assert min(c for c, _ in every) >= 0.01 - 0.001
     worst = int(np.argmin(traj.min_clearance))
     true, _ = safety.clearances(s, traj.q[worst])
-    assert within_bend(s, traj.q[worst], traj.min_clearance[worst], true)
+    assert reported_is_real(s, traj.q[worst], traj.min_clearance[worst], true)
 
 
 def test_the_baseline_drives_the_probe_into_the_pad() -> None:
