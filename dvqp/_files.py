@@ -19,8 +19,10 @@ def output_path(path: str | Path, suffixes: Sequence[str]) -> Path:
     ------
     ParameterError
         ``output: <path>: unknown format '.txt' (use .npz, .csv)``, ``… no such directory``,
-        ``… is a directory``.
+        ``… is a directory``, ``output: empty file name``.
     """
+    if not str(path).strip():
+        raise ParameterError("output", "empty file name")
     target = Path(path)
     suffix = target.suffix.lower()
     if target.is_dir():

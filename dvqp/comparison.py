@@ -33,8 +33,9 @@ if TYPE_CHECKING:
 FIELDS = (
     "scene", "file", "backend", "success", "steps", "failures", "relaxed", "braking", "substepped",
     "median_step_us", "p95_step_us", "median_solver_us", "median_rest_us", "median_iterations",
-    "ratio_to_pinv", "max_task_error", "min_clearance", "closest", "min_probe_clearance",
-    "min_tilt", "min_self_distance", "closest_pair", "min_link_height", "lowest_link",
+    "refused_calls", "refusals", "ratio_to_pinv", "max_task_error", "min_clearance", "closest",
+    "min_probe_clearance", "min_tilt", "min_self_distance", "closest_pair", "min_link_height",
+    "lowest_link",
     "max_joint_acceleration", "max_limit_excess", "worst_limit", "start_broken",
     "max_joint_limit_violation", "max_velocity_limit_violation", "final_tracking_error",
     "final_joint_speed", "braking_time", "error",
@@ -62,7 +63,8 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
     substeps); ``relaxed`` (the task gave way to a limit) and ``braking`` (the limits
     conflicted and the arm slowed toward rest); ``substepped`` (steps split to keep a limit);
     median and 95th-percentile full step time (µs), the medians of the solver call alone and
-    of the rest of the step (µs) and of the solver's iterations; the largest task error
+    of the rest of the step (µs) and of the solver's iterations; the backend calls refused (no
+    accepted answer: the step relaxed or braked) and by kind (``refusals``); the largest task error
     ``‖J̄Q̇ − ẋ‖∞`` of the succeeded steps; the smallest clearance of any guarded part (m) and
     the part and obstacle that have it (``closest``); the probe's own smallest clearance (m);
     the smallest probe tilt from radial (rad); the smallest distance between non-adjacent
@@ -92,6 +94,8 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
         "median_step_us": _finite(np.median(steps_us)) if traj.n_steps else None,
         "p95_step_us": _finite(np.percentile(steps_us, 95)) if traj.n_steps else None,
         **_solver_figures(traj),
+        "refused_calls": sum(traj.refusals.values()),
+        "refusals": traj.refused or None,
         "ratio_to_pinv": None,
         "max_task_error": _finite(np.max(traj.task_error[ok])) if np.any(ok) else None,
         **_clearances(scene, traj),
@@ -285,12 +289,9 @@ def rows_to_csv(rows: Sequence[Row], fields: Sequence[str] = FIELDS) -> str:
 
 def machine() -> dict[str, Any]:
     """Platform, processor, CPU count and Python version of this machine."""
-    return {
-        "platform": platform.platform(),
-        "processor": platform.processor() or platform.machine(),
-        "cpu_count": os.cpu_count(),
-        "python": platform.python_version(),
-    }
+    processor = platform.processor() or platform.machine()
+    return {"platform": platform.platform(), "processor": processor,
+            "cpu_count": os.cpu_count(), "python": platform.python_version()}  # fmt: skip
 
 
 def quiet_worker() -> None:

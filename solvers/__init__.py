@@ -8,6 +8,7 @@
 from .exceptions import ProblemShapeError, SolverError, UnknownBackendError
 from .problem import Problem
 from .protocol import Backend
+from .refusal import REFUSALS
 from .registry import (
     BackendInfo,
     available_backends,
@@ -20,6 +21,7 @@ from .solution import Solution, SolverFailure
 from .stateful import RawResult, StatefulBackend
 
 __all__ = [
+    "REFUSALS",
     "Backend",
     "BackendInfo",
     "Problem",

@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
+import warnings
 from collections.abc import Iterator
 from time import perf_counter
 from typing import Any
@@ -164,17 +165,22 @@ class QpsolversBackend:
             P, G, A = (None if m is None else sp.csc_matrix(m) for m in (P, G, A))
         qp = qpsolvers.Problem(P, np.array(problem.q), G, h, A, b, lb, ub)
         quiet = _quiet_c_stdout() if self.solver in CHATTY else contextlib.nullcontext()
-        with quiet:
+        # qpsolvers warns of a failed solve (its status word says the same): kept off stderr
+        with quiet, warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
             started = perf_counter()
             result = qpsolvers.solve_problem(qp, self.solver, initvals=guess, **self.settings)
             solver_time = perf_counter() - started
+        status = _status(result.extras, result.found)
+        if caught and status in ("found", "not found"):  # the warning is all the solver said
+            status = str(caught[-1].message)
         z = None
         if keep is not None and result.z is not None:
             z = np.zeros(problem.n_in)
             z[keep] = result.z
         return RawResult(
             x=result.x,
-            status=_status(result.extras, result.found),
+            status=status,
             iterations=_iterations(result.extras),
             y=result.y if problem.n_eq else None,
             z=z,

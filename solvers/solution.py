@@ -12,6 +12,7 @@ from ._kkt import FINITE, MISFIT, MISFITTING
 from .exceptions import ProblemShapeError, SolverError
 from .kkt import evaluate, floats, quick
 from .problem import Problem
+from .refusal import refusal
 from .residuals import ACCEPTABLE, Residuals, failed_checks, passing
 
 
@@ -190,6 +191,16 @@ class Solution:
         """Build a solution for a solve that produced no answer at all (e.g. an exception)."""
         return cls(problem, None, status, False, backend, tolerance, None, solve_time,
                    message=message, retried=retried, solver_time=solver_time)  # fmt: skip
+
+    @property
+    def refusal(self) -> str:
+        """Why no answer was accepted, as one of :data:`REFUSALS` (``""`` when ``found``).
+
+        Named from the solver's status word (``"infeasible"``, ``"iteration limit"``, ``"time
+        limit"``), else ``"inaccurate"`` (an ``x`` that failed the check) or ``"no answer"``.
+        The word only names the failure; whether an answer is accepted never depends on it.
+        """
+        return "" if self.found else refusal(self.status, self.x is not None)
 
     def require(self) -> np.ndarray:
         """Return ``x`` if the solution was found, else raise :class:`SolverFailure`.

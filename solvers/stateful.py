@@ -11,6 +11,7 @@ judged itself, e.g. with :meth:`Solution.adopt <solvers.Solution.adopt>`).
 
 from __future__ import annotations
 
+import signal
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass
 from time import perf_counter
@@ -78,7 +79,9 @@ def solve_guarded(
     :class:`SolverError` instead. The solution's ``solver_time`` is the result's
     own ``solver_time`` when the adapter measured it, else the time of ``run``. A
     :class:`Solution` returned by ``run`` (an adapter that checked its answer itself, see
-    :meth:`Solution.adopt <solvers.Solution.adopt>`) is returned as is.
+    :meth:`Solution.adopt <solvers.Solution.adopt>`) is returned as is. A solver that caught
+    a SIGINT (Ctrl-C) and stopped, status ``interrupted`` (OSQP does), has the signal raised
+    again, so that the program's own handler sees it (a KeyboardInterrupt by default).
     """
     start = perf_counter()
     try:
@@ -96,6 +99,8 @@ def solve_guarded(
             message=f"{backend.name} raised {type(exc).__name__}: {exc}",
             solver_time=perf_counter() - start,
         )
+    if "interrupt" in raw.status.lower():  # OSQP answers a Ctrl-C by stopping: the Ctrl-C
+        signal.raise_signal(signal.SIGINT)  # was meant for the program, give it back to it
     if isinstance(raw, Solution):
         return raw
     solver_time = raw.solver_time

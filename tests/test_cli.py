@@ -153,7 +153,7 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
                                 "solver", "us", "rest", "us", "iters", "x", "pinv", "task",
                                 "err", "clearance", "m", "closest", "self", "m",
                                 "qdd", "excess", "q",
-                                "viol", "rad", "qd", "viol", "rad/s", "relaxed", "split",
+                                "viol", "rad", "qd", "viol", "rad/s", "relaxed", "refused", "split",
                                 "fails", "end", "qd", "brake", "s"]  # fmt: skip
     assert [line.split()[:4] for line in lines[2:6]] == [
         ["one", "pinv", "yes", "21"], ["one", "daqp", "yes", "23"],
@@ -169,7 +169,7 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
     keys = ["median_step_us", "p95_step_us", "max_task_error", "min_clearance",
             "min_probe_clearance", "min_tilt", "max_limit_excess", "max_joint_limit_violation",
             "max_velocity_limit_violation", "failures", "relaxed", "substepped",
-            "braking_time"]  # fmt: skip
+            "braking_time", "refused_calls"]  # fmt: skip
     for key in keys:
         assert isinstance(first[key], (int, float)), key
     assert [r["final_joint_speed"] for r in doc["results"]] == [0.0] * 4  # every run at rest
@@ -397,7 +397,7 @@ def test_a_run_too_big_for_the_memory_is_refused_before_it_starts(
     scene = write_scene(tmp_path, motion=LONG)
     assert main(["plan", scene, "--backend", "pinv", "-o", str(tmp_path / "t.npz")]) == 2
     assert capsys.readouterr().err == (
-        f"dvqp: {scene}: motion: about 1.5e+06 steps: roughly 2.5 min and 0.9 GB, more than this "
+        f"dvqp: {scene}: motion: about 1.5e+06 steps: roughly 2.5 min and 1.7 GB, more than this "
         "machine's 0.1 GB allow: use a larger dt or a shorter motion\n"
     )
     assert [p.name for p in tmp_path.iterdir()] == ["small.toml"]

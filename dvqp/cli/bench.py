@@ -119,8 +119,8 @@ def check_options(args: argparse.Namespace) -> Options:
     workers = _integer("--workers", args.workers, 1)
     names = [b.strip() for b in args.backends.split(",")] if args.backends else None
     backends = tuple(dict.fromkeys(check_name(b) for b in names or default_resolvers()))
-    json_out = output_path(args.json, (".json",)) if args.json else None
-    csv_out = output_path(args.csv, (".csv",)) if args.csv else None
+    json_out = output_path(args.json, (".json",)) if args.json is not None else None
+    csv_out = output_path(args.csv, (".csv",)) if args.csv is not None else None
     scenes_dir = _scenes_dir(args.save_scenes) if args.save_scenes else None
     if args.scheduler is not None:
         if not args.scheduler.strip():

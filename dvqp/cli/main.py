@@ -29,7 +29,7 @@ from dvqp.cli import console as console_cli
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
 from dvqp.cli.report import format_summary, format_table, rows_to_csv, write_text
-from dvqp.errors import DvqpError, SingularConfigurationError
+from dvqp.errors import DvqpError, SingularConfigurationError, one_line
 from dvqp.resolution.registry import check_name, default_resolvers, describe_resolvers
 from dvqp.scenes import environment
 
@@ -64,7 +64,7 @@ def _run(args: argparse.Namespace) -> int:
     try:
         return int(args.run(args))
     except DvqpError as exc:
-        print(f"dvqp: {exc}", file=sys.stderr)
+        print(f"dvqp: {one_line(str(exc))}", file=sys.stderr)
         return 2
 
 
@@ -122,7 +122,7 @@ def _notice(bar: ProgressBar, text: str) -> None:
 
 def _plan(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
-    output = output_path(args.output, (".npz", ".csv")) if args.output else None
+    output = output_path(args.output, (".npz", ".csv")) if args.output is not None else None
     check_name(args.backend)  # unknown backend: exit 2 before any work
     check_size([scene], 1)
     try:  # a progress bar on stderr, erased when done
@@ -130,7 +130,7 @@ def _plan(args: argparse.Namespace) -> int:
             traj = plan(scene, args.backend, progress=lambda k, n: bar.show(k, n, "steps"),
                         notice=lambda text: _notice(bar, text))  # fmt: skip
     except SingularConfigurationError as exc:
-        print(f"dvqp: {scene.source}: {args.backend}: {exc}", file=sys.stderr)
+        print(f"dvqp: {one_line(scene.source)}: {args.backend}: {exc}", file=sys.stderr)
         return 1
     if output is not None:
         traj.save(output)  # written even for a failed run, to look at it
@@ -147,9 +147,9 @@ def _compare(args: argparse.Namespace) -> int:
     backends = [check_name(name) for name in names or default_resolvers()]
     scenes = [load_scene(path) for path in args.scenes]  # every scene valid before any run
     check_size(scenes, len(backends))
-    json_out = output_path(args.json, (".json",)) if args.json else None
-    csv_out = output_path(args.csv, (".csv",)) if args.csv else None
-    plot_out = output_path(args.plot, FIGURE_FORMATS) if args.plot else None
+    json_out = output_path(args.json, (".json",)) if args.json is not None else None
+    csv_out = output_path(args.csv, (".csv",)) if args.csv is not None else None
+    plot_out = output_path(args.plot, FIGURE_FORMATS) if args.plot is not None else None
     with contextlib.closing(ProgressBar(sys.stderr)) as bar:
         rows = cmp.compare(args.scenes, backends, args.jobs, progress=bar.show)
     print(format_table(rows))

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 from dvqp.cli.figures import write_atomic
 from dvqp.comparison import Row, aligned, cell
 from dvqp.comparison import rows_to_csv as rows_to_csv  # part of this module's API (docs)
+from dvqp.errors import one_line
 from dvqp.limits import start_broken_lines
 
 if TYPE_CHECKING:
@@ -29,7 +30,7 @@ TABLE = (  # (row key, header, format)
     ("max_joint_acceleration", "qdd", "{:.3g}"), ("max_limit_excess", "excess", "{:.2g}"),
     ("max_joint_limit_violation", "q viol rad", "{:.3g}"),
     ("max_velocity_limit_violation", "qd viol rad/s", "{:.3g}"), ("relaxed", "relaxed", "{}"),
-    ("substepped", "split", "{}"), ("failures", "fails", "{}"),
+    ("refused_calls", "refused", "{}"), ("substepped", "split", "{}"), ("failures", "fails", "{}"),
     ("final_joint_speed", "end qd", "{:.3g}"), ("braking_time", "brake s", "{:.3f}"),
 )  # fmt: skip
 """Columns of :func:`format_table`: (row key, header, format of a defined value)."""
@@ -46,7 +47,7 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
     ``output`` the file the trajectory was saved to (or None)."""
     tool = traj.tool[-1]
     lines = [
-        f"scene           {scene.name} ({scene.source}), {scene.mode} mode",
+        f"scene           {scene.name} ({one_line(scene.source)}), {scene.mode} mode",
         f"backend         {traj.backend}",
         f"steps           {_steps(row)}",
         f"result          {_result(row)}",
@@ -64,7 +65,8 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         f"p95 {cell(row['p95_step_us'], '{:.0f}')} us",
         f"solver          {cell(row['median_solver_us'], '{:.1f}')} us a step in the solver's "
         f"calls, {cell(row['median_rest_us'], '{:.1f}')} us the rest, "
-        f"{cell(row['median_iterations'], '{:.0f}')} iterations (medians)",
+        f"{cell(row['median_iterations'], '{:.0f}')} iterations (medians)"
+        + (f"; {row['refused_calls']} calls refused ({traj.refused})" if traj.refusals else ""),
         f"final tool DV   l = {tool[0]:.4f} m, z = {tool[1]:.4f} m, h = {tool[2]:.4f} m, "
         f"alpha = {tool[3]:.4f} rad",
     ]

@@ -163,9 +163,9 @@ def simulate(
         started = now
         if progress is not None:
             progress(i + 1, cmd.shape[0])
-    if not stop:
-        return record.trajectory(dt, radius, resolver.name, cmd.shape[0],
-                                 start_broken=stepper.start_broken())  # fmt: skip
-    steps = brake(stepper, record, cmd.shape[0], dt, verify=check, max_halvings=max_halvings)
-    return record.trajectory(dt, radius, resolver.name, cmd.shape[0] + steps, cmd.shape[0],
-                             stepper.start_broken())  # fmt: skip
+    steps = brake(stepper, record, cmd.shape[0], dt, verify=check,
+                  max_halvings=max_halvings) if stop else 0  # fmt: skip
+    refused = {} if stepper.solver is None else dict(stepper.solver.refusals)
+    braked = cmd.shape[0] if stop else -1
+    return record.trajectory(dt, radius, resolver.name, cmd.shape[0] + steps, braked,
+                             stepper.start_broken(), refused)  # fmt: skip

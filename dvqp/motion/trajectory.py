@@ -7,6 +7,7 @@ import zipfile
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -109,6 +110,10 @@ class Trajectory:
         The first step of the stop that ends the run at rest (steps ``brake_start..N−1`` brake,
         with the tool held still; ``N`` if the run needed none): −1 if the run was not stopped
         (``stop=False``, or a file written before runs were stopped).
+    refusals : dict of str to int
+        QP backend calls that gave no accepted answer, by kind (``"infeasible"``,
+        ``"iteration limit"``, ``"inaccurate"``…, :data:`solvers.REFUSALS`); the step then
+        took the relaxed or braking path (empty: none, the baseline, or an older file).
     """
 
     t: NDArray[np.float64]
@@ -141,6 +146,7 @@ class Trajectory:
     rail: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 3)))
     start_broken: tuple[StartBroken, ...] = ()
     brake_start: int = -1
+    refusals: dict[str, int] = field(default_factory=dict)
 
     @classmethod
     def from_samples(
@@ -192,6 +198,12 @@ class Trajectory:
         return float(steps * self.t[1]) if steps else 0.0  # t[1] is dt
 
     @property
+    def refused(self) -> str:
+        """``"10 infeasible, 2 iteration limit"``: :attr:`refusals`, most first (``""``: none)."""
+        ranked = sorted(self.refusals.items(), key=lambda item: (-item[1], item[0]))
+        return ", ".join(f"{count} {kind}" for kind, count in ranked)
+
+    @property
     def ok(self) -> bool:
         """Every step succeeded."""
         return bool(np.all(self.success))
@@ -219,6 +231,7 @@ class Trajectory:
                     tracking_error=self.tracking_error,
                     start_broken=np.str_(json.dumps([asdict(b) for b in self.start_broken])),
                     brake_start=np.int64(self.brake_start),
+                    refusals=np.str_(json.dumps(self.refusals)),
                     meta=np.str_(json.dumps({"versions": versions(), **CONVENTIONS})),
                 )
             else:
@@ -256,6 +269,7 @@ class Trajectory:
                     pipe_radius=float(data["pipe_radius"]),
                     scene_text=str(data["scene"]),
                     brake_start=int(data["brake_start"]) if "brake_start" in data else -1,
+                    refusals=_refusals(data),
                 )
         except OSError as exc:
             reason = exc.strerror or type(exc).__name__
@@ -264,3 +278,13 @@ class Trajectory:
             # numpy's own text for pickled data suggests loading it unsafely: never pass it on
             reason = "a missing array" if isinstance(exc, KeyError) else "not a dvqp .npz file"
             raise DvqpError(f"{path}: not a dvqp trajectory ({reason})") from exc
+
+
+def _refusals(data: Any) -> dict[str, int]:
+    """The ``refusals`` of a loaded file (none in a file written before they were counted)."""
+    if "refusals" not in data:
+        return {}
+    counts = json.loads(str(data["refusals"]))
+    if not isinstance(counts, dict):
+        raise ValueError("refusals")
+    return {str(kind): int(count) for kind, count in counts.items()}

@@ -22,6 +22,7 @@ fails.
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -115,6 +116,9 @@ class QPSolver:
             np.concatenate([qp.ub, inf]),
         )  # fmt: skip
         self.backends = factory(), factory()
+        self.refusals: Counter[str] = Counter()
+        """Backend calls that gave no accepted answer, by :attr:`solvers.Solution.refusal`
+        (the step then took the relaxed or braking path)."""
 
     def solve(self, rest: bool = False) -> Answer:
         """Strict, else relaxed, else braking (``x`` a view, valid until the next solve).
@@ -131,9 +135,12 @@ class QPSolver:
         solution = strict.solve(self.strict)
         spent, status = solution.solver_time, "optimal"
         if not solution.found:
+            self.refusals[solution.refusal] += 1
             self._load_relaxed()
             solution = relaxed.solve(self.relaxed)
             spent, status = spent + solution.solver_time, "relaxed"
+            if not solution.found:
+                self.refusals[solution.refusal] += 1
         if solution.found and solution.x is not None:
             return Answer(solution.x[: qp.cost.shape[0]], status, solution.iterations, spent)
         if np.any(qp.lb > qp.ub):
@@ -150,6 +157,7 @@ class QPSolver:
             r.G[:, :n] = qp.G
 
     def reset(self) -> None:
-        """Forget the backends' warm starts."""
+        """Forget the backends' warm starts and the refusals counted (a run starts)."""
+        self.refusals.clear()
         for backend in self.backends:
             backend.reset()

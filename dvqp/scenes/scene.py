@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp.errors import SceneError
+from dvqp.errors import SceneError, one_line
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
 from dvqp.limits import Limit
@@ -144,7 +144,8 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
         start.check_floor(f, robot, q0, radius, limits)
     stem = "scene" if source.startswith("<") else Path(source).stem
     return Scene(
-        name=f.string(doc, "name", "", stem), description=f.string(doc, "description", "", ""),
+        name=one_line(f.string(doc, "name", "", stem)),
+        description=one_line(f.string(doc, "description", "", "")),
         source=source, text=text, pipe_radius=radius, weld=weld, robot=robot, q0=q0,
         weights=weights, orbital_level=level, obstacles=obstacles,
         objective=objective, limits=limits, dt=dt, jog=jog, path=path, ramp=ramp,

@@ -35,7 +35,20 @@ class ArraysType(types.StructRef):
 
 
 class Arrays(structref.StructRefProxy):
-    """A packed dataclass on the Python side (only handed to compiled code)."""
+    """A packed dataclass on the Python side (only handed to compiled code).
+
+    Its numba type is a plain attribute, not numba's property: numba reads it on every call
+    with ``PyObject_HasAttr``, which clears any exception. Python code run there (a property)
+    is where a pending Ctrl-C is raised, and the KeyboardInterrupt would be lost.
+    """
+
+    _numba_type_: Any = None  # shadows StructRefProxy's property; set per instance when boxed
+
+    @classmethod
+    def _numba_box_(cls, ty: Any, mi: Any) -> Arrays:
+        instance = super()._numba_box_(ty, mi)
+        instance._numba_type_ = ty
+        return instance  # type: ignore[no-any-return]
 
 
 structref.define_boxing(ArraysType, Arrays)
