@@ -31,6 +31,8 @@ MAX_ACTUATED = 64
 """At most this many links, and this many revolute, continuous and prismatic joints."""
 MAX_NAME = 200
 """Longest name of the robot, a link or a joint, characters."""
+MAX_OFFSET = 1e3
+"""Largest coordinate of an ``origin``, m (farther, the kinematics could overflow)."""
 ACTUATED = ("revolute", "continuous", "prismatic")
 JOINT_TYPES = (*ACTUATED, "fixed")
 """The joint types dvqp accepts (``floating`` and ``planar`` are refused)."""
@@ -123,10 +125,11 @@ def _check(root: Element) -> int:
                        f"most {MAX_ACTUATED}")  # fmt: skip
     if actuated == 0:
         raise _Refused("no revolute, continuous or prismatic joint: nothing moves")
-    names = _unique([_name(link.get("name"), f"link {i}") for i, link in enumerate(links)], "link")
+    names = [_name(link.get("name"), f"link number {i + 1}") for i, link in enumerate(links)]
+    _unique(names, "link")
     parents = {}
     for i, joint in enumerate(joints):
-        parents[i] = _joint(joint, _name(joint.get("name"), f"joint {i}"), set(names))
+        parents[i] = _joint(joint, _name(joint.get("name"), f"joint number {i + 1}"), set(names))
     joint_names = _unique([joint.get("name", "") for joint in joints], "joint")
     _tree(names, [(joint_names[i], *parents[i]) for i in range(len(joints))])
     for owner, what in [*zip(links, names, strict=True), *zip(joints, joint_names, strict=True)]:
@@ -221,6 +224,10 @@ def _numbers(owner: Element, what: str) -> None:
                     raise _Refused(f"{what}: <{tag}> has no {key}")
                 if tag == "axis" and found and math.hypot(*found) < 1e-6:
                     raise _Refused(f"{what}: axis xyz {element.get(key)!r} has no direction")
+                far = [v for v in found if abs(v) > MAX_OFFSET]
+                if (tag, key) == ("origin", "xyz") and far:
+                    raise _Refused(f"{what}: origin xyz {element.get(key)!r}: a coordinate "
+                                   f"beyond {MAX_OFFSET:g} m")  # fmt: skip
 
 
 def _floats(element: Element, key: str, count: int, what: str) -> list[float]:
