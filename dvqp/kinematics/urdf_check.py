@@ -214,8 +214,8 @@ def _tree(links: list[str], joints: list[tuple[str, str, str]]) -> None:
 
 
 def _numbers(owner: Element, what: str) -> None:
-    """Every numeric attribute of :data:`NUMBERS` below ``owner`` is finite, of its count;
-    an axis is not zero."""
+    """Every numeric attribute of :data:`NUMBERS` below ``owner`` is finite, of its count; an
+    axis is not zero, an origin within :data:`MAX_OFFSET`."""
     for tag, attributes in NUMBERS.items():
         for element in owner.iter(tag):
             for key, count in attributes.items():
