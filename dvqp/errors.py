@@ -85,6 +85,17 @@ class SceneError(DvqpError, ValueError):
         super().__init__(f"{one_line(path)}: {where}{one_line(reason)}")
 
 
+class RobotFileError(DvqpError, ValueError):
+    """A robot (URDF) file is refused: ``<path>: <reason>``, ``reason`` what is wrong with it
+    (``joint 'cyc': link 'link2' already has parent joint 'joint2'``) or why the URDF parser
+    could not load it."""
+
+    def __init__(self, path: str, reason: str) -> None:
+        self.path = path
+        self.reason = reason
+        super().__init__(f"{one_line(path)}: {one_line(reason)}")
+
+
 class OutputError(DvqpError, OSError):
     """The output file ``path`` could not be written: ``reason`` (``"No space left on
     device"``), with the operating system's ``errno`` if there was one.

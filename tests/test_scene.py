@@ -410,15 +410,20 @@ def test_urdf_errors_name_robot_urdf_and_keep_the_parser_quiet(
     floating = _urdf_arm().replace('name="j3" type="revolute"', 'name="j3" type="floating"')
     with pytest.raises(SceneError) as info:
         load_scene(_write_urdf_scene(tmp_path, floating))
-    assert str(info.value).endswith(
-        "robot.urdf: joint 'j3' is a FreeFlyer joint: only revolute, continuous and prismatic "
-        "joints are supported"
+    assert str(info.value) == (
+        f"{tmp_path / 'arm.toml'}: robot.urdf: {tmp_path / 'arm.urdf'}: joint 'j3' has type "
+        "'floating': dvqp takes only revolute, continuous, prismatic and fixed joints"
     )
     with pytest.raises(SceneError) as info:
         load_scene(_write_urdf_scene(tmp_path, "this is <not> XML"))
+    assert str(info.value).endswith("arm.urdf: not well-formed XML: syntax error: line 1, column 0")
+    bad = _urdf_arm().replace("</joint>", '<dynamics damping="x"/></joint>', 1)  # the parser's
+    with pytest.raises(SceneError) as info:
+        load_scene(_write_urdf_scene(tmp_path, bad))
     message = str(info.value)
     assert message.startswith(f"{tmp_path / 'arm.toml'}: robot.urdf: {tmp_path / 'arm.urdf'}: ")
-    assert "cannot load URDF" in message and "XML_ERROR" in message and "\n" not in message
+    assert "cannot load URDF" in message and "damping value (x)" in message
+    assert "\n" not in message
     assert capfd.readouterr() == ("", "")  # the C++ parser's own lines are kept off fd 1 and 2
 
 

@@ -3,10 +3,13 @@
 The bundled scenes, their motion cut to a few steps, are mutated as people get scene files
 wrong — a value of another type, a missing or unknown key, a non-finite or extreme number, an
 array of the wrong length, values nested hundreds of levels deep, garbage bytes — and run
-through :func:`dvqp.cli.main`. Either the input is refused (exit 2, exactly one ``dvqp:`` line
-on stderr, nothing written), or the run happens (exit 0 or 1, no traceback, every stderr line a
-``dvqp:`` line) and its saved arrays are finite except where ``docs/cli.md`` says otherwise: the
-task error of a failed step, the clearance when there is no obstacle.
+through :func:`dvqp.cli.main`; for the URDF scene, its arm's file may be edited instead
+(tests/urdf_edits.py: a second parent, a cycle, a bad number or name, junk). Either the input
+is refused (exit 2, exactly one ``dvqp:`` line on stderr, nothing written; a broken URDF tree,
+number, name or joint type always, by the file's checks), or the run happens (exit 0 or 1, no
+traceback, every stderr line a ``dvqp:`` line) and its saved arrays are finite except where
+``docs/cli.md`` says otherwise: the task error of a failed step, the clearance when there is
+no obstacle.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ import math
 import shutil
 import sys
 import tempfile
+import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +33,7 @@ from dvqp import SceneError, load_scene
 from dvqp.cli import main
 from dvqp.cli.progress import RunEstimate
 from dvqp.scenes import environment
+from tests.urdf_edits import EDITS, REFUSED_EDITS, edit, joints_of
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -196,10 +201,15 @@ def check_arrays(path: Path) -> None:
 def test_a_mistaken_scene_is_refused_in_one_line_or_runs_to_finite_arrays(
     name: str, backend: str, data: st.DataObject
 ) -> None:
-    content = mutate(short(name), data)
+    urdf_edit = name == "urdf-arm" and data.draw(st.booleans(), label="edit the URDF")
+    content = dumps(short(name)) if urdf_edit else mutate(short(name), data)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         shutil.copy(SCENES / "ndt13.urdf", folder / "ndt13.urdf")
+        if urdf_edit:  # the arm's file edited instead of the scene
+            kind = data.draw(st.sampled_from(EDITS), label="URDF edit")
+            root = ET.parse(folder / "ndt13.urdf").getroot()
+            (folder / "ndt13.urdf").write_text(edit(root, joints_of(root), kind, data), "utf-8")
         scene = folder / "scene.toml"
         if isinstance(content, bytes):
             scene.write_bytes(content)
@@ -210,6 +220,8 @@ def test_a_mistaken_scene_is_refused_in_one_line_or_runs_to_finite_arrays(
         code, err = run(folder, scene, backend)
         lines = err.splitlines()
         assert "Traceback" not in err and all(line.startswith("dvqp: ") for line in lines), err
+        if urdf_edit and kind in REFUSED_EDITS:
+            assert code == 2 and "robot.urdf: " in err and "cannot load URDF" not in err, err
         if code == 2:
             assert len(lines) == 1, err
             assert sorted(p.name for p in folder.iterdir()) == ["ndt13.urdf", "scene.toml"]

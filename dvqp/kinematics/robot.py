@@ -237,17 +237,19 @@ class Robot:
 
         The URDF's base frame is the pipe's frame: its z axis is the pipe axis. ``continuous``
         joints become revolute joints without position limits (``±inf``); ``revolute`` and
-        ``prismatic`` joints keep their limits; other joint types (``floating``, ``planar``)
-        are refused. Velocity limits default to the URDF's, or :data:`DEFAULT_QD_MAX` where it
-        gives none. What the C++ URDF parser prints is kept off the terminal; its first
-        complaint is part of the error.
+        ``prismatic`` joints keep their limits. Velocity limits default to the URDF's, or
+        :data:`DEFAULT_QD_MAX` where it gives none. The file is checked before Pinocchio's
+        parser sees it (:func:`~dvqp.kinematics.urdf_check.read_urdf`: size, one tree of
+        links, joint types and counts, names, numbers); what the C++ parser prints is kept off
+        the terminal, its first complaint is part of the error.
 
         Raises
         ------
-        DvqpError
-            ``<path>: cannot load URDF: <reason>`` for a file that is not a valid URDF.
+        RobotFileError
+            ``<path>: <reason>``: a file the checks refuse, or ``<path>: cannot load URDF:
+            <reason>`` one the parser refuses.
         ParameterError
-            ``urdf``: a joint of a type other than the above; ``frames``: no such frame.
+            ``frames``: no such frame.
         """
         model = urdf_model(path)
         if qd_max is None:

@@ -8,20 +8,27 @@ import numpy as np
 import pinocchio as pin
 
 from dvqp._files import c_output_captured
-from dvqp.errors import DvqpError, ParameterError
+from dvqp.errors import RobotFileError
+from dvqp.kinematics.urdf_check import read_urdf
 
 
 def urdf_model(path: str | Path) -> pin.Model:
-    """The Pinocchio model of the URDF file ``path``, each continuous joint (nq = 2) a revolute
-    one (nq = 1) without limits (errors: see :meth:`dvqp.Robot.from_urdf`)."""
+    """The Pinocchio model of the URDF file ``path``, checked first (:func:`read_urdf`), each
+    continuous joint (nq = 2) a revolute one (nq = 1) without limits (errors: see
+    :meth:`dvqp.Robot.from_urdf`)."""
+    checked = read_urdf(path)
     noise: list[str] = []
     try:
         with c_output_captured(noise):
-            model = pin.buildModelFromUrdf(str(path))
+            model = pin.buildModelFromXML(checked.text)
     except (RuntimeError, ValueError) as exc:
         detail = f" ({noise[0]})" if noise else ""
-        raise DvqpError(f"{path}: cannot load URDF: {exc}{detail}") from exc
-    return _bounded_revolute(model)
+        raise RobotFileError(str(path), f"cannot load URDF: {exc}{detail}") from exc
+    model = _bounded_revolute(model)
+    if model.nq != checked.actuated:  # the checks and the parser must agree on the joints
+        raise RobotFileError(str(path), f"the URDF parser read {model.nq} joint coordinates, "
+                             f"the file has {checked.actuated} joints that move")  # fmt: skip
+    return model
 
 
 UNBOUNDED_REVOLUTE = {"JointModelRUBX": pin.JointModelRX, "JointModelRUBY": pin.JointModelRY,
@@ -32,14 +39,9 @@ nq = 1 twins (any other axis: ``JointModelRevoluteUnboundedUnaligned``, see :fun
 
 def _bounded_revolute(model: pin.Model) -> pin.Model:
     """``model`` with each continuous joint as a revolute one, joints, bodies and frames keeping
-    their names, placements, inertias and order; any other joint with ``nq != nv`` is refused."""
+    their names, placements, inertias and order (:func:`read_urdf` let no other joint with
+    ``nq != nv`` through)."""
     twins = [_twin(model.joints[i]) for i in range(1, model.njoints)]
-    for name, joint, twin in zip(model.names[1:], model.joints[1:], twins, strict=True):
-        if joint.nq != joint.nv and twin is None:
-            raise ParameterError(
-                "urdf", f"joint {name!r} is a {joint.shortname().removeprefix('JointModel')} "
-                "joint: only revolute, continuous and prismatic joints are supported"
-            )  # fmt: skip
     if all(twin is None for twin in twins):
         return model
     out = pin.Model()

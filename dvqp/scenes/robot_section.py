@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 from dvqp import _validate
 from dvqp.errors import DvqpError, ParameterError
 from dvqp.kinematics.robot import Robot
+from dvqp.kinematics.urdf_check import read_urdf
 from dvqp.scenes.fields import Bound, Fields, join
 
 LINK_LENGTH = Bound(0.0, 10.0, "m")
@@ -26,38 +27,59 @@ MODELS = ("ndt13",)
 def robot(
     f: Fields, doc: dict[str, Any], base_dir: Path
 ) -> tuple[Robot, NDArray[np.float64], NDArray[np.float64]]:
-    """The arm, its start configuration (rad) and the diagonal of W, each checked."""
+    """The arm, its start configuration (rad) and the diagonal of W, each checked.
+
+    Every per-joint array is checked against the arm's joint count (13, or the URDF file's, the
+    file checked) before the arm is built.
+    """
     t = f.table(doc, "robot", "", ROBOT_KEYS)
-    arm = _arm(f, t, base_dir)
-    q0 = f.vector(t, "q0", "robot", arm.n, within=ANGLE)
+    n = _joint_count(f, t, base_dir)
+    q0 = f.vector(t, "q0", "robot", n, within=ANGLE)
+    weights = f.vector(t, "weights", "robot", n, scalar=True, default=1.0, within=JOINT_WEIGHT)
+    limits = _limits(f, t, n)
+    f.vector(t, "qdd_max", "robot", n, scalar=True, default=1.0, infinite=True)  # bounds: limits
+    arm = _arm(f, t, base_dir, limits)
     for i, (q, lo, hi) in enumerate(zip(q0, arm.q_min, arm.q_max, strict=True)):
         if not lo - 1e-12 <= q <= hi + 1e-12:
             f.fail(f"robot.q0[{i}]", f"{q:g} rad is outside [q_min, q_max] = [{lo:g}, {hi:g}] rad")
-    weights = f.vector(t, "weights", "robot", arm.n, scalar=True, default=1.0, within=JOINT_WEIGHT)
     return arm, _validate.readonly(q0), _validate.readonly(weights)
 
 
-def _arm(f: Fields, t: dict[str, Any], base_dir: Path) -> Robot:
+def _joint_count(f: Fields, t: dict[str, Any], base_dir: Path) -> int:
+    """13 for the built-in arm; for a URDF file, checked (:func:`read_urdf`), its number of
+    revolute, continuous and prismatic joints. No model is built."""
     if ("model" in t) == ("urdf" in t):
         f.fail("robot", "give exactly one of 'model' (built in) or 'urdf' (a file)")
     if "model" in t:
         model = f.string(t, "model", "robot")
         if model not in MODELS:
             f.fail("robot.model", f"unknown model {model!r} (known: {', '.join(MODELS)})")
+        return 13
+    urdf = base_dir / f.string(t, "urdf", "robot")
+    if not urdf.is_file():
+        f.fail("robot.urdf", f"no such file: {urdf}")
+    try:
+        return read_urdf(urdf).actuated
+    except DvqpError as exc:
+        f.fail("robot.urdf", str(exc))
+
+
+def _arm(f: Fields, t: dict[str, Any], base_dir: Path, limits: dict[str, Any]) -> Robot:
+    """The arm (``model`` or ``urdf``, as :func:`_joint_count` checked) with the scene's
+    ``limits`` (None: the arm's own)."""
+    given = {k: v for k, v in limits.items() if v is not None}
+    if "model" in t:
         for key in ("points", "tool", "rail"):
             if key in t:
                 f.fail(join("robot", key), "only with 'urdf'")
         lengths = f.vector(t, "link_lengths", "robot", 7, within=LINK_LENGTH)
-        limits = _limits(f, t, 13)
         with f.mapped("robot"):
-            return Robot.ndt13(lengths, **{k: v for k, v in limits.items() if v is not None})
+            return Robot.ndt13(lengths, **given)
     if "link_lengths" in t:
         f.fail("robot.link_lengths", "only with model = 'ndt13'")
     urdf = base_dir / f.string(t, "urdf", "robot")
     points, tool = f.strings(t, "points", "robot"), f.string(t, "tool", "robot")
     rail = f.string(t, "rail", "robot") if "rail" in t else None
-    if not urdf.is_file():
-        f.fail("robot.urdf", f"no such file: {urdf}")
     try:
         loaded = Robot.from_urdf(urdf, points, tool, rail=rail)
     except ParameterError as exc:
@@ -66,11 +88,9 @@ def _arm(f: Fields, t: dict[str, Any], base_dir: Path) -> Robot:
         f.fail("robot.urdf", str(exc))
     except (ArithmeticError, ValueError, RuntimeError) as exc:  # Pinocchio on a strange model
         f.fail("robot.urdf", f"{urdf}: cannot use this model ({exc})")
-    limits = _limits(f, t, loaded.n)
-    if limits["qd_max"] is None:
-        limits["qd_max"] = loaded.qd_max
     with f.mapped("robot"):
-        return Robot(loaded.model, points, tool, rail_frame=rail, name=loaded.name, **limits)
+        return Robot(loaded.model, points, tool, rail_frame=rail, name=loaded.name,
+                     **{"qd_max": loaded.qd_max, **given})  # fmt: skip
 
 
 def _limits(f: Fields, t: dict[str, Any], n: int) -> dict[str, NDArray[np.float64] | None]:
