@@ -80,3 +80,12 @@ def test_an_empty_output_name_is_refused_before_any_run(
     assert main([a.format(scene=scene) for a in command]) == 2
     captured = capsys.readouterr()
     assert captured.err == "dvqp: output: empty file name\n" and captured.out == ""
+
+
+def test_an_error_the_console_sends_shows_hostile_text_escaped() -> None:
+    import json
+
+    from dvqp.console import protocol
+
+    message = json.loads(protocol.error(f"unknown backend {HOSTILE!s}"))["message"]
+    assert message.isprintable() and "\\x1b[31mRED\\r\\n" in message

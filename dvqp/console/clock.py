@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from dvqp.console.session import ConsoleSession
+from dvqp.errors import one_line
 
 MAX_LAG = 0.1
 """Largest lag behind real time (s) made up by stepping faster; more is dropped."""
@@ -116,7 +117,7 @@ class RealTimeClock:
             self.session.step()
         except Exception as exc:  # the clock must keep the console alive
             self.session.stop()
-            message = f"dvqp: console: step failed: {type(exc).__name__}: {exc}"
+            message = f"dvqp: console: step failed: {type(exc).__name__}: {one_line(str(exc))}"
             if message not in self._reported:
                 self._reported.add(message)
                 print(message, file=sys.stderr)

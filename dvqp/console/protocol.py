@@ -17,6 +17,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp.errors import one_line
+
 MAX_MESSAGE_BYTES = 4096
 """Largest client message answered, bytes (UTF-8); a longer one gets an ``error`` reply."""
 MAX_LINEAR_SPEED = 0.1
@@ -123,5 +125,5 @@ def encode(message: dict[str, Any]) -> str:
 
 
 def error(message: str) -> str:
-    """The ``error`` reply."""
-    return encode({"type": "error", "message": message})
+    """The ``error`` reply (unprintable characters escaped: the page shows it as text)."""
+    return encode({"type": "error", "message": one_line(message)})
