@@ -44,8 +44,15 @@ CACHES: list[SoftCache] = []
 """Every cache made by :func:`njit`, in order."""
 
 
-def note(text: str) -> None:
-    """``dvqp: note: <text>``, one line on stderr."""
+_NOTED: set[str] = set()  # the notes given once a process
+
+
+def note(text: str, once: str = "") -> None:
+    """``dvqp: note: <text>``, one line on stderr (only the first time for a given ``once``)."""
+    if once:
+        if once in _NOTED:
+            return
+        _NOTED.add(once)
     print(f"dvqp: note: {text}", file=sys.stderr, flush=True)
 
 
@@ -116,8 +123,6 @@ class _EntryFiles(IndexDataCacheFile):
 class SoftCache(FunctionCache):
     """numba's ``FunctionCache`` of ``py_func`` whose entries fail soft (see the module)."""
 
-    unsaved_noted = False  # one note a process when saving fails
-
     def __init__(self, py_func: Callable[..., Any]) -> None:
         super().__init__(py_func)
         self.source = inspect.getfile(py_func)
@@ -141,10 +146,8 @@ class SoftCache(FunctionCache):
         try:
             super().save_overload(sig, data)
         except Exception as exc:  # a full disk: compiled all the same, not cached
-            if not SoftCache.unsaved_noted:
-                SoftCache.unsaved_noted = True
-                note(f"compile cache not written ({self._cache_path}: {_reason(exc)}): "
-                     "compiled code is not cached")  # fmt: skip
+            note(f"compile cache not written ({self._cache_path}: {_reason(exc)}): "
+                 "compiled code is not cached", once="unsaved")  # fmt: skip
 
 
 def _cache_for(function: Callable[..., Any]) -> SoftCache | NullCache:
@@ -152,7 +155,7 @@ def _cache_for(function: Callable[..., Any]) -> SoftCache | NullCache:
     try:
         cache = SoftCache(function)
     except (RuntimeError, OSError) as exc:  # no writable folder: numba itself would refuse
-        note(f"no compile cache for {function.__module__}.{function.__qualname__} ({exc})")
+        note(f"no compile cache ({exc}): compiled code is not cached", once="uncached")
         return NullCache()
     CACHES.append(cache)
     return cache

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numba
 import pytest
+from numba.core.caching import NullCache
 from numba.core.dispatcher import Dispatcher
 
 import solvers.jit
@@ -129,13 +130,29 @@ def test_a_cache_that_cannot_be_written_leaves_the_run_compiled_with_one_note(
 
     monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path))
     monkeypatch.setattr(_EntryFiles, "_open_for_write", full)
-    monkeypatch.setattr(SoftCache, "unsaved_noted", False)
+    monkeypatch.setattr(solvers.jit, "_NOTED", set())
     assert run_kernel() == (0, 1)
     assert run_kernel() == (0, 1)  # nothing was cached
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and err[0].startswith("dvqp: note: compile cache not written (")
     assert err[0].endswith(": No space left on device): compiled code is not cached")
     assert not [p for p in tmp_path.rglob("*") if p.is_file()]
+
+
+def test_a_function_with_no_folder_to_cache_in_compiles_uncached_with_one_note(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    def nowhere(self: object, py_func: object) -> None:  # numba's words, as it would raise
+        raise RuntimeError(f"cannot cache function {py_func!r}: no locator available")
+
+    monkeypatch.setattr(SoftCache, "__init__", nowhere)
+    monkeypatch.setattr(solvers.jit, "_NOTED", set())
+    kernels = [njit(_twice), njit(_twice)]
+    assert [k(3.0) for k in kernels] == [6.0, 6.0]
+    assert all(isinstance(k._cache, NullCache) for k in kernels)
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith("dvqp: note: no compile cache (cannot cache")
+    assert err[0].endswith("no locator available): compiled code is not cached")
 
 
 def test_every_compiled_function_of_dvqp_and_solvers_has_the_soft_cache() -> None:
