@@ -10,6 +10,7 @@ from typing import Any
 
 import dvqp
 import solvers
+from dvqp.errors import DvqpError
 from solvers.jit import entry_files
 
 ROOTS = [Path(dvqp.__file__).parent, Path(solvers.__file__).parent]
@@ -30,7 +31,7 @@ def show_path(args: argparse.Namespace) -> int:
     """Print each folder holding (or to hold) compiled functions of dvqp, one a line: under
     ``NUMBA_CACHE_DIR`` if it is set, else each source folder's ``__pycache__`` (or numba's
     user-wide cache folder where that cannot be written)."""
-    for folder in entry_files(ROOTS):
+    for folder in _entries():
         print(folder)
     return 0
 
@@ -40,7 +41,7 @@ def clear(args: argparse.Namespace) -> int:
     temporary files) and print how many files and bytes; exit 1 if one could not be deleted
     (``dvqp: <file>: cannot remove: <reason>``), after deleting the others."""
     count = size = failed = 0
-    for files in entry_files(ROOTS).values():
+    for files in _entries().values():
         for path in files:
             try:
                 nbytes = path.stat().st_size
@@ -54,3 +55,11 @@ def clear(args: argparse.Namespace) -> int:
                 count, size = count + 1, size + nbytes
     print(f"removed {count} compile cache files ({size:,} bytes)")
     return 1 if failed else 0
+
+
+def _entries() -> dict[Path, list[Path]]:
+    """:func:`solvers.jit.entry_files` of dvqp; an unreadable folder is a :class:`DvqpError`."""
+    try:
+        return entry_files(ROOTS)
+    except OSError as exc:
+        raise DvqpError(f"{exc.filename}: cannot read: {exc.strerror or exc}") from exc
