@@ -1,7 +1,7 @@
 """Small compiled helpers of the adapters' per-step update paths.
 
 Each compiles (or loads numba's cache) at its first call, for its one declared signature
-(:func:`solvers._jit.compiled_on_first_call`); the arrays it is given must be float64 and
+(:func:`solvers.jit.compiled_on_first_call`); the arrays it is given must be float64 and
 C-contiguous, of the declared dimensions, or the call raises ``TypeError``.
 """
 
@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import types
 
-from ._jit import compiled_on_first_call
+from .jit import compiled_on_first_call
 
 _VEC_IN = types.Array(types.float64, 1, "C", readonly=True)
 _MAT_IN = types.Array(types.float64, 2, "C", readonly=True)

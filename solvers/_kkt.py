@@ -1,7 +1,7 @@
 """The compiled KKT kernel behind :mod:`solvers.kkt` (see there for what it computes).
 
 :func:`kernel` and :func:`stacked` compile (or load numba's cache) at their first call, for
-their one declared signature (:func:`solvers._jit.compiled_on_first_call`); the ``@njit``
+their one declared signature (:func:`solvers.jit.compiled_on_first_call`); the ``@njit``
 helpers are inlined into both and never compiled on their own.
 """
 
@@ -10,9 +10,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, types
+from numba import types
 
-from ._jit import compiled_on_first_call
+from .jit import compiled_on_first_call, njit
 
 _VEC = types.Array(types.float64, 1, "C", readonly=True)
 _MAT = types.Array(types.float64, 2, "C", readonly=True)

@@ -25,6 +25,7 @@ from dvqp import comparison as cmp
 from dvqp._files import output_path
 from dvqp._versions import versions
 from dvqp.cli import bench as bench_cmd
+from dvqp.cli import cache as cache_cmd
 from dvqp.cli import console as console_cli
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
@@ -97,6 +98,7 @@ def _parser() -> argparse.ArgumentParser:
     g.set_defaults(run=_plot)
     console_cli.register(sub)
     bench_cmd.register(sub)
+    cache_cmd.register(sub)
     b = sub.add_parser("backends", help="list the installed backends and their versions")
     b.set_defaults(run=_backends)
     return parser

@@ -14,7 +14,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
 from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon, Shape
@@ -23,6 +22,7 @@ from dvqp.geometry.shapes.circle import circle_point, circle_segment
 from dvqp.geometry.shapes.polygon import polygon_point, polygon_segment
 from dvqp.kinematics.developed_view import wrap_period
 from dvqp.workspace import ProximityBuffers
+from solvers.jit import njit
 
 Array = NDArray[np.float64]
 
@@ -92,7 +92,7 @@ class ShapeArrays:
                    np.array([s.size for s in shapes], float), np.full(count, math.inf))  # fmt: skip
 
 
-@njit(cache=True)
+@njit
 def _point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
     """``(d, ∂d/∂l, ∂d/∂z)`` of a point to obstacle j."""
     code, data, period = shapes.code[j], shapes.data[j], shapes.period
@@ -105,7 +105,7 @@ def _point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
     return polygon_point(wrap_period(pl - data[0], period), pz, shapes.vl[a:b], shapes.vz[a:b])
 
 
-@njit(cache=True)
+@njit
 def shape_segment(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
     """``(d, t, ∂d/∂l, ∂d/∂z)`` of a segment to obstacle j."""
     code, data, period = shapes.code[j], shapes.data[j], shapes.period
@@ -120,7 +120,7 @@ def shape_segment(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
     return polygon_segment(la, az, lb, bz, shapes.vl[a:b], shapes.vz[a:b])
 
 
-@njit(cache=True)
+@njit
 def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
     """Distances and normals of the points ``chain`` (m; columns l, z, ...) and of the links
     ``near.ends`` between them to every compiled obstacle, into ``near`` (a packed
@@ -141,7 +141,7 @@ def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
             near.link_normal[j, i, 0], near.link_normal[j, i, 1] = nl, nz
 
 
-@njit(cache=True)
+@njit
 def penalties(size, near) -> None:  # type: ignore[no-untyped-def]
     """Every row's penalty ``e = d (d + 2ρ)`` (m²) and ``∇e = 2 (d + ρ) ∇d`` (m)."""
     for j in range(size.shape[0]):

@@ -27,12 +27,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
 from dvqp.geometry.measure import OTHER, shape_segment
 from dvqp.kinematics.state import KinematicState
 from dvqp.workspace import link_ends
+from solvers.jit import njit
 
 PRECISION = 1e-5
 """m: the most a link's clearance, where measured in pieces, may be below its real one."""
@@ -40,7 +40,7 @@ MAX_PIECES = 256
 """Pieces waiting at once in the halving of one link (:func:`real_links`)."""
 
 
-@njit(cache=True)
+@njit
 def link_bend(ax, ay, bx, by):  # type: ignore[no-untyped-def]
     """``(g, t)``: the signed largest ``g(t) = θ(t) − t Δφ`` (rad) of the link from
     ``(ax, ay)`` to ``(bx, by)`` (the xy parts of its ends, m) and where it is (``t`` in
@@ -72,13 +72,13 @@ def link_bends(state: KinematicState) -> NDArray[np.float64]:
                      for a, b in ends])  # fmt: skip
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _at(a, b, t):  # type: ignore[no-untyped-def]
     """The point ``a + t (b − a)`` of a 3-D link: ``(x, y, z)``, m."""
     return a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])
 
 
-@njit(cache=True)
+@njit
 def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ignore[no-untyped-def]
     """The clearance of every guarded link's real DV image to every obstacle, into ``near``'s
     ``real_*`` rows: the least over the link's pieces of the straight piece's clearance less
@@ -122,7 +122,7 @@ def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ign
                 _pieces(shapes, j, i, a, b, chain[ends[i, 0], 0], radius, near)
 
 
-@njit(cache=True)
+@njit
 def _piece(shapes, j, a, b, la, radius, t0, t1):  # type: ignore[no-untyped-def]
     """``(d, δ, s, ∂d/∂l, ∂d/∂z)`` of the piece ``[t0, t1]`` of the link ``a → b`` to obstacle
     j: its straight DV piece's clearance, its bend, its closest point's parameter and normal."""
@@ -134,7 +134,7 @@ def _piece(shapes, j, a, b, la, radius, t0, t1):  # type: ignore[no-untyped-def]
     return d, radius * abs(link_bend(x0, y0, x1, y1)[0]), s, nl, nz
 
 
-@njit(cache=True)
+@njit
 def _pieces(shapes, j, i, a, b, la, radius, near) -> None:  # type: ignore[no-untyped-def]
     """Link i's clearance to obstacle j by halving its pieces, a level at a time (branch and
     bound). Each piece has its straight DV piece's clearance ``d`` and bend ``δ``: its real
@@ -168,7 +168,7 @@ def _pieces(shapes, j, i, a, b, la, radius, near) -> None:  # type: ignore[no-un
         live, halves, count = halves, live, n
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _candidate(near, j, i, piece, found):  # type: ignore[no-untyped-def]
     """Write the piece ``[t0, t1]`` with ``(d, δ, s, n_l, n_z)`` as link i's clearance to
     obstacle j; return it, ``d − δ``."""
@@ -180,7 +180,7 @@ def _candidate(near, j, i, piece, found):  # type: ignore[no-untyped-def]
     return found[0] - found[1]
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _turn(a, b, ja, jb, t, c):  # type: ignore[no-untyped-def]
     """``∂φ/∂Q_c`` (rad/rad) of the link's point at ``t``, ``φ = atan2(y, x)``:
     ``(x ∂y − y ∂x)/ρ²``; ``ja``, ``jb`` the ends' positional Jacobians (rows x, y, z)."""
@@ -190,7 +190,7 @@ def _turn(a, b, ja, jb, t, c):  # type: ignore[no-untyped-def]
     return (x * dy - y * dx) / (x * x + y * y)
 
 
-@njit(cache=True)
+@njit
 def real_link_gradient(near, origins, frame_jacobians, radius, j, i, out) -> None:  # type: ignore[no-untyped-def]
     """``∂d/∂Q`` (m/rad, (n,)) of link i's real clearance to obstacle j (as :func:`real_links`
     measured it) into ``out``: ``n · ∂p/∂Q`` at the closest point ``p`` of its piece, less the

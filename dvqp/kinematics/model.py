@@ -18,11 +18,11 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
-from numba import njit
 from numpy.typing import NDArray
 
 from dvqp.errors import ParameterError
 from dvqp.kinematics.developed_view import HEADING_FLOOR, RHO_MIN
+from solvers.jit import njit
 
 Array = NDArray[np.float64]
 
@@ -114,7 +114,7 @@ def _motion_of(joint: pin.JointModel, name: str) -> tuple[int, Array]:
                          "prismatic joints about a fixed axis are supported")  # fmt: skip
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _motion(kind: int, axis: Array, value: float, out: Array) -> None:
     """``M_j(q_j)``: rotation by ``value`` about ``axis`` (Rodrigues) or translation along it."""
     for r in range(4):
@@ -132,7 +132,7 @@ def _motion(kind: int, axis: Array, value: float, out: Array) -> None:
     out[2, 0], out[2, 1], out[2, 2] = z * x * v - y * s, z * y * v + x * s, c + z * z * v
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _compose(a: Array, b: Array, out: Array) -> None:
     """``out = a · b`` of two rigid transforms (4, 4)."""
     for r in range(3):
@@ -143,7 +143,7 @@ def _compose(a: Array, b: Array, out: Array) -> None:
     out[3, 0], out[3, 1], out[3, 2], out[3, 3] = 0.0, 0.0, 0.0, 1.0
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _joints(model, q) -> None:  # type: ignore[no-untyped-def]
     """``model.work[j] = oMi[j]`` and ``model.world[j]`` its motion axis in the base frame."""
     work, count = model.work, model.parents.shape[0]
@@ -160,7 +160,7 @@ def _joints(model, q) -> None:  # type: ignore[no-untyped-def]
             model.world[j, r] = work[j, r, 0] * u[0] + work[j, r, 1] * u[1] + work[j, r, 2] * u[2]
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _frame_jacobian(model, f, origin, jac) -> None:  # type: ignore[no-untyped-def]
     """``[J_v; J_ω]`` (6, n) of the point ``origin`` moved by the joints supporting frame f."""
     for r in range(6):
@@ -180,7 +180,7 @@ def _frame_jacobian(model, f, origin, jac) -> None:  # type: ignore[no-untyped-d
         jac[3, c], jac[4, c], jac[5, c] = w0, w1, w2
 
 
-@njit(cache=True)
+@njit
 def kinematics(model, radius, state) -> int:  # type: ignore[no-untyped-def]
     """Frames, frame Jacobians and DV coordinates of ``state.q``, written into ``state``
     (a packed :class:`~dvqp.workspace.StateBuffers`; ``model`` a packed :class:`ModelArrays`,
@@ -214,7 +214,7 @@ def kinematics(model, radius, state) -> int:  # type: ignore[no-untyped-def]
     return -1
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _developed(radius, origin, jac, out, rows) -> bool:  # type: ignore[no-untyped-def]
     """``[l, z, h]`` of a point (``l = R atan2(y, x)``, ``z``, ``h = ρ − R``) and its rows
     ``∂[l, z, h]/∂Q`` through the point's linear Jacobian; False on the pipe axis."""
@@ -232,7 +232,7 @@ def _developed(radius, origin, jac, out, rows) -> bool:  # type: ignore[no-untyp
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _heading(origin, axis, jac, row) -> float:  # type: ignore[no-untyped-def]
     """The heading ``α = atan2(z_z, (O_x z_y − O_y z_x)/ρ)`` (rad) of the tool axis on the
     surface, and ``∂α/∂Q`` into ``row``: with ``ż = ω × z``,

@@ -16,13 +16,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
 from dvqp.errors import ParameterError
 from dvqp.kinematics.robot import Robot
 from dvqp.limits.limit import Limit
+from solvers.jit import njit
 
 DEFAULT_QDD_MAX = 10.0
 """rad/s²: the default joint acceleration limit of the NDT arm's drives."""
@@ -70,14 +70,14 @@ class AccelerationLimit(Limit):
         np.copyto(self._previous, qdot)
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _braking(a: float, dt: float, room: float) -> float:
     """Fastest velocity toward a limit ``room`` (rad) away that still stops before it, rad/s:
     ``Q̇ dt + Q̇²/(2a) ≤ room`` (an unlimited side, ``room = inf``, gives inf)."""
     return -a * dt + math.sqrt((a * dt) ** 2 + 2.0 * a * max(room, 0.0))
 
 
-@njit(cache=True)
+@njit
 def acceleration_bounds(q: Array, q_min: Array, q_max: Array, qdd_max: Array, previous: Array,
                         dt: float, lb: Array, ub: Array) -> None:  # fmt: skip
     """The box ``|Q̇ − Q̇_prev| ≤ q̈_max dt`` capped by the braking bounds, intersected into

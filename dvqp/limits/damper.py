@@ -27,13 +27,13 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.limit import Limit
 from dvqp.workspace import Kernel, StepPlan
+from solvers.jit import njit
 
 Array = NDArray[np.float64]
 
@@ -140,7 +140,7 @@ class DamperArrays:
     angle: NDArray[np.bool_]
 
 
-@njit(cache=True)
+@njit
 def damper_value(distance: float, safe: float, gain: float, dt: float, depth: float,
                  deceleration: float) -> float:  # fmt: skip
     """The right-hand side of a damper row (see the module docstring), m/s."""
@@ -152,7 +152,7 @@ def damper_value(distance: float, safe: float, gain: float, dt: float, depth: fl
     return min(max(rhs, low), high)
 
 
-@njit(cache=True)
+@njit
 def damper_rows(params, dampers, dt: float, G: Array, h: Array) -> None:  # type: ignore[no-untyped-def]
     """Rows ``r`` of ``G``, ``h`` from damper r's distance (``dampers``, packed
     :class:`~dvqp.workspace.DamperBuffers`; ``params`` a packed :class:`DamperArrays`):
@@ -171,7 +171,7 @@ def damper_rows(params, dampers, dt: float, G: Array, h: Array) -> None:  # type
             h[r] = np.inf
 
 
-@njit(cache=True)
+@njit
 def damper_values(angle, distance: Array, values: Array, start: int) -> None:  # type: ignore[no-untyped-def]
     """The verified values of the damper rows at ``values[start:]``: the distances, or the
     angle ``asin(min(d, 1))`` of an ``angle`` row."""

@@ -16,9 +16,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from numba import njit
-
 from dvqp.workspace.buffers import Array
+from solvers.jit import njit
 
 
 @dataclass(frozen=True)
@@ -136,7 +135,7 @@ def start_broken_lines(found: Sequence[StartBroken]) -> list[str]:
     return lines
 
 
-@njit(cache=True)
+@njit
 def worst_excess(values: Array, floor: Array, tolerance: Array, out: Array) -> int:
     """``out = [floor − value, (floor − value)/tolerance]`` of the value of largest ratio
     (``[−inf, −inf]`` if none); returns its index, or −1. A NaN is the worst (never kept)."""

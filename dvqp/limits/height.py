@@ -18,13 +18,13 @@ import math
 from typing import ClassVar
 
 import numpy as np
-from numba import njit
 
 from dvqp.errors import ParameterError
 from dvqp.geometry.proximity import link_label
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
 from dvqp.workspace import link_ends
+from solvers.jit import njit
 
 
 class SurfaceHeight(VelocityDamper):
@@ -112,7 +112,7 @@ def _finite(name: str, value: float) -> float:
     return float(value)
 
 
-@njit(cache=True)
+@njit
 def height_distances(guarded, jacobians, first, count, start, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
     """Heights ``h`` (m) and ``∂h/∂Q`` of the guarded points ``first .. first + count − 1``
     (``guarded`` (k+1, 3), ``jacobians`` (k+1, 3, n)), from row ``start``."""
@@ -123,7 +123,7 @@ def height_distances(guarded, jacobians, first, count, start, distance, gradient
             gradient[r, c] = jacobians[p, 2, c]
 
 
-@njit(cache=True)
+@njit
 def chord_low(guarded, origins, a, b, radius):  # type: ignore[no-untyped-def]
     """``(h, t*, inside, u_x, u_y)`` of the lowest point of the chord joining guarded frames
     ``a`` and ``b`` (``origins`` (m, 3), m): its height (m; where the lowest point is an end,
@@ -142,7 +142,7 @@ def chord_low(guarded, origins, a, b, radius):  # type: ignore[no-untyped-def]
     return h, t, inside, px / max(rho, 1e-300), py / max(rho, 1e-300)
 
 
-@njit(cache=True)
+@njit
 def chord_heights(
     guarded, origins, frame_jacobians, ends, radius, chords, distance, gradient, usable
 ) -> None:  # type: ignore[no-untyped-def]
@@ -159,7 +159,7 @@ def chord_heights(
             gradient[r, q] = ux * jx + uy * jy
 
 
-@njit(cache=True)
+@njit
 def lowest_chords(guarded, origins, ends, k, radius):  # type: ignore[no-untyped-def]
     """``(h, i, h_holder)``: the lowest height (m) of the chords of the guarded links ``ends``
     (L, 2) other than the probe holder (link ``k − 1``): the body links and the carriage link,

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
 from dvqp.kinematics.robot import Robot
 from dvqp.limits.limit import Limit
+from solvers.jit import njit
 
 Array = NDArray[np.float64]
 
@@ -34,7 +34,7 @@ class JointPositionLimit(Limit):
         self.q_max = robot.q_max
 
 
-@njit(cache=True)
+@njit
 def position_bounds(q: Array, q_min: Array, q_max: Array, dt: float, lb: Array,
                     ub: Array) -> None:  # fmt: skip
     """``min((q_min − q)/dt, 0) ≤ Q̇ ≤ max((q_max − q)/dt, 0)``, intersected into ``lb``,
@@ -44,7 +44,7 @@ def position_bounds(q: Array, q_min: Array, q_max: Array, dt: float, lb: Array,
         ub[i] = min(ub[i], max((q_max[i] - q[i]) / dt, 0.0))
 
 
-@njit(cache=True)
+@njit
 def joint_room(q: Array, q_min: Array, q_max: Array, values: Array, start: int) -> None:
     """The verified values ``[q_max − q, q − q_min]`` (rad, 2n) at ``values[start:]``
     (``inf`` on an unlimited side: never the worst)."""
@@ -68,7 +68,7 @@ class JointVelocityLimit(Limit):
         self.qd_max = robot.qd_max
 
 
-@njit(cache=True)
+@njit
 def velocity_bounds(qd_max: NDArray[np.float64], lb: NDArray[np.float64],
                     ub: NDArray[np.float64]) -> None:  # fmt: skip
     """``−q̇_max ≤ Q̇ ≤ q̇_max``, intersected into ``lb``, ``ub`` in place."""

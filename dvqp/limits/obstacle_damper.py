@@ -11,7 +11,6 @@ from __future__ import annotations
 from typing import ClassVar
 
 import numpy as np
-from numba import njit
 
 from dvqp import _validate
 from dvqp.errors import ParameterError
@@ -19,6 +18,7 @@ from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.proximity import link_label, point_label
 from dvqp.geometry.real_links import real_link_gradient
 from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
+from solvers.jit import njit
 
 
 class ObstacleDamper(VelocityDamper):
@@ -78,7 +78,7 @@ class ObstacleDamper(VelocityDamper):
         )
 
 
-@njit(cache=True)
+@njit
 def obstacle_distances(near, jacobians, origins, frame_jacobians, radius, reach, members,
                        start, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]  # fmt: skip
     """Clearances of every (point, obstacle) pair then every (link, obstacle) pair of the

@@ -18,13 +18,13 @@ import math
 from typing import ClassVar
 
 import numpy as np
-from numba import njit
 
 from dvqp import _validate
 from dvqp.geometry.proximity import link_label
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
 from dvqp.workspace import PairBuffers, as_struct
+from solvers.jit import njit
 
 
 class SelfCollision(VelocityDamper):
@@ -76,7 +76,7 @@ class SelfCollision(VelocityDamper):
                      for a, b in zip(pairs.i, pairs.j, strict=True))  # fmt: skip
 
 
-@njit(cache=True)
+@njit
 def pair_distances(o, pairs) -> None:  # type: ignore[no-untyped-def]
     """Distance, unit normal ``c_i − c_j``, ``s`` and ``t`` of the link pairs of the guarded
     points ``o`` (m, 3) into ``pairs`` (a packed PairBuffers): link i's segment
@@ -118,7 +118,7 @@ def pair_distances(o, pairs) -> None:  # type: ignore[no-untyped-def]
         pairs.normal[m, 0], pairs.normal[m, 1], pairs.normal[m, 2] = x / scale, y / scale, z / scale
 
 
-@njit(cache=True)
+@njit
 def self_distances(pairs, jac, start, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
     """Every pair's distance (m) and ``∂d/∂Q`` (see the module docstring) from row ``start``
     (``jac`` the guarded frames' (m, 6, n) Jacobians)."""

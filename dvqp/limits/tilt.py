@@ -15,10 +15,9 @@ from __future__ import annotations
 import math
 from typing import ClassVar
 
-from numba import njit
-
 from dvqp.errors import ParameterError
 from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
+from solvers.jit import njit
 
 SIN_FLOOR = 1e-9
 """The smallest ``sin θ`` the gradient divides by (the axis radial)."""
@@ -65,7 +64,7 @@ class TiltLimit(VelocityDamper):
         return ("probe/tilt",)
 
 
-@njit(cache=True)
+@njit
 def tilt_cosine(origins, axes, frame_jacobians, m, du) -> float:  # type: ignore[no-untyped-def]
     """``u = cos θ`` of the probe (guarded frame ``m``) and ``∂u/∂Q`` into ``du`` (n,)."""
     jac = frame_jacobians[m]
@@ -80,7 +79,7 @@ def tilt_cosine(origins, axes, frame_jacobians, m, du) -> float:  # type: ignore
     return u
 
 
-@njit(cache=True)
+@njit
 def tilt_distance(origins, axes, frame_jacobians, m, row, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
     """Row ``row``: ``d = sin θ`` of the probe (frame ``m``) and
     ``∂d/∂Q = −(u / max(d, ε)) ∂u/∂Q``."""
@@ -93,7 +92,7 @@ def tilt_distance(origins, axes, frame_jacobians, m, row, distance, gradient, us
     distance[row], usable[row] = d, True
 
 
-@njit(cache=True)
+@njit
 def tilt_angle(origins, axes, m) -> float:  # type: ignore[no-untyped-def]
     """The tilt θ of the probe (guarded frame ``m``) from the radial direction, rad, in
     [0, π]."""

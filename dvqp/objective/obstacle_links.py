@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from numba import njit
 from numpy.typing import ArrayLike
 
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.objective.term import Array, ObjectiveTerm, point_gains, pull_points
+from solvers.jit import njit
 
 
 class ObstacleLinks(ObjectiveTerm):
@@ -32,7 +32,7 @@ class ObstacleLinks(ObjectiveTerm):
         self.k_obstacle = point_gains("k_obstacle", k_obstacle)
 
 
-@njit(cache=True)
+@njit
 def obstacle_links(
     penalty: Array,
     penalty_gradient: Array,

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from numba import njit
 from numpy.typing import ArrayLike
 
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.objective.term import Array, ObjectiveTerm, point_gains, pull_points
+from solvers.jit import njit
 
 
 class ObstaclePoints(ObjectiveTerm):
@@ -31,7 +31,7 @@ class ObstaclePoints(ObjectiveTerm):
         self.k_obstacle = point_gains("k_obstacle", k_obstacle)
 
 
-@njit(cache=True)
+@njit
 def obstacle_points(penalty: Array, penalty_gradient: Array, coef: Array, jacobians: Array,
                     at_points: Array, value: Array, gradient: Array) -> None:  # fmt: skip
     """Add ``Σ_j Σ_i ½ c_ji e_ji`` over the body points inside obstacle j (``e < 0``) to

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike
 
 from dvqp.errors import ParameterError
 from dvqp.objective.term import Array, ObjectiveTerm, point_gains
+from solvers.jit import njit
 
 
 class OrbitalLevel(ObjectiveTerm):
@@ -30,7 +30,7 @@ class OrbitalLevel(ObjectiveTerm):
         self.k_height = point_gains("k_height", k_height)
 
 
-@njit(cache=True)
+@njit
 def orbital_level(guarded: Array, jacobians: Array, level: float, k_height: Array,
                   value: Array, gradient: Array) -> None:  # fmt: skip
     """Add ``−Σ_i ½ k²_i (h_i − h*)²`` to ``value`` (1,) and ``−Σ_i k²_i (h_i − h*) ∂h_i/∂Q``

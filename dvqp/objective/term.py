@@ -12,13 +12,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.kinematics.state import KinematicState
 from dvqp.workspace import Kernel, StepPlan
+from solvers.jit import njit
 
 Array = NDArray[np.float64]
 
@@ -71,7 +71,7 @@ def per_point(name: str, gains: Array, k: int) -> Array:
     return _validate.broadcast(name, gains, k)
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def pull_points(at_points: Array, jacobians: Array, gradient: Array) -> None:
     """``gradient −= Σ_i at_points[i] · ∂[l, z]_i/∂Q`` over the k body points
     (``at_points`` (k, 2), ``jacobians`` the guarded points' (k+1, 3, n))."""

@@ -17,12 +17,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
 from dvqp import _validate
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
+from solvers.jit import njit
 
 Array = NDArray[np.float64]
 
@@ -54,7 +54,7 @@ class PseudoinverseResolver(Resolver):
         self.damping = _validate.positive("damping", damping, strict=False)
 
 
-@njit(cache=True)
+@njit
 def _cholesky(a: Array, info: Array) -> bool:
     """``a = L Lᵀ`` in place (lower), pivots' smallest and largest squares into ``info``;
     False if ``a`` is not positive definite."""
@@ -78,7 +78,7 @@ def _cholesky(a: Array, info: Array) -> bool:
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _solve(factor: Array, x: Array) -> None:
     """``x = (L Lᵀ)⁻¹ x`` in place, ``factor`` from :func:`_cholesky`."""
     m = factor.shape[0]
@@ -94,7 +94,7 @@ def _solve(factor: Array, x: Array) -> None:
         x[r] = v / factor[r, r]
 
 
-@njit(cache=True)
+@njit
 def pinv_step(A, b, cost, weights, P, dense, damping, info, out) -> int:  # type: ignore[no-untyped-def]
     """``out = M⁻¹g + M⁻¹Aᵀ (A M⁻¹ Aᵀ + μ² I)⁻¹ (b − A M⁻¹ g)`` with ``g = −cost`` and
     ``M = diag(weights)``, or the dense ``P`` if ``dense``. Returns −1, :data:`SINGULAR` (the

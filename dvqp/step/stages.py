@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
 from dvqp.geometry.measure import measure_chain, penalties
 from dvqp.geometry.real_links import real_links
 from dvqp.kinematics.model import kinematics
@@ -31,6 +29,7 @@ from dvqp.objective.obstacle_points import obstacle_points
 from dvqp.objective.orbital_level import orbital_level
 from dvqp.resolution.pinv import NOT_DEFINITE, pinv_step
 from dvqp.tasks.tool_dv import tool_rows
+from solvers.jit import njit
 
 MEASURE, ASSESS, CONCLUDE = 0, 1, 2
 """Stages of :func:`evaluate`."""
@@ -41,7 +40,7 @@ SINGULAR_TASK, INDEFINITE_METRIC, BAD_COMMAND = -2, -3, -4
 is not finite."""
 
 
-@njit(cache=True)
+@njit
 def evaluate(s, integrate, first, last) -> int:  # type: ignore[no-untyped-def]
     """Evaluate the state at ``s.state.q`` (first ``q += dt·x`` if ``integrate``), stages
     ``first`` to ``last``; returns −1, or the index of a singular guarded frame."""
@@ -63,7 +62,7 @@ def evaluate(s, integrate, first, last) -> int:  # type: ignore[no-untyped-def]
     return -1
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _integrate(s) -> None:  # type: ignore[no-untyped-def]
     """``s.motion = [‖A x − b‖∞, max |dt x|]`` and ``q += dt x``."""
     A, b, x, q, dt = s.qp.A, s.qp.b, s.x, s.state.q, s.dt[0]
@@ -81,7 +80,7 @@ def _integrate(s) -> None:  # type: ignore[no-untyped-def]
     s.motion[0], s.motion[1] = error, largest
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _objective(s) -> None:  # type: ignore[no-untyped-def]
     """``w`` and ``∂w/∂Q`` of dvqp's terms (a user's are added after)."""
     o, st, near = s.objective, s.state, s.near
@@ -97,7 +96,7 @@ def _objective(s) -> None:  # type: ignore[no-untyped-def]
                    st.guarded_jacobians, o.scratch, o.value, o.gradient)  # fmt: skip
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _distances(s) -> None:  # type: ignore[no-untyped-def]
     """The distances of dvqp's dampers, each into its rows."""
     m, st, d = s.measures, s.state, s.dampers
@@ -117,7 +116,7 @@ def _distances(s) -> None:  # type: ignore[no-untyped-def]
         self_distances(s.pairs, st.frame_jacobians, m.selves[i], *out)
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _conclude(s) -> None:  # type: ignore[no-untyped-def]
     """The verified values and their worst excess, the diagnostics, the sample."""
     c, st = s.checks, s.state
@@ -131,7 +130,7 @@ def _conclude(s) -> None:  # type: ignore[no-untyped-def]
         _sample(s)
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _diagnostics(s) -> None:  # type: ignore[no-untyped-def]
     """``[tilt, self distance, min clearance, probe clearance, closest part, lowest link
     chord, lowest holder point]`` (rad, m, m, m, index ``r (m + L) + i`` of recorded obstacle
@@ -153,7 +152,7 @@ def _diagnostics(s) -> None:  # type: ignore[no-untyped-def]
         out[3] = min(out[3], near.point_distance[j, k], near.real_distance[j, k - 1])
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _sample(s) -> None:  # type: ignore[no-untyped-def]
     """Row ``s.record.index[0]`` of the trajectory's samples, and each verified value's lowest
     over the samples."""
@@ -182,7 +181,7 @@ def _sample(s) -> None:  # type: ignore[no-untyped-def]
         c.lowest[i] = c.values[i] if c.values[i] < c.settled[i] else c.settled[i]
 
 
-@njit(cache=True)
+@njit
 def prepare(s, first, last) -> int:  # type: ignore[no-untyped-def]
     """Write this step's QP (stage ``ROWS``: the tasks' rows, the cost, the bounds reset and
     every box intersected, the damper rows) and close it (``CLOSE``): returns −1, the first
@@ -206,7 +205,7 @@ def prepare(s, first, last) -> int:  # type: ignore[no-untyped-def]
     return -1
 
 
-@njit(cache=True)
+@njit
 def prepare_baseline(s, first, last) -> int:  # type: ignore[no-untyped-def]
     """:func:`prepare` for the baseline (its own function: neither compiles the other's code),
     its step in ``s.pinv.x``: −1, :data:`SINGULAR_TASK`, :data:`INDEFINITE_METRIC` or
@@ -222,7 +221,7 @@ def prepare_baseline(s, first, last) -> int:  # type: ignore[no-untyped-def]
     return -1
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _rows(s) -> bool:  # type: ignore[no-untyped-def]
     """The tasks' rows, the metric and the cost; False if the command is not finite."""
     qp, p = s.qp, s.pinv

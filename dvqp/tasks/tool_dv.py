@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
 from dvqp.tasks.task import Task
+from solvers.jit import njit
 
 
 class ToolTask(Task):
@@ -23,7 +23,7 @@ class ToolTask(Task):
         return "ToolTask()"
 
 
-@njit(cache=True)
+@njit
 def tool_rows(tool_jacobian: NDArray[np.float64], command: NDArray[np.float64],
               A: NDArray[np.float64], b: NDArray[np.float64], start: int) -> None:  # fmt: skip
     """Rows ``start .. start + 3`` of ``A``, ``b``: ``J̄`` (4, n) and the command (4,)."""

@@ -20,10 +20,12 @@ from typing import Any
 
 import numba
 import numpy as np
-from numba import njit, types
+from numba import types
 from numba.core.extending import intrinsic
 from numba.experimental import structref
 from numba.experimental.structref import _Utils
+
+from solvers.jit import njit
 
 
 @structref.register
@@ -70,7 +72,7 @@ def _fill(typingctx, struct, values):  # type: ignore[no-untyped-def]
     return types.none(struct, values), codegen
 
 
-@njit(cache=True)
+@njit
 def _make(struct_type, values):  # type: ignore[no-untyped-def]
     instance = structref.new(struct_type)
     _fill(instance, values)

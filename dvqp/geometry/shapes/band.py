@@ -6,11 +6,11 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
-from numba import njit
 
 from dvqp import _validate
 from dvqp.errors import ParameterError
 from dvqp.geometry.shapes.shape import Array, Shape
+from solvers.jit import njit
 
 _FLAT = 1e-15
 """m: a link whose ends differ less in z is parallel to the band."""
@@ -68,14 +68,14 @@ class Band(Shape):
         return np.array([[np.nan, self.z_min], [np.nan, self.z_max]])
 
 
-@njit(cache=True)
+@njit
 def band_point(z_min: float, z_max: float, z: float) -> tuple[float, float]:
     """``max(z_min − z, z − z_max)`` (m) and ``∂d/∂z`` (∓1)."""
     below, above = z_min - z, z - z_max
     return max(below, above), -1.0 if below >= above else 1.0
 
 
-@njit(cache=True)
+@njit
 def band_segment(z_min: float, z_max: float, za: float, zb: float) -> tuple[float, float, float]:
     """``(d, t, ∂d/∂z)`` of a segment from z ``za`` to ``zb``. The distance is convex and
     piecewise linear along it: its minimum is at an end or where the segment crosses the band's

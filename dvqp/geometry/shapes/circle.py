@@ -7,12 +7,12 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
 from dvqp import _validate
 from dvqp.geometry.shapes.shape import Array, Shape
 from dvqp.kinematics.developed_view import wrap_period
+from solvers.jit import njit
 
 _TINY = 1e-12
 """m: a point closer than this to the centre has no normal (0)."""
@@ -69,7 +69,7 @@ class Circle(Shape):
         return self.center + self.radius * np.column_stack([np.cos(a), np.sin(a)])
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _from_offset(sl: float, sz: float, radius: float) -> tuple[float, float, float]:
     """``‖s‖ − R`` and the normal ``−s/‖s‖`` (0 at the centre) from the offset ``s = S − p``."""
     dist = math.sqrt(sl * sl + sz * sz)
@@ -78,13 +78,13 @@ def _from_offset(sl: float, sz: float, radius: float) -> tuple[float, float, flo
     return dist - radius, 0.0, 0.0
 
 
-@njit(cache=True)
+@njit
 def circle_point(cl, cz, radius, pl, pz, period):  # type: ignore[no-untyped-def]
     """``(d, ∂d/∂l, ∂d/∂z)`` of the point ``(pl, pz)`` to the circle at ``(cl, cz)``, m."""
     return _from_offset(wrap_period(cl - pl, period), cz - pz, radius)
 
 
-@njit(cache=True)
+@njit
 def circle_segment(cl, cz, radius, al, az, bl, bz, period):  # type: ignore[no-untyped-def]
     """``(d, t, ∂d/∂l, ∂d/∂z)`` of a segment: its closest point to the centre is
     ``p̄ = a + t (b − a)``, ``t = clip((S − a)·(b − a)/‖b − a‖², 0, 1)`` (exact)."""

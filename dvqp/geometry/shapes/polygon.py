@@ -12,12 +12,12 @@ from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
-from numba import njit
 
 from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry.shapes import polygon_geometry as geo
 from dvqp.geometry.shapes.shape import Array, Shape
+from solvers.jit import njit
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,7 +105,7 @@ GOLDEN_STEPS = 40
 INV_PHI = (math.sqrt(5.0) - 1.0) / 2.0
 
 
-@njit(cache=True)
+@njit
 def polygon_point(pl: float, pz: float, vl: Array, vz: Array) -> tuple[float, float, float]:
     """``(d, ∂d/∂l, ∂d/∂z)`` of one point (local l) to the polygon of vertices ``vl, vz``
     (local, (V,) each): the distance to the nearest edge, negative inside (even-odd rule)."""
@@ -139,7 +139,7 @@ def polygon_point(pl: float, pz: float, vl: Array, vz: Array) -> tuple[float, fl
     return 0.0, turn * ez / norm, -turn * el / norm
 
 
-@njit(cache=True)
+@njit
 def _crosses(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array) -> bool:
     n = vl.shape[0]
     for i in range(n):
@@ -153,7 +153,7 @@ def _crosses(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array) -
     return False
 
 
-@njit(cache=True)
+@njit
 def _outside(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array):  # type: ignore[no-untyped-def]
     """A segment that does not cross the outline: closest at an end, or at its point nearest
     a vertex (two segments that do not cross are closest at an endpoint of one of them)."""
@@ -174,7 +174,7 @@ def _outside(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array): 
     return d, t, nl, nz
 
 
-@njit(cache=True)
+@njit
 def _deepest(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array):  # type: ignore[no-untyped-def]
     """A segment that enters: the smallest signed distance along it, by sampling then a
     golden-section search between the best sample's neighbours."""
@@ -206,7 +206,7 @@ def _deepest(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array): 
     return d, t, nl, nz
 
 
-@njit(cache=True)
+@njit
 def polygon_segment(al: float, az: float, bl: float, bz: float, vl: Array, vz: Array):  # type: ignore[no-untyped-def]
     """``(d, t, ∂d/∂l, ∂d/∂z)`` of one segment: exact for a segment outside; for one that
     enters, the deepest point to the golden-section search's precision (1e-9 of its length)."""

@@ -1,0 +1,251 @@
+"""Every compiled function of ``solvers`` and ``dvqp``, with an on-disk cache that fails soft.
+
+:func:`njit` is numba's ``njit`` with ``cache=True``; :func:`compiled_on_first_call` the same
+for one declared signature, compiled at the first call. Their cache, :class:`SoftCache`, is
+numba's own (same folders, same index and data files) with three changes:
+
+- an entry that cannot be loaded (an index or data file cut short, garbled, empty, missing,
+  unreadable, of another kind; a data file numba cannot rebuild) is deleted and its function
+  compiled anew, with one line on stderr: ``dvqp: note: compile cache entry <file> could not
+  be read (<reason>): discarded, recompiling``. The next run finds the fresh entry.
+- an entry that cannot be saved (a full disk) leaves its function compiled for this process
+  only, with one note a process; a function that has no folder to cache in is not cached.
+- each data file holds the SHA-256 of its contents: machine code cut short or overwritten
+  (numba writes by renaming a complete file, but a crash before the disk is flushed can leave
+  zeros) is refused before it is loaded, never run. Its index is marked with this format, so
+  that numba's plain entries are those of "another version", ignored and overwritten.
+
+:data:`CACHES` lists the caches made, for :func:`entry_files` (``dvqp cache``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import inspect
+import os
+import pickle
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numba
+from numba.core.caching import FunctionCache, IndexDataCacheFile, NullCache
+from numba.core.dispatcher import Dispatcher
+from numba.core.typing.templates import Signature
+
+_MAGIC = b"dvqp-sha256\n"
+_DIGEST = 32
+_FORMAT = "+dvqp-sha256"  # appended to the numba version written at the head of an index
+_ENTRY_SUFFIXES = (".nbi", ".nbc")
+
+CACHES: list[SoftCache] = []
+"""Every cache made by :func:`njit`, in order."""
+
+
+_NOTED: set[str] = set()  # the notes given once a process
+
+
+def note(text: str, once: str = "") -> None:
+    """``dvqp: note: <text>``, one line on stderr (only the first time for a given ``once``)."""
+    if once:
+        if once in _NOTED:
+            return
+        _NOTED.add(once)
+    print(f"dvqp: note: {text}", file=sys.stderr, flush=True)
+
+
+class EntryError(Exception):
+    """A data file that is not a whole entry written by :class:`SoftCache`."""
+
+
+def _reason(exc: BaseException) -> str:
+    """A short reason: ``No such file or directory``, ``UnpicklingError: pickle data was
+    truncated``, ``checksum mismatch``."""
+    if isinstance(exc, OSError) and exc.strerror:
+        return exc.strerror
+    if isinstance(exc, EntryError):
+        return str(exc)
+    text = str(exc).splitlines()[0][:100] if str(exc) else ""
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+class _EntryFiles(IndexDataCacheFile):
+    """numba's index and data files of one function, checksummed; an unreadable one is deleted."""
+
+    def __init__(self, cache_path: str, filename_base: str, source_stamp: Any) -> None:
+        super().__init__(cache_path, filename_base, source_stamp)
+        self._version = numba.__version__ + _FORMAT
+
+    def entry(self, key: Any) -> tuple[str, Any] | None:
+        """``(data file, its unpickled contents)`` of ``key``, or None if there is none (or it
+        could not be read: then it is discarded)."""
+        try:
+            name = self._load_index().get(key)
+        except Exception as exc:  # cut short, garbled, unreadable: any error means unusable
+            self.discard(self._index_path, exc)
+            return None
+        if name is None:
+            return None
+        path = self._data_path(name)
+        try:
+            return path, self._load_data(name)
+        except Exception as exc:
+            self.discard(path, exc)
+            return None
+
+    def discard(self, path: str, exc: BaseException) -> None:
+        """Delete ``path`` (if it can be) and say so."""
+        with contextlib.suppress(OSError):
+            os.unlink(path)
+        note(f"compile cache entry {path} could not be read ({_reason(exc)}): "
+             "discarded, recompiling")  # fmt: skip
+
+    def _load_data(self, name: str) -> Any:
+        with open(self._data_path(name), "rb") as fh:
+            raw = fh.read()
+        if not raw:
+            raise EntryError("empty file")
+        if raw[: len(_MAGIC)] != _MAGIC:
+            raise EntryError("not a checksummed entry")
+        digest, payload = raw[len(_MAGIC) :][:_DIGEST], raw[len(_MAGIC) + _DIGEST :]
+        if hashlib.sha256(payload).digest() != digest:
+            raise EntryError("checksum mismatch: cut short or overwritten")
+        return pickle.loads(payload)
+
+    def _save_data(self, name: str, data: Any) -> None:
+        payload = self._dump(data)
+        with self._open_for_write(self._data_path(name)) as fh:
+            fh.write(_MAGIC + hashlib.sha256(payload).digest() + payload)
+
+
+class SoftCache(FunctionCache):
+    """numba's ``FunctionCache`` of ``py_func`` whose entries fail soft (see the module)."""
+
+    def __init__(self, py_func: Callable[..., Any]) -> None:
+        super().__init__(py_func)
+        self.source = inspect.getfile(py_func)
+        self._cache_file = _EntryFiles(
+            self._cache_path, self._impl.filename_base, self._impl.locator.get_source_stamp()
+        )
+
+    def _load_overload(self, sig: Any, target_context: Any) -> Any:
+        if not self._enabled:
+            return None
+        found = self._cache_file.entry(self._index_key(sig, target_context.codegen()))
+        if found is None:
+            return None
+        try:
+            return self._impl.rebuild(target_context, found[1])
+        except Exception as exc:  # unpickled, but not a compiled function numba can load
+            self._cache_file.discard(found[0], exc)
+            return None
+
+    def save_overload(self, sig: Any, data: Any) -> None:
+        try:
+            super().save_overload(sig, data)
+        except Exception as exc:  # a full disk: compiled all the same, not cached
+            note(f"compile cache not written ({self._cache_path}: {_reason(exc)}): "
+                 "compiled code is not cached", once="unsaved")  # fmt: skip
+
+
+def _cache_for(function: Callable[..., Any]) -> SoftCache | NullCache:
+    """The soft cache of ``function``, or no cache if no folder can hold it."""
+    try:
+        cache = SoftCache(function)
+    except (RuntimeError, OSError) as exc:  # no writable folder: numba itself would refuse
+        note(f"no compile cache ({exc}): compiled code is not cached", once="uncached")
+        return NullCache()
+    CACHES.append(cache)
+    return cache
+
+
+def njit(function: Callable[..., Any] | None = None, **options: Any) -> Any:
+    """``numba.njit(cache=True, **options)``, its cache a :class:`SoftCache`.
+
+    Use as ``@njit`` or ``@njit(inline="always")``; compiles at the first call, as numba's.
+    """
+    if "cache" in options:
+        raise TypeError("njit: always cached, no 'cache' option")
+
+    def decorate(f: Callable[..., Any]) -> Dispatcher:
+        dispatcher = numba.njit(**options)(f)
+        dispatcher._cache = _cache_for(f)  # what numba's enable_caching() sets, soft
+        return dispatcher
+
+    return decorate if function is None else decorate(function)
+
+
+def entry_files(roots: list[Path]) -> dict[Path, list[Path]]:
+    """Cache folder -> its entry files (index, data and leftover temporary files) of the
+    modules under ``roots`` that made a cache here; other files are never listed."""
+    stems: dict[Path, set[str]] = {}
+    for cache in CACHES:
+        source = Path(cache.source).resolve()
+        if any(source.is_relative_to(root.resolve()) for root in roots):
+            stems.setdefault(Path(cache.cache_path), set()).add(source.stem)
+    found = {}
+    for folder, names in sorted(stems.items()):
+        files = sorted(folder.iterdir()) if folder.is_dir() else []
+        found[folder] = [
+            p for p in files
+            if p.is_file() and p.name.split(".")[0] in names
+            and any(p.name.endswith(s) or f"{s}.tmp." in p.name for s in _ENTRY_SUFFIXES)
+        ]  # fmt: skip
+    return found
+
+
+def compiled_on_first_call(
+    signature: Signature, **options: Any
+) -> Callable[[Callable[..., Any]], Dispatcher]:
+    """``njit(signature, cache=True, **options)``, compiled at the first call, not at import.
+
+    ``njit`` given a signature compiles it (or loads it from numba's on-disk cache) when the
+    module is imported: seconds of CPU with an empty cache, in every process that imports
+    ``solvers``, whether it solves anything or not. A plain lazy ``njit`` would instead compile
+    one specialisation per distinct argument types, and writable and read-only arrays are
+    distinct types: twice the compile time for a kernel called with both.
+
+    The dispatcher returned compiles nothing until it is called. Its first call compiles
+    ``signature`` alone (or loads it from the cache) and then disables compilation, as
+    ``njit(signature)`` does at import: from then on, that first call included, arguments
+    are converted to the signature (a writable array passes as a read-only one) or refused
+    with ``TypeError``, and there is one specialisation, however the function is called.
+
+    Parameters
+    ----------
+    signature : numba Signature
+        The one signature to compile, e.g. ``types.boolean(types.float64[::1])``.
+    **options
+        Further ``njit`` options (e.g. ``fastmath``); the cache is always a :class:`SoftCache`.
+
+    Returns
+    -------
+    callable
+        A decorator turning a function into its numba dispatcher.
+
+    Notes
+    -----
+    The hook is the dispatcher's ``_compile_for_args``, which numba calls only when no compiled
+    overload fits the arguments and compilation is enabled, i.e. only until the first call
+    has compiled. Replacing it returns the dispatcher itself, which numba then calls again with
+    the same arguments: now a typed call of the one overload. Concurrent first calls are safe
+    (the second ``compile`` finds the overload the first one made). Meant for functions called
+    from Python: numba's typing of a call from other jitted code would compile the callee for
+    the caller's argument types instead. ``tests/test_solvers_structure.py`` checks, in a fresh
+    interpreter, that importing compiles nothing and that each kernel ends with one overload.
+    """
+
+    def decorate(function: Callable[..., Any]) -> Dispatcher:
+        dispatcher: Dispatcher = njit(**options)(function)
+
+        def compile_declared(*args: Any, **kwargs: Any) -> Dispatcher:
+            dispatcher.compile(signature)
+            dispatcher.disable_compile()
+            return dispatcher
+
+        dispatcher._compile_for_args = compile_declared
+        return dispatcher
+
+    return decorate
