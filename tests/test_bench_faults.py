@@ -122,7 +122,7 @@ def test_a_scene_that_kills_its_worker_again_is_reported_lost(tmp_path: Path) ->
     assert lost == [(2, "pinv"), (2, "daqp")]
     assert all(r["steps"] > 0 for r in doc["results"] if r["index"] != 2)
     assert doc["summary"]["pinv"]["lost"] == doc["summary"]["daqp"]["lost"] == 1
-    assert "lost            1 scene (worker lost or timed out: no figures): bench-s3-0002" in printed
+    assert "1 scene (worker lost or timed out: no figures): bench-s3-0002" in printed
 
 
 def interrupt(proc: subprocess.Popen[str], partial: Path) -> tuple[float, str, list[dict]]:
