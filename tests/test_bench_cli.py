@@ -99,6 +99,8 @@ def test_bench_prints_a_summary_and_writes_json_csv_and_scene_files(
         (["--count", "two"], "dvqp: --count: must be an integer >= 1, got 'two'"),
         (["--workers", "0"], "dvqp: --workers: must be an integer >= 1"),
         (["--seed", "-3"], "dvqp: --seed: must be an integer >= 0"),
+        (["--scene-timeout", "0"], "dvqp: --scene-timeout: must be a number of seconds > 0"),
+        (["--scene-timeout", "nan"], "dvqp: --scene-timeout: must be a number of seconds > 0"),
         (["--json", "{tmp}/no/such/a.json"], "dvqp: output: "),
         (["--csv", "{tmp}/a.txt"], "dvqp: output: "),
         (["--save-scenes", "{tmp}/file.txt"], "dvqp: --save-scenes: "),

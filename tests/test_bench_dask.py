@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import time
+
 import pytest
 
 pytest.importorskip("dask.distributed")
 
-from dvqp.bench import generate_scenes, outcome_differences, run_suite
+from dvqp.bench import dask_run, generate_scenes, outcome_differences, run_suite
 
 BACKENDS = ("pinv", "daqp", "osqp")
 
@@ -29,3 +31,23 @@ def test_a_local_cluster_gives_the_same_outcomes_as_a_local_run() -> None:
         mine, theirs = local.summary[backend], on_dask.summary[backend]
         for key in ("succeeded", "failed_steps", "relaxed_steps", "worst_task_error"):
             assert mine[key] == theirs[key]
+
+
+def test_a_scene_running_past_the_timeout_is_given_up_and_reported(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    real = dask_run.run_job
+
+    def slow(job: dask_run.Job) -> list:
+        if job.index == 1:
+            time.sleep(4.0)  # a worker thread cannot be stopped: it ends on its own
+        return real(job)
+
+    monkeypatch.setattr(dask_run, "run_job", slow)  # the cluster's threads run it
+    scenes = generate_scenes(11, 3)
+    suite = run_suite(scenes, ["pinv"], seed=11, scheduler="local", workers=2, scene_timeout=1.5)
+    assert [(r["index"], r["error"]) for r in suite.rows if r["steps"] is None] == [
+        (1, "timed out after 1.5 s")
+    ]
+    assert [r["index"] for r in suite.rows] == [0, 1, 2] and not suite.interrupted
+    assert suite.summary["pinv"]["lost"] == suite.summary["pinv"]["raised"] == 1

@@ -8,7 +8,7 @@ backend, :mod:`~dvqp.bench.execution` (here) or :mod:`~dvqp.bench.dask_run` runs
 
 from dvqp.bench.dask_run import DaskUnavailableError, import_distributed
 from dvqp.bench.generate import BenchScene, generate_scene, generate_scenes, save_scenes
-from dvqp.bench.output import Suite, bench_json, format_summary, rows_to_csv
+from dvqp.bench.output import PartialFile, Suite, bench_json, format_summary, rows_to_csv
 from dvqp.bench.runner import Job, run_job
 from dvqp.bench.suite import BenchInterrupted, make_suite, run_suite
 from dvqp.bench.summary import (
@@ -20,8 +20,8 @@ from dvqp.bench.summary import (
 )
 
 __all__ = [
-    "SHIFT_US", "BenchInterrupted", "BenchScene", "DaskUnavailableError", "Job", "Suite",
-    "bench_json", "format_summary", "generate_scene", "generate_scenes", "import_distributed",
-    "make_suite", "outcome_differences", "qp_disagreement", "rows_to_csv", "run_job", "run_suite",
-    "save_scenes", "shifted_geometric_mean", "summarize_backends",
+    "SHIFT_US", "BenchInterrupted", "BenchScene", "DaskUnavailableError", "Job", "PartialFile",
+    "Suite", "bench_json", "format_summary", "generate_scene", "generate_scenes",
+    "import_distributed", "make_suite", "outcome_differences", "qp_disagreement", "rows_to_csv",
+    "run_job", "run_suite", "save_scenes", "shifted_geometric_mean", "summarize_backends",
 ]  # fmt: skip

@@ -1,5 +1,11 @@
 """Run bench jobs on a Dask distributed cluster: an existing scheduler or a LocalCluster.
 
+A scene whose worker dies is run again by the scheduler on another worker (and once more if it
+raised: ``retries=1``); one that killed its workers too often (Dask's ``allowed-failures``) is
+reported as ``worker lost``, one that runs longer than the scene timeout as ``timed out``.
+When no worker is left for :data:`WORKER_WAIT` seconds the suite stops
+(:class:`WorkersLostError`) instead of waiting for ever.
+
 Dask is optional (``pip install 'dvqp[dask]'``): it is imported only by
 :func:`import_distributed`, when a cluster is asked for. The workers run
 :func:`dvqp.bench.runner.run_job` on the scene text, so they need dvqp (and the named
@@ -10,16 +16,30 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import time
 from collections.abc import Iterator, Sequence
 from types import ModuleType
 from typing import Any
 
 from dvqp.bench.execution import OnRows, Progress, Where
-from dvqp.bench.runner import Job, run_job
+from dvqp.bench.runner import Job, Row, lost_rows, run_job
 from dvqp.errors import DvqpError, one_line
 
 CONNECT_TIMEOUT = "10s"
 """How long to wait for an existing scheduler."""
+WORKER_WAIT = 10.0
+"""How long to wait for a worker, s: at the start, and when every worker has left."""
+SCENE_TIMEOUT = 600.0
+"""How long a scene may run on a worker by default, s (all its backends)."""
+POLL = 0.5
+"""How often the scheduler is asked what runs where, s."""
+
+
+class WorkersLostError(DvqpError):
+    """Every worker left the cluster during a suite; ``suite`` (set by
+    :func:`~dvqp.bench.suite.run_suite`) holds the scenes finished before."""
+
+    suite: Any = None
 
 
 class DaskUnavailableError(DvqpError, ImportError):
@@ -62,7 +82,7 @@ def dask_client(scheduler: str, workers: int = 1) -> Iterator[tuple[Any, Where]]
     DaskUnavailableError
         Dask is not installed.
     DvqpError
-        ``scheduler <address>: cannot connect: <reason>``, or ``… no worker within 10s``.
+        ``scheduler <address>: cannot connect: <reason>``, or ``… no worker within 10 s``.
     """
     dd = import_distributed()
     logger = logging.getLogger("distributed")
@@ -82,39 +102,87 @@ def dask_client(scheduler: str, workers: int = 1) -> Iterator[tuple[Any, Where]]
             reason = one_line(str(exc) or type(exc).__name__)
             raise DvqpError(f"scheduler {scheduler}: cannot connect: {reason}") from exc
         try:
-            client.wait_for_workers(1, timeout=CONNECT_TIMEOUT)
+            client.wait_for_workers(1, timeout=WORKER_WAIT)
         except (OSError, TimeoutError) as exc:
-            raise DvqpError(f"scheduler {scheduler}: no worker within {CONNECT_TIMEOUT}") from exc
+            raise DvqpError(f"scheduler {scheduler}: no worker within {WORKER_WAIT:g} s") from exc
         threads = int(sum(client.nthreads().values()))
         yield client, Where("dask", threads, scheduler)
 
 
 def run_dask(
-    client: Any, jobs: Sequence[Job], on_rows: OnRows, progress: Progress | None = None
+    client: Any,
+    jobs: Sequence[Job],
+    on_rows: OnRows,
+    progress: Progress | None = None,
+    timeout: float = SCENE_TIMEOUT,
 ) -> None:
     """Run every job on the cluster of ``client``, handing each scene's rows to ``on_rows``.
 
-    Ctrl-C (KeyboardInterrupt) cancels what has not finished and propagates. A job that fails
-    on a worker for another reason than a failed run (e.g. dvqp missing there) raises
-    ``DvqpError("dask: <scene>: <error>")``.
+    A scene running longer than ``timeout`` s (from when a worker took it) is cancelled and
+    gets :func:`~dvqp.bench.runner.lost_rows` ``timed out after <timeout> s``; one whose
+    workers died too often (``KilledWorker``) ``worker lost``. Ctrl-C (KeyboardInterrupt)
+    cancels what has not finished and propagates. A job that fails on a worker for another
+    reason than a failed run (e.g. dvqp missing there) raises ``DvqpError("dask: <scene>:
+    <error>")``; no worker left for :data:`WORKER_WAIT` s raises :class:`WorkersLostError`.
     """
     dd = import_distributed()
     total, done = sum(len(job.backends) for job in jobs), 0
-    futures = {client.submit(run_job, job, pure=False): job for job in jobs}
+    futures = {client.submit(run_job, job, pure=False, retries=1): job for job in jobs}
+    remaining, watch = dict(futures), _Watch(client, timeout)
     try:
-        for future in dd.as_completed(list(futures)):
-            job = futures[future]
+        while remaining:
             try:
-                rows = future.result()
-            except DvqpError:
-                raise
-            except Exception as exc:
-                reason = f"{type(exc).__name__}: {one_line(str(exc))}"
-                raise DvqpError(f"dask: {job.name}: {reason}") from exc
-            on_rows(rows)
-            done += len(job.backends)
-            if progress is not None:
-                progress(done, total, job.name)
+                finished = dd.wait(list(remaining), POLL, return_when="FIRST_COMPLETED").done
+            except TimeoutError:
+                finished = set()
+            late = [f for f in watch.overdue(remaining) if f not in finished]
+            client.cancel(late)
+            for future in [*finished, *late]:
+                job = remaining.pop(future)
+                on_rows(_rows(dd, future, job) if future in finished else lost_rows(
+                    job, f"timed out after {timeout:g} s"))  # fmt: skip
+                done += len(job.backends)
+                if progress is not None:
+                    progress(done, total, job.name)
     except BaseException:
         client.cancel(list(futures))
         raise
+
+
+def _rows(dd: ModuleType, future: Any, job: Job) -> list[Row]:
+    """The rows of a finished job: its result, or ``worker lost`` if its workers died."""
+    try:
+        return future.result()
+    except DvqpError:
+        raise
+    except dd.KilledWorker:
+        return lost_rows(job)
+    except Exception as exc:
+        reason = f"{type(exc).__name__}: {one_line(str(exc))}"
+        raise DvqpError(f"dask: {job.name}: {reason}") from exc
+
+
+class _Watch:
+    """What the scheduler runs: when each job began on a worker (first seen), and since when
+    no worker is left."""
+
+    def __init__(self, client: Any, timeout: float) -> None:
+        self.client, self.timeout = client, timeout
+        self.started: dict[str, float] = {}
+        self.alone: float | None = None  # since when no worker is left
+
+    def overdue(self, futures: dict[Any, Job]) -> list[Any]:
+        """The futures running longer than the timeout; :class:`WorkersLostError` when no
+        worker has been left for :data:`WORKER_WAIT` s."""
+        now, processing = time.monotonic(), self.client.processing()
+        if processing:
+            self.alone = None
+        elif self.alone is None:
+            self.alone = now
+        elif now - self.alone > WORKER_WAIT:
+            left = sum(1 for f in futures if f.status == "pending")
+            raise WorkersLostError(f"no worker left for {WORKER_WAIT:g} s; {left} scenes not run")
+        for keys in processing.values():
+            for key in keys:
+                self.started.setdefault(str(key), now)
+        return [f for f in futures if now - self.started.get(str(f.key), now) > self.timeout]

@@ -1,17 +1,21 @@
 """Run bench jobs in this process or a local process pool (``concurrent.futures``).
 
 Rows are handed to ``on_rows`` scene by scene as they finish, so a caller interrupted by
-Ctrl-C still holds every finished scene. Where the runs went is described by :class:`Where`,
-which the results carry: timings of workers that ran side by side are marked ``parallel``.
+Ctrl-C still holds every finished scene. A pool worker that dies (killed by the OOM killer, say)
+costs only its own scene: the pool is rebuilt, and the scenes that were running when it died are
+run again, each alone; one that kills its worker again is reported as ``worker lost``. Where the
+runs went is described by :class:`Where`, which the results carry: timings of workers that ran
+side by side are marked ``parallel``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass
 
-from dvqp.bench.runner import Job, Row, run_job
+from dvqp.bench.runner import Job, Row, lost_rows, run_job
 from dvqp.comparison import quiet_worker
 
 Progress = Callable[[int, int, str], None]
@@ -58,8 +62,11 @@ def run_local(
 ) -> None:
     """Run every job, in this process (``workers`` 1) or in a pool of ``workers`` processes.
 
-    Ctrl-C (KeyboardInterrupt) stops the pool without waiting for it and propagates; the
-    rows of the scenes finished before it have been handed to ``on_rows``.
+    The pool runs one scene per process at a time. When a process dies, the pool is rebuilt;
+    the scenes it was running are run again, one at a time, and a scene whose process dies
+    then too gets :func:`~dvqp.bench.runner.lost_rows` (``worker lost``). Ctrl-C
+    (KeyboardInterrupt) kills the pool's processes at once and propagates; the rows of the
+    scenes finished before it have been handed to ``on_rows``.
     """
     total, done = sum(len(job.backends) for job in jobs), 0
 
@@ -69,17 +76,61 @@ def run_local(
         if progress is not None:
             progress(done, total, label)
 
+    def finished(job: Job, rows: list[Row]) -> None:
+        on_rows(rows)
+        tick(len(rows), job.name)
+
     if local_where(jobs, workers).workers == 1:
         for job in jobs:
             on_rows(run_job(job, lambda backend, j=job: tick(1, f"{j.name} {backend}")))
         return
+    rest = list(jobs)
+    while rest:
+        suspects, rest = _pool_round(rest, workers, finished)
+        for job in suspects:  # alone, so that a death now is its own
+            if _pool_round([job], 1, finished)[0]:
+                finished(job, lost_rows(job))
+
+
+def _pool_round(
+    jobs: Sequence[Job], workers: int, finished: Callable[[Job, list[Row]], None]
+) -> tuple[list[Job], list[Job]]:
+    """Run ``jobs`` in a new pool of ``workers`` processes, one job per process at a time,
+    handing each finished one to ``finished``, until they are done or a process dies.
+
+    Returns the jobs that were running when a process died (they could not finish: the pool
+    fails every job it holds) and those not started yet; both empty when every job finished.
+    """
+    todo, running, broken = list(reversed(jobs)), {}, []
     pool = ProcessPoolExecutor(max_workers=workers, initializer=quiet_worker)
     try:
-        futures: dict[Future[list[Row]], Job] = {pool.submit(run_job, job): job for job in jobs}
-        for future in as_completed(futures):
-            on_rows(future.result())
-            tick(len(futures[future].backends), futures[future].name)
+        while (todo or running) and not broken:
+            while todo and len(running) < workers:
+                job = todo.pop()
+                running[pool.submit(run_job, job)] = job
+            wait(running, return_when=FIRST_COMPLETED)
+            if any(_lost(f) for f in running):
+                wait(running)  # a broken pool fails every job it holds, at once
+            for future in [f for f in running if f.done()]:
+                job = running.pop(future)
+                if _lost(future):
+                    broken.append(job)
+                else:
+                    finished(job, future.result())
     except BaseException:
-        pool.shutdown(wait=False, cancel_futures=True)
+        _kill(pool)
         raise
     pool.shutdown(wait=True)
+    return broken, todo[::-1]
+
+
+def _lost(future: Future[list[Row]]) -> bool:
+    """The future is done and failed because its pool lost a process."""
+    return future.done() and isinstance(future.exception(), BrokenProcessPool)
+
+
+def _kill(pool: ProcessPoolExecutor) -> None:
+    """Kill the pool's processes now (their scenes are abandoned) and drop its queued jobs."""
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        process.kill()
+    pool.shutdown(wait=False, cancel_futures=True)

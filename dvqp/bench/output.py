@@ -6,13 +6,15 @@ cells; flags are ``true``/``false`` in the CSV.
 
 from __future__ import annotations
 
+import contextlib
 import json
 from dataclasses import dataclass
-from typing import Any
+from pathlib import Path
+from typing import IO, Any
 
 from dvqp._versions import versions
 from dvqp.bench.execution import Where
-from dvqp.bench.runner import EXTRA_FIELDS, Row
+from dvqp.bench.runner import EXTRA_FIELDS, Row, is_lost
 from dvqp.comparison import FIELDS, aligned, cell, machine
 from dvqp.comparison import rows_to_csv as csv_text
 
@@ -56,6 +58,7 @@ def format_summary(suite: Suite) -> str:
     table = [["backend", *(h for _, h, _ in COLUMNS)]]
     table += [[b, *(cell(suite.summary[b][k], f) for k, _, f in COLUMNS)] for b in suite.backends]
     scenes = len({r["scene"] for r in suite.rows})
+    lost = sorted({r["scene"] for r in suite.rows if is_lost(r)})
     timed = suite.summary[suite.backends[0]]["timed_scenes"] if suite.backends else 0
     d = suite.disagreement
     lines = [
@@ -75,6 +78,9 @@ def format_summary(suite: Suite) -> str:
             else "no scene with two successful QP runs to compare"
         ),
     ]
+    if lost:
+        lines.append(f"lost            {len(lost)} scene{'s' * (len(lost) > 1)} (worker lost or "
+                     f"timed out: no figures): {', '.join(lost)}")  # fmt: skip
     return "\n".join(lines)
 
 
@@ -101,3 +107,28 @@ def rows_to_csv(suite: Suite) -> str:
     flat = [{**r, **dict(zip(TOOL, r.get("final_tool") or [None] * 4, strict=True))}
             for r in _marked(suite)]  # fmt: skip
     return csv_text(flat, CSV_FIELDS)
+
+
+class PartialFile:
+    """``<output>.partial``: the results of each finished scene as JSON lines (one result a
+    line, as in the JSON's ``results``), appended and flushed as the scene arrives, so that
+    they outlive a process that is killed. :meth:`remove` it once the outputs are written."""
+
+    def __init__(self, output: Path) -> None:
+        self.path = output.with_name(output.name + ".partial")
+        self._file: IO[str] | None = open(self.path, "w", encoding="utf-8")  # noqa: SIM115
+
+    def add(self, rows: list[Row]) -> None:
+        """Append one scene's ``rows`` (NaN and infinities as ``null``) and flush them."""
+        if self._file is not None:
+            clean = json.loads(json.dumps(rows), parse_constant=lambda _: None)
+            self._file.write("".join(json.dumps(r, allow_nan=False) + "\n" for r in clean))
+            self._file.flush()
+
+    def remove(self) -> None:
+        """Close and delete the file."""
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+        with contextlib.suppress(OSError):
+            self.path.unlink()

@@ -22,6 +22,11 @@ EXTRA_FIELDS = (
 )  # fmt: skip
 """Keys a bench row adds to :data:`dvqp.comparison.FIELDS`, after ``index`` (its first key)."""
 
+WORKER_LOST = "worker lost"
+"""The ``error`` of a run whose worker died (twice) before answering."""
+LOST = (WORKER_LOST, "timed out")
+"""How the ``error`` of a lost run begins: its worker died, or gave no answer in time."""
+
 
 @dataclass(frozen=True)
 class Job:
@@ -42,7 +47,6 @@ def run_job(job: Job, on_run: Callable[[str], None] | None = None) -> list[Row]:
     :func:`dvqp.comparison.error_row`. ``on_run(backend)`` is called after each run.
     """
     scene = loads(job.text, f"{job.name}.toml")
-    shapes = ",".join(o.kind for o in scene.obstacles)
     rows = []
     for backend in job.backends:
         try:
@@ -51,13 +55,30 @@ def run_job(job: Job, on_run: Callable[[str], None] | None = None) -> list[Row]:
             row = error_row(scene, backend, exc, EXTRA_FIELDS)
         else:
             row = _figures(scene, traj)
-        rows.append(
-            {"index": job.index, **row, "mode": scene.mode, "dt": scene.dt, "obstacles": shapes}
-        )
+        rows.append(_with_scene(job, scene, row))
         if on_run is not None:
             on_run(backend)
     add_ratios(rows)
     return rows
+
+
+def lost_rows(job: Job, reason: str = WORKER_LOST) -> list[Row]:
+    """The rows of a scene whose worker gave no answer: one per backend, as a run that raised
+    (:func:`dvqp.comparison.error_row`) with ``error`` ``reason`` (beginning as :data:`LOST`)."""
+    scene = loads(job.text, f"{job.name}.toml")
+    error = DvqpError(reason)
+    return [_with_scene(job, scene, error_row(scene, b, error, EXTRA_FIELDS)) for b in job.backends]
+
+
+def is_lost(row: Row) -> bool:
+    """The row is of a lost run (:func:`lost_rows`)."""
+    return str(row.get("error") or "").startswith(LOST)
+
+
+def _with_scene(job: Job, scene: Scene, row: Row) -> Row:
+    """``row`` with the scene's ``index`` first and its ``mode``, ``dt`` and obstacle shapes."""
+    shapes = ",".join(o.kind for o in scene.obstacles)
+    return {"index": job.index, **row, "mode": scene.mode, "dt": scene.dt, "obstacles": shapes}
 
 
 def _figures(scene: Scene, traj: Trajectory) -> Row:

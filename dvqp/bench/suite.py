@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
-from dvqp.bench.dask_run import dask_client, run_dask
+from dvqp.bench.dask_run import SCENE_TIMEOUT, WorkersLostError, dask_client, run_dask
 from dvqp.bench.execution import Progress, Where, local_where, run_local
 from dvqp.bench.generate import BenchScene
 from dvqp.bench.output import Suite
@@ -31,6 +31,8 @@ def run_suite(
     scheduler: str | None = None,
     progress: Progress | None = None,
     ready: Callable[[Where], None] | None = None,
+    on_scene: Callable[[list[Row]], None] | None = None,
+    scene_timeout: float = SCENE_TIMEOUT,
     shift: float = SHIFT_US,
 ) -> Suite:
     """Run every scene with every backend and sum the runs up per backend.
@@ -39,32 +41,45 @@ def run_suite(
     ``backends`` are resolver names checked by the caller. ``scheduler`` None runs them in
     ``workers`` local processes, else on a Dask scheduler at that address, or on a LocalCluster
     of ``workers`` for ``"local"``. ``progress(done, total, label)`` counts runs; ``ready(where)``
-    is called once where the runs go is ready (a scheduler reached), before the first run.
-    ``shift``: of the shifted geometric means, µs.
+    is called once where the runs go is ready (a scheduler reached), before the first run;
+    ``on_scene(rows)`` with the rows of each scene as it finishes (e.g. to save them at once).
+    ``scene_timeout``: on Dask, how long a scene may run (s); ``shift``: of the shifted
+    geometric means, µs.
 
     Raises
     ------
     BenchInterrupted
         Ctrl-C; it carries the suite of the finished scenes.
+    WorkersLostError
+        Every Dask worker left; its ``suite`` holds the finished scenes.
     DaskUnavailableError, DvqpError
         Dask is missing, or the scheduler cannot be reached.
     """
     jobs = [Job(s.index, s.name, s.text, tuple(backends)) for s in scenes]
     rows: list[Row] = []
+
+    def finished(scene_rows: list[Row]) -> None:
+        rows.extend(scene_rows)
+        if on_scene is not None:
+            on_scene(scene_rows)
+
     where = local_where(jobs, workers) if scheduler is None else Where("dask", 0, scheduler)
     try:
         if scheduler is None:
             if ready is not None:
                 ready(where)
-            run_local(jobs, workers, rows.extend, progress)
+            run_local(jobs, workers, finished, progress)
         else:
             with dask_client(scheduler, workers) as (client, where):
                 if ready is not None:
                     ready(where)
-                run_dask(client, jobs, rows.extend, progress)
+                run_dask(client, jobs, finished, progress, scene_timeout)
     except KeyboardInterrupt as exc:
         suite = make_suite(rows, backends, seed, len(scenes), where, shift, interrupted=True)
         raise BenchInterrupted(suite) from exc
+    except WorkersLostError as exc:
+        exc.suite = make_suite(rows, backends, seed, len(scenes), where, shift, interrupted=True)
+        raise
     return make_suite(rows, backends, seed, len(scenes), where, shift)
 
 

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from dvqp.bench.runner import Row
+from dvqp.bench.runner import Row, is_lost
 from dvqp.errors import ParameterError
 from dvqp.resolution.registry import PINV
 
@@ -43,7 +43,8 @@ def summarize_backends(
     """One dict of figures per backend, in ``backends`` order (undefined figures None).
 
     ``runs``, ``succeeded``, ``success_rate`` (0..1), ``failed_steps``, ``relaxed_steps``,
-    ``substepped_steps``, ``raised`` (runs that ended in an error, no figures);
+    ``substepped_steps``, ``raised`` (runs that ended in an error, no figures), ``lost`` (of
+    those, runs whose worker died or timed out: :func:`~dvqp.bench.runner.is_lost`);
     ``step_time_sgm_us`` and ``solve_time_sgm_us`` (shifted geometric mean over the timed
     scenes of each run's mean full step time and mean solver time, µs) and their ``_ratio``
     to the best backend; ``timed_scenes``; ``worst_limit_excess`` (m or rad);
@@ -65,6 +66,7 @@ def summarize_backends(
             "relaxed_steps": sum(r["relaxed"] or 0 for r in runs),
             "substepped_steps": sum(r["substepped"] or 0 for r in runs),
             "raised": sum(1 for r in runs if r["steps"] is None),
+            "lost": sum(1 for r in runs if is_lost(r)),
             "step_time_sgm_us": step[b][0],
             "step_time_sgm_ratio": step[b][1],
             "solve_time_sgm_us": solve[b][0],

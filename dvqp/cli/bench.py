@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import math
 import sys
 import tempfile
 from dataclasses import dataclass
@@ -20,6 +21,7 @@ from dvqp._files import output_path
 from dvqp.bench import (
     BenchInterrupted,
     DaskUnavailableError,
+    PartialFile,
     Suite,
     bench_json,
     format_summary,
@@ -29,6 +31,7 @@ from dvqp.bench import (
     run_suite,
     save_scenes,
 )
+from dvqp.bench.dask_run import SCENE_TIMEOUT, WorkersLostError
 from dvqp.bench.execution import Where
 from dvqp.cli.progress import ProgressBar
 from dvqp.cli.report import write_text
@@ -47,6 +50,7 @@ class Options:
     backends: tuple[str, ...]
     workers: int
     scheduler: str | None
+    scene_timeout: float
     json: Path | None
     csv: Path | None
     scenes_dir: Path | None
@@ -70,36 +74,50 @@ def register(subparsers: Any) -> argparse.ArgumentParser:
                    help="local processes, or LocalCluster workers (default: 1)")  # fmt: skip
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask scheduler "
                    "(tcp://host:8786), or 'local' for a LocalCluster")  # fmt: skip
+    p.add_argument("--scene-timeout", metavar="SECONDS", default=str(SCENE_TIMEOUT),
+                   help="on Dask, give a scene up after running this long "
+                   f"(default: {SCENE_TIMEOUT:g})")  # fmt: skip
     p.set_defaults(run=run)
     return p
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``dvqp bench``; return 0. Bad input raises a DvqpError before any run (exit 2);
-    Ctrl-C a KeyboardInterrupt, after the finished scenes were summed up and written."""
+    """Run ``dvqp bench``; return 0, or 1 when every Dask worker left (the finished scenes
+    written). Bad input raises a DvqpError before any run (exit 2); Ctrl-C a
+    KeyboardInterrupt, after the finished scenes were summed up and written."""
     options = check_options(args)
     scenes = generate_scenes(options.seed, options.count)
+    partial: list[PartialFile] = []
 
     def ready(where: Where) -> None:
         if options.scenes_dir is not None:
             options.scenes_dir.mkdir(exist_ok=True)
             save_scenes(scenes, options.scenes_dir)
+        if out := options.json or options.csv:  # the results as they arrive, until written
+            partial.append(PartialFile(out))
 
     try:
         with contextlib.closing(ProgressBar(sys.stderr)) as bar:
             suite = run_suite(
                 scenes, options.backends, seed=options.seed, workers=options.workers,
                 scheduler=options.scheduler, progress=bar.show, ready=ready,
+                on_scene=lambda rows: [p.add(rows) for p in partial],
+                scene_timeout=options.scene_timeout,
             )  # fmt: skip
     except BenchInterrupted as exc:
-        _report(exc.suite, options)  # what finished is still written
+        _report(exc.suite, options, partial)  # what finished is still written
         raise
-    _report(suite, options)
+    except WorkersLostError as exc:
+        _report(exc.suite, options, partial)
+        print(f"dvqp: scheduler {options.scheduler}: {exc}", file=sys.stderr)
+        return 1
+    _report(suite, options, partial)
     return 0
 
 
-def _report(suite: Suite, options: Options) -> None:
-    """Print the summary; write the JSON and CSV files asked for."""
+def _report(suite: Suite, options: Options, partial: list[PartialFile]) -> None:
+    """Print the summary; write the JSON and CSV files asked for, then remove the partial
+    file that held the results while the suite ran."""
     print(format_summary(suite))
     if options.scenes_dir is not None:
         print(f"scene files     {options.scenes_dir}/bench-s{options.seed}-*.toml "
@@ -108,6 +126,8 @@ def _report(suite: Suite, options: Options) -> None:
         write_text(options.json, bench_json(suite))
     if options.csv is not None:
         write_text(options.csv, rows_to_csv(suite))
+    for file in partial:
+        file.remove()
 
 
 def check_options(args: argparse.Namespace) -> Options:
@@ -117,6 +137,7 @@ def check_options(args: argparse.Namespace) -> Options:
     count = _integer("--count", args.count, 1)
     seed = _integer("--seed", args.seed, 0)
     workers = _integer("--workers", args.workers, 1)
+    timeout = _seconds("--scene-timeout", args.scene_timeout)
     names = [b.strip() for b in args.backends.split(",")] if args.backends else None
     backends = tuple(dict.fromkeys(check_name(b) for b in names or default_resolvers()))
     json_out = output_path(args.json, (".json",)) if args.json is not None else None
@@ -129,7 +150,9 @@ def check_options(args: argparse.Namespace) -> Options:
             import_distributed()
         except DaskUnavailableError as exc:
             raise DvqpError(f"--scheduler {exc}") from exc
-    return Options(count, seed, backends, workers, args.scheduler, json_out, csv_out, scenes_dir)
+    return Options(
+        count, seed, backends, workers, args.scheduler, timeout, json_out, csv_out, scenes_dir
+    )
 
 
 def _integer(option: str, text: str, minimum: int) -> int:
@@ -140,6 +163,17 @@ def _integer(option: str, text: str, minimum: int) -> int:
         value = None
     if value is None or value < minimum:
         raise ParameterError(option, f"must be an integer >= {minimum}, got {text!r}")
+    return value
+
+
+def _seconds(option: str, text: str) -> float:
+    """``text`` as a finite number of seconds > 0, else a ParameterError naming ``option``."""
+    try:
+        value = float(str(text).strip())
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise ParameterError(option, f"must be a number of seconds > 0, got {text!r}")
     return value
 
 
