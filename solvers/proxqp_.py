@@ -51,6 +51,11 @@ class ProxqpBackend(StatefulBackend):
         # The default 1e-4 declares feasible problems infeasible (cold and,
         # more often, warm after a large data change) once eps_abs is tight.
         "eps_primal_inf": 1e-10,
+        # ...so an infeasible problem is not declared so: it runs to the iteration caps,
+        # ProxQP's 10 000 outer x 1 500 inner took up to 33 s a call (pipe-rack: 188 s). No
+        # accepted solve on the bundled and bench scenes needs more than 725 outer iterations.
+        "max_iter": 2000,
+        "max_iter_in": 150,
         "verbose": False,
     }
 

@@ -40,7 +40,7 @@ SETTINGS: dict[str, dict[str, Any]] = {
     "piqp": {"eps_abs": 1e-10, "eps_rel": 0.0},
     # proxqp.dense.solve takes no eps_primal_inf: this path keeps proxsuite's 1e-4 and
     # can call a feasible problem infeasible (the direct adapter lowers it).
-    "proxqp": {"eps_abs": 1e-9, "eps_rel": 0.0},
+    "proxqp": {"eps_abs": 1e-9, "eps_rel": 0.0, "max_iter": 2000},  # as proxqp_.py caps it
 }
 
 #: Primal residual tolerance of the check, per solver (also the accuracy on ``x``
