@@ -21,6 +21,7 @@ from dvqp.comparison import rows_to_csv as csv_text
 COLUMNS = (  # (summary key, header, format of a defined value)
     ("runs", "runs", "{}"), ("succeeded", "ok", "{}"), ("success_rate", "success", "{:.1%}"),
     ("failed_steps", "failed steps", "{}"), ("relaxed_steps", "relaxed steps", "{}"),
+    ("capped_calls", "capped calls", "{}"),
     ("step_time_sgm_us", "step sgm us", "{:.0f}"), ("step_time_sgm_ratio", "x best", "{:.2f}"),
     ("solve_time_sgm_us", "solve sgm us", "{:.0f}"), ("solve_time_sgm_ratio", "x best", "{:.2f}"),
     ("worst_limit_excess", "worst excess", "{:.2g}"),

@@ -19,6 +19,7 @@ from dvqp.scenes import Scene, loads
 
 EXTRA_FIELDS = (
     "mode", "dt", "obstacles", "mean_step_us", "mean_solve_us", "median_solve_us", "total_step_s",
+    "capped_calls",
 )  # fmt: skip
 """Keys a bench row adds to :data:`dvqp.comparison.FIELDS`, after ``index`` (its first key)."""
 
@@ -90,4 +91,5 @@ def _figures(scene: Scene, traj: Trajectory) -> Row:
         "mean_solve_us": float(np.mean(solve_us)) if solve_us.size else None,
         "median_solve_us": float(np.median(solve_us)) if solve_us.size else None,
         "total_step_s": float(np.sum(traj.step_time)),
+        "capped_calls": sum(traj.refusals.get(k, 0) for k in ("iteration limit", "time limit")),
     }

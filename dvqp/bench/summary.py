@@ -43,8 +43,10 @@ def summarize_backends(
     """One dict of figures per backend, in ``backends`` order (undefined figures None).
 
     ``runs``, ``succeeded``, ``success_rate`` (0..1), ``failed_steps``, ``relaxed_steps``,
-    ``substepped_steps``, ``raised`` (runs that ended in an error, no figures), ``lost`` (of
-    those, runs whose worker died or timed out: :func:`~dvqp.bench.runner.is_lost`);
+    ``substepped_steps``, ``refused_calls`` (backend calls with no accepted answer) and of those
+    ``capped_calls`` (stopped at an iteration or time cap), ``raised`` (runs that ended in an
+    error, no figures), ``lost`` (of those, runs whose worker died or timed out:
+    :func:`~dvqp.bench.runner.is_lost`);
     ``step_time_sgm_us`` and ``solve_time_sgm_us`` (shifted geometric mean over the timed
     scenes of each run's mean full step time and mean solver time, µs) and their ``_ratio``
     to the best backend; ``timed_scenes``; ``worst_limit_excess`` (m or rad);
@@ -64,6 +66,8 @@ def summarize_backends(
             "success_rate": ok / len(runs) if runs else None,
             "failed_steps": sum(r["failures"] or 0 for r in runs),
             "relaxed_steps": sum(r["relaxed"] or 0 for r in runs),
+            "refused_calls": sum(r.get("refused_calls") or 0 for r in runs),
+            "capped_calls": sum(r.get("capped_calls") or 0 for r in runs),
             "substepped_steps": sum(r["substepped"] or 0 for r in runs),
             "raised": sum(1 for r in runs if r["steps"] is None),
             "lost": sum(1 for r in runs if is_lost(r)),
