@@ -68,8 +68,18 @@ def test_backends_are_compared_on_the_scenes_every_backend_ran() -> None:
 
 def test_step_counts_and_worst_figures_are_summed_and_maximised() -> None:
     rows = [
-        row("s0", "osqp", 1.0, 1.0, failures=2, relaxed=5, success=False, max_limit_excess=3e-5,
-            refused_calls=6, capped_calls=1),
+        row(
+            "s0",
+            "osqp",
+            1.0,
+            1.0,
+            failures=2,
+            relaxed=5,
+            success=False,
+            max_limit_excess=3e-5,
+            refused_calls=6,
+            capped_calls=1,
+        ),
         row("s1", "osqp", 1.0, 1.0, relaxed=7, max_task_error=0.04, refused_calls=7),
     ]
     s = summarize_backends(rows, ["osqp"])["osqp"]
