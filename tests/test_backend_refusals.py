@@ -76,3 +76,15 @@ def test_the_summary_counts_refused_calls_and_stderr_has_no_warning(
     assert code == 0 and err == ""
     solver_line = next(line for line in out.splitlines() if line.startswith("solver "))
     assert "calls refused (" in solver_line and "infeasible)" in solver_line
+
+
+def test_a_bench_row_counts_the_calls_stopped_at_an_iteration_cap() -> None:
+    pytest.importorskip("proxsuite")
+    from dvqp.bench.runner import Job, run_job
+
+    text = (SCENES / "joint-limit.toml").read_text(encoding="utf-8")
+    (row,) = run_job(Job(0, "joint-limit", text, ("proxqp",)))
+    traj = plan(load_scene(SCENES / "joint-limit.toml"), "proxqp")
+    capped = traj.refusals.get("iteration limit", 0) + traj.refusals.get("time limit", 0)
+    assert capped > 0  # ProxQP stops at its cap on a few of this scene's infeasible problems
+    assert (row["capped_calls"], row["refused_calls"]) == (capped, sum(traj.refusals.values()))
