@@ -7,8 +7,6 @@ parallel processes when ``jobs > 1`` (noisier timings). The row helpers serve ``
 
 from __future__ import annotations
 
-import csv
-import io
 import os
 import platform
 import signal
@@ -26,6 +24,7 @@ from dvqp.kinematics import KinematicState
 from dvqp.limits import lowest_link, self_distance, start_broken_lines
 from dvqp.planning import check_run, final_errors, worst_sample_excess
 from dvqp.resolution.registry import PINV
+from dvqp.table_text import csv_text
 
 if TYPE_CHECKING:
     from dvqp import Scene, Trajectory
@@ -181,18 +180,18 @@ def run_error(scene: Scene, traj: Trajectory) -> str | None:
 
 
 def run_scene(
-    path: str, backends: Sequence[str], progress: Callable[[str], None] | None = None
-) -> list[Row]:
-    """Load a scene and run it with every backend; the rows in ``backends`` order.
-
-    A run that raises a :class:`~dvqp.errors.DvqpError` gives an :func:`error_row`.
-    ``progress(backend)`` is called after each run.
+    path: str, backends: Sequence[str], progress: Callable[[str], None] | None = None,
+    options: dict[str, dict[str, Any]] | None = None,
+) -> list[Row]:  # fmt: skip
+    """Load a scene and run it with every backend (``options``: settings by backend); the rows
+    in ``backends`` order. A run that raises a :class:`~dvqp.errors.DvqpError` gives an
+    :func:`error_row`. ``progress(backend)`` is called after each run.
     """
-    scene = load_scene(path)
+    scene, given = load_scene(path), options or {}
     rows = []
     for backend in backends:
         try:
-            rows.append(summarize(scene, plan(scene, backend)))
+            rows.append(summarize(scene, plan(scene, backend, options=given.get(backend))))
         except DvqpError as exc:
             rows.append(error_row(scene, backend, exc))
         if progress is not None:
@@ -222,12 +221,14 @@ def compare(
     backends: Sequence[str],
     jobs: int = 1,
     progress: Callable[[int, int, str], None] | None = None,
+    options: dict[str, dict[str, Any]] | None = None,
 ) -> list[Row]:
     """Run every scene with every backend; rows grouped by scene in ``paths`` order.
 
     The scene files and backend names are checked by the caller (else scene errors surface
     here; an unknown backend gives failed rows). ``jobs`` worker processes run one scene each
-    (1: all in this process). ``progress(done, total, label)`` counts runs (scene × backend).
+    (1: all in this process). ``progress(done, total, label)`` counts runs (scene × backend);
+    ``options``: backends' settings, over each scene's own.
     """
     total, done = len(paths) * len(backends), 0
     results: dict[str, list[Row]] = {}
@@ -240,51 +241,21 @@ def compare(
 
     if jobs <= 1 or len(paths) <= 1:
         for path in paths:
-            results[path] = run_scene(path, backends, lambda b, p=path: tick(1, f"{p} {b}"))
+            results[path] = run_scene(path, backends, lambda b, p=path: tick(1, f"{p} {b}"),
+                                      options)  # fmt: skip
     else:
         with ProcessPoolExecutor(max_workers=jobs, initializer=quiet_worker) as pool:
-            futures = {pool.submit(run_scene, path, list(backends)): path for path in paths}
+            futures = {pool.submit(run_scene, path, list(backends), None, options): path
+                       for path in paths}  # fmt: skip
             for future in as_completed(futures):
                 results[futures[future]] = future.result()
                 tick(len(backends), futures[future])
     return [row for path in paths for row in results[path]]
 
 
-def cell(value: Any, fmt: str = "{}") -> str:
-    """A table cell: ``-`` for None, ``yes``/``NO`` for a flag, else ``fmt.format(value)``."""
-    if value is None:
-        return "-"
-    if isinstance(value, bool):
-        return "yes" if value else "NO"
-    return fmt.format(value)
-
-
-def aligned(table: Sequence[Sequence[str]], left: int = 1) -> str:
-    """Rows of cells as text columns two spaces apart, a rule of ``-`` under the first row;
-    the first ``left`` columns left-justified, the others right-justified."""
-    widths = [max(len(line[i]) for line in table) for i in range(len(table[0]))]
-    just = [str.ljust] * left + [str.rjust] * (len(widths) - left)
-    lines = [
-        "  ".join(j(c, w) for j, c, w in zip(just, line, widths, strict=True)) for line in table
-    ]
-    lines.insert(1, "  ".join("-" * w for w in widths))
-    return "\n".join(lines)
-
-
-def csv_cell(value: Any) -> str:
-    """A CSV cell: empty for None or a non-finite float, ``true``/``false`` for a flag."""
-    if value is None or (isinstance(value, float) and not np.isfinite(value)):
-        return ""
-    return str(value).lower() if isinstance(value, bool) else str(value)
-
-
 def rows_to_csv(rows: Sequence[Row], fields: Sequence[str] = FIELDS) -> str:
-    """The rows as CSV text: a header of ``fields``, then one line per row (:func:`csv_cell`)."""
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(fields)
-    writer.writerows([csv_cell(row.get(key)) for key in fields] for row in rows)
-    return buf.getvalue()
+    """The rows as CSV text: a header of ``fields`` (default :data:`FIELDS`), one line a row."""
+    return csv_text(rows, fields)
 
 
 def machine() -> dict[str, Any]:

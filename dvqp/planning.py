@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -81,6 +82,7 @@ def plan(
     progress: Callable[[int, int], None] | None = None,
     notice: Callable[[str], None] | None = None,
     stop: bool = True,
+    options: dict[str, Any] | None = None,
 ) -> Trajectory:
     """Run a scene with a resolver and return its trajectory, ended at rest.
 
@@ -102,15 +104,18 @@ def plan(
     stop
         Brake after the last command (JOG) or the path's end until every joint has stopped
         (:mod:`dvqp.motion.stop`); False: end with the last command.
+    options
+        Settings of the QP backend, over the scene's ``[solvers.<backend>]`` ones.
 
     Raises
     ------
     BackendError
-        Unknown backend.
+        Unknown backend, or a setting it does not take.
     SingularConfigurationError
         The baseline met a singular task Jacobian.
     """
-    resolver = make_resolver(backend, scene.spec().with_extra(tasks, limits))
+    settings = {**scene.solver_options.get(backend, {}), **(options or {})}
+    resolver = make_resolver(backend, scene.spec().with_extra(tasks, limits), settings)
     c = scene_commands(scene)
     traj = simulate(
         scene.robot, scene.pipe_radius, resolver, scene.q0, c.velocity, scene.dt,

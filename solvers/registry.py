@@ -12,12 +12,16 @@ from __future__ import annotations
 
 import functools
 import importlib
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import metadata
 from typing import Any
 
-from .exceptions import UnknownBackendError
+import numpy as np
+
+from .exceptions import SolverError, UnknownBackendError
+from .problem import Problem
 from .protocol import Backend
 
 QPSOLVERS_PREFIX = "qpsolvers:"
@@ -121,7 +125,29 @@ def make_backend(name: str, **options: Any) -> Backend:
     factory = _factories().get(name)
     if factory is None:
         raise UnknownBackendError(name, available_backends())
-    return factory(**options)
+    backend = factory(**options)
+    if set(options) - {"tolerance"}:
+        _try_settings(backend, sorted(options))
+    return backend
+
+
+def _try_settings(backend: Backend, names: list[str]) -> None:
+    """Solve a one-variable problem with the settings given: a solver that refuses one (a
+    wrong type, a name its wrapper does not read) raises :class:`SolverError` here, not in
+    the middle of a run."""
+    tiny = Problem(np.eye(1), np.zeros(1), G=-np.eye(1), h=-np.ones(1))  # x >= 1, active
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            solution = backend.solve(tiny)
+    except SolverError as exc:
+        reason = str(exc).splitlines()[0]
+    else:
+        backend.reset()
+        if solution.status != "exception":
+            return
+        reason = solution.message.splitlines()[0]
+    raise SolverError(f"{backend.name}: settings {', '.join(names)} refused: {reason}")
 
 
 def backend_versions() -> dict[str, str]:

@@ -147,7 +147,9 @@ class StatefulBackend:
     def __init__(self, *, tolerance: float | None = None, **settings: Any) -> None:
         unknown = sorted(set(settings) - self.known_settings())
         if unknown:
-            raise SolverError(f"{self.name}: unknown settings {unknown}")
+            accepted = ", ".join(sorted(self.known_settings()))
+            raise SolverError(f"{self.name}: unknown setting {', '.join(map(repr, unknown))} "
+                              f"(accepted: {accepted})")  # fmt: skip
         self.tolerance = self.default_tolerance if tolerance is None else float(tolerance)
         self.settings: dict[str, Any] = {**self.default_settings, **settings}
         self._structure: Hashable | None = None

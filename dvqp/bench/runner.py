@@ -7,7 +7,8 @@ worker or a remote machine run exactly the same scene.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -32,12 +33,14 @@ LOST = (WORKER_LOST, "timed out")
 @dataclass(frozen=True)
 class Job:
     """One scene to run: its ``index`` in the suite, its ``name`` (it is loaded as
-    ``<name>.toml``), the scene file's ``text`` and the ``backends``, run in this order."""
+    ``<name>.toml``), the scene file's ``text`` and the ``backends``, run in this order, with
+    ``options`` (settings by backend, ``--solver-option``)."""
 
     index: int
     name: str
     text: str
     backends: tuple[str, ...]
+    options: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
 def run_job(job: Job, on_run: Callable[[str], None] | None = None) -> list[Row]:
@@ -51,7 +54,7 @@ def run_job(job: Job, on_run: Callable[[str], None] | None = None) -> list[Row]:
     rows = []
     for backend in job.backends:
         try:
-            traj = plan(scene, backend)
+            traj = plan(scene, backend, options=job.options.get(backend))
         except DvqpError as exc:
             row = error_row(scene, backend, exc, EXTRA_FIELDS)
         else:

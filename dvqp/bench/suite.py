@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import Any
 
 from dvqp.bench.dask_run import SCENE_TIMEOUT, WorkersLostError, dask_client, run_dask
 from dvqp.bench.execution import Progress, Where, local_where, run_local
@@ -34,6 +35,7 @@ def run_suite(
     on_scene: Callable[[list[Row]], None] | None = None,
     scene_timeout: float = SCENE_TIMEOUT,
     shift: float = SHIFT_US,
+    options: dict[str, dict[str, Any]] | None = None,
 ) -> Suite:
     """Run every scene with every backend and sum the runs up per backend.
 
@@ -44,7 +46,7 @@ def run_suite(
     is called once where the runs go is ready (a scheduler reached), before the first run;
     ``on_scene(rows)`` with the rows of each scene as it finishes (e.g. to save them at once).
     ``scene_timeout``: on Dask, how long a scene may run (s); ``shift``: of the shifted
-    geometric means, µs.
+    geometric means, µs; ``options``: settings by backend (``--solver-option``).
 
     Raises
     ------
@@ -55,7 +57,7 @@ def run_suite(
     DaskUnavailableError, DvqpError
         Dask is missing, or the scheduler cannot be reached.
     """
-    jobs = [Job(s.index, s.name, s.text, tuple(backends)) for s in scenes]
+    jobs = [Job(s.index, s.name, s.text, tuple(backends), dict(options or {})) for s in scenes]
     rows: list[Row] = []
 
     def finished(scene_rows: list[Row]) -> None:

@@ -33,8 +33,10 @@ from dvqp.bench import (
 )
 from dvqp.bench.dask_run import SCENE_TIMEOUT, WorkersLostError
 from dvqp.bench.execution import Where
+from dvqp.cli import solver_option
 from dvqp.cli.progress import ProgressBar
 from dvqp.cli.report import write_text
+from dvqp.cli.solver_option import solver_options
 from dvqp.errors import DvqpError, ParameterError
 from dvqp.resolution.registry import check_name, default_resolvers
 
@@ -54,6 +56,7 @@ class Options:
     json: Path | None
     csv: Path | None
     scenes_dir: Path | None
+    solver_options: dict[str, dict[str, Any]]
 
 
 def register(subparsers: Any) -> argparse.ArgumentParser:
@@ -77,6 +80,7 @@ def register(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument("--scene-timeout", metavar="SECONDS", default=str(SCENE_TIMEOUT),
                    help="on Dask, give a scene up after running this long "
                    f"(default: {SCENE_TIMEOUT:g})")  # fmt: skip
+    solver_option.add_argument(p)
     p.set_defaults(run=run)
     return p
 
@@ -102,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
                 scenes, options.backends, seed=options.seed, workers=options.workers,
                 scheduler=options.scheduler, progress=bar.show, ready=ready,
                 on_scene=lambda rows: [p.add(rows) for p in partial],
-                scene_timeout=options.scene_timeout,
+                scene_timeout=options.scene_timeout, options=options.solver_options,
             )  # fmt: skip
     except BenchInterrupted as exc:
         _report(exc.suite, options, partial)  # what finished is still written
@@ -150,9 +154,9 @@ def check_options(args: argparse.Namespace) -> Options:
             import_distributed()
         except DaskUnavailableError as exc:
             raise DvqpError(f"--scheduler {exc}") from exc
-    return Options(
-        count, seed, backends, workers, args.scheduler, timeout, json_out, csv_out, scenes_dir
-    )
+    settings = solver_options(args.solver_option, backends)
+    return Options(count, seed, backends, workers, args.scheduler, timeout, json_out, csv_out,
+                   scenes_dir, settings)  # fmt: skip
 
 
 def _integer(option: str, text: str, minimum: int) -> int:

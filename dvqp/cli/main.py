@@ -27,9 +27,11 @@ from dvqp._versions import versions
 from dvqp.cli import bench as bench_cmd
 from dvqp.cli import cache as cache_cmd
 from dvqp.cli import console as console_cli
+from dvqp.cli import solver_option
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
 from dvqp.cli.report import format_summary, format_table, rows_to_csv, write_text
+from dvqp.cli.solver_option import solver_options
 from dvqp.errors import DvqpError, SingularConfigurationError, one_line
 from dvqp.resolution.registry import check_name, default_resolvers, describe_resolvers
 from dvqp.scenes import environment
@@ -82,6 +84,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("scene", help="scene file (.toml)")
     p.add_argument("--backend", default="daqp", help="pinv or a QP backend (default: daqp)")
     p.add_argument("-o", "--output", help="trajectory file to write (.npz or .csv)")
+    solver_option.add_argument(p)
     p.set_defaults(run=_plan)
     c = sub.add_parser("compare", help="run scenes with several backends, print one table")
     c.add_argument("scenes", nargs="+", metavar="SCENE", help="scene files (.toml)")
@@ -90,6 +93,7 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--csv", help="write the figures as CSV")
     c.add_argument("--plot", help="write a figure of the comparison (.png/.svg/.pdf)")
     c.add_argument("--jobs", type=_positive_int, default=1, help="worker processes (scenes)")
+    solver_option.add_argument(c)
     c.set_defaults(run=_compare)
     g = sub.add_parser("plot", help="draw a saved trajectory")
     g.add_argument("trajectory", help="trajectory file (.npz) written by 'dvqp plan'")
@@ -126,11 +130,12 @@ def _plan(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     output = output_path(args.output, (".npz", ".csv")) if args.output is not None else None
     check_name(args.backend)  # unknown backend: exit 2 before any work
+    options = solver_options(args.solver_option, [args.backend]).get(args.backend)
     check_size([scene], 1)
     try:  # a progress bar on stderr, erased when done
         with contextlib.closing(ProgressBar(sys.stderr)) as bar:
             traj = plan(scene, args.backend, progress=lambda k, n: bar.show(k, n, "steps"),
-                        notice=lambda text: _notice(bar, text))  # fmt: skip
+                        notice=lambda text: _notice(bar, text), options=options)  # fmt: skip
     except SingularConfigurationError as exc:
         print(f"dvqp: {one_line(scene.source)}: {args.backend}: {exc}", file=sys.stderr)
         return 1
@@ -148,12 +153,13 @@ def _compare(args: argparse.Namespace) -> int:
     names = [b.strip() for b in args.backends.split(",")] if args.backends else None
     backends = [check_name(name) for name in names or default_resolvers()]
     scenes = [load_scene(path) for path in args.scenes]  # every scene valid before any run
+    options = solver_options(args.solver_option, backends)
     check_size(scenes, len(backends))
     json_out = output_path(args.json, (".json",)) if args.json is not None else None
     csv_out = output_path(args.csv, (".csv",)) if args.csv is not None else None
     plot_out = output_path(args.plot, FIGURE_FORMATS) if args.plot is not None else None
     with contextlib.closing(ProgressBar(sys.stderr)) as bar:
-        rows = cmp.compare(args.scenes, backends, args.jobs, progress=bar.show)
+        rows = cmp.compare(args.scenes, backends, args.jobs, progress=bar.show, options=options)
     print(format_table(rows))
     for row in rows:
         if row["error"]:

@@ -11,10 +11,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from dvqp.cli.figures import write_atomic
-from dvqp.comparison import Row, aligned, cell
+from dvqp.comparison import Row
 from dvqp.comparison import rows_to_csv as rows_to_csv  # part of this module's API (docs)
 from dvqp.errors import one_line
 from dvqp.limits import start_broken_lines
+from dvqp.table_text import aligned, cell
 
 if TYPE_CHECKING:
     from dvqp import Scene, Trajectory

@@ -25,6 +25,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,16 +37,18 @@ from dvqp.resolution.step import Resolver
 from dvqp.workspace import QPBuffers
 
 
-def make_backend(name: str) -> solvers.Backend:
-    """A fresh QP backend by name (see :func:`solvers.available_backends`).
+def make_backend(name: str, **options: Any) -> solvers.Backend:
+    """A fresh QP backend by name (see :func:`solvers.available_backends`), with ``options``
+    (its settings).
 
     Raises
     ------
     BackendError
-        Unknown or not installed; the message lists the installed backends.
+        Unknown or not installed (the message lists the installed backends), or a setting it
+        does not take.
     """
     try:
-        return solvers.make_backend(name)
+        return solvers.make_backend(name, **options)
     except solvers.SolverError as exc:
         raise BackendError(str(exc)) from exc
 
@@ -61,13 +64,18 @@ class QPResolver(Resolver):
         Backend name, e.g. ``"daqp"``, ``"osqp"``, ``"qpsolvers:quadprog"``, or a zero-argument
         callable returning a fresh :class:`solvers.Backend` (a run makes two: the strict and the
         relaxed problem keep their own warm starts).
+    options
+        Settings of the backend named by ``backend`` (e.g. ``{"eps_abs": 1e-6}``).
     """
 
     holds_limits = True
 
-    def __init__(self, spec: StepSpec, backend: str | Callable[[], solvers.Backend]) -> None:
+    def __init__(self, spec: StepSpec, backend: str | Callable[[], solvers.Backend],
+                 options: dict[str, Any] | None = None) -> None:  # fmt: skip
         super().__init__(spec)
-        factory = (lambda: make_backend(backend)) if isinstance(backend, str) else backend
+        settings = dict(options or {})
+        named = isinstance(backend, str)
+        factory = (lambda: make_backend(backend, **settings)) if named else backend
         self.factory: Callable[[], solvers.Backend] = factory
         self.name = backend if isinstance(backend, str) else factory().name
         if isinstance(backend, str):

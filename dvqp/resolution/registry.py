@@ -8,12 +8,13 @@ listing what is installed and the extra that installs more.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import solvers
 from dvqp._versions import __version__
 from dvqp.errors import BackendError
 from dvqp.resolution.pinv import PseudoinverseResolver
-from dvqp.resolution.qp import QPResolver
+from dvqp.resolution.qp import QPResolver, make_backend
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 
@@ -71,7 +72,25 @@ def check_name(name: str) -> str:
     return name
 
 
-def make_resolver(name: str, spec: StepSpec) -> Resolver:
+def check_options(name: str, options: dict[str, Any]) -> dict[str, Any]:
+    """``options`` if the backend ``name`` takes them (a backend is made with them once).
+
+    Raises
+    ------
+    BackendError
+        Unknown backend; ``pinv`` given settings; a setting the backend does not take (its
+        accepted settings listed where the backend can say them).
+    """
+    check_name(name)
+    if name == PINV:
+        if options:
+            raise BackendError("pinv: the pseudoinverse has no settings")
+        return options
+    make_backend(name, **options)
+    return options
+
+
+def make_resolver(name: str, spec: StepSpec, options: dict[str, Any] | None = None) -> Resolver:
     """A fresh resolver of ``spec`` by name.
 
     Parameters
@@ -80,13 +99,15 @@ def make_resolver(name: str, spec: StepSpec) -> Resolver:
         ``"pinv"`` or a QP backend name of :func:`solvers.available_backends`.
     spec
         The tasks, objective, limits and weights of the step.
+    options
+        Settings of the QP backend (``{"eps_abs": 1e-6}``), checked (:func:`check_options`).
 
     Raises
     ------
     BackendError
-        Unknown or not installed (see :func:`check_name`).
+        Unknown or not installed (see :func:`check_name`), or settings it does not take.
     """
-    check_name(name)
+    check_options(name, options or {})
     if name == PINV:
         return PseudoinverseResolver(spec)
-    return QPResolver(spec, name)
+    return QPResolver(spec, name, options)

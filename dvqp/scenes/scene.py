@@ -29,6 +29,7 @@ from dvqp.scenes import obstacles as obstacle_section
 from dvqp.scenes import robot_section, start
 from dvqp.scenes import sections as sec
 from dvqp.scenes.fields import Fields
+from dvqp.scenes.solver_options import solver_options
 from dvqp.tasks import ToolTask
 
 if sys.version_info >= (3, 11):
@@ -39,7 +40,7 @@ else:  # pragma: no cover - Python 3.10
 __all__ = ["Environment", "Scene", "environment", "load_scene", "loads"]
 
 TOP_KEYS = ("name", "description", "pipe", "robot", "objective", "obstacles", "constraints",
-            "motion")  # fmt: skip
+            "motion", "solvers")  # fmt: skip
 """The keys a scene file may have at its top level."""
 
 
@@ -71,6 +72,8 @@ class Scene:
         The JOG segments (empty in path mode) or the path to follow (None in JOG mode).
     dt, ramp : float
         The step, and the time JOG velocity changes are spread linearly over (0: steps), s.
+    solver_options : dict of str to dict
+        ``[solvers.<backend>]``: settings handed to that QP backend when the scene runs on it.
     """
 
     name: str
@@ -90,6 +93,7 @@ class Scene:
     jog: tuple[JogSegment, ...] = field(repr=False)
     path: ToolPath | None = field(repr=False)
     ramp: float = 0.0
+    solver_options: dict[str, dict[str, Any]] = field(default_factory=dict, repr=False)
 
     def spec(self) -> StepSpec:
         """The step of this scene: the tool's DV task, the objective, the limits, ``W``."""
@@ -138,6 +142,8 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
         limits = sec.limits(f, doc, robot, obstacles)
     with f.guard("motion"):
         dt, jog, path, ramp = sec.motion(f, doc)
+    with f.guard("solvers"):
+        options = solver_options(f, doc)
     with f.guard("robot.q0"):
         start.check_start(f, robot, q0, radius, obstacles)
     with f.guard("constraints"):
@@ -149,6 +155,7 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
         source=source, text=text, pipe_radius=radius, weld=weld, robot=robot, q0=q0,
         weights=weights, orbital_level=level, obstacles=obstacles,
         objective=objective, limits=limits, dt=dt, jog=jog, path=path, ramp=ramp,
+        solver_options=options,
     )  # fmt: skip
 
 

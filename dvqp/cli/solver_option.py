@@ -1,0 +1,59 @@
+"""``--solver-option NAME.KEY=VALUE``: a QP backend's setting from the command line."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from typing import Any
+
+from dvqp.errors import ParameterError
+from dvqp.resolution.registry import check_options
+from dvqp.scenes.solver_options import setting_value
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+FLAG = "--solver-option"
+
+
+def add_argument(parser: argparse.ArgumentParser) -> None:
+    """The repeatable ``--solver-option`` of ``plan``, ``compare`` and ``bench``."""
+    parser.add_argument(FLAG, action="append", default=[], metavar="NAME.KEY=VALUE",
+                        help="a setting of a QP backend, e.g. osqp.eps_abs=1e-6 (repeatable; "
+                        "over the scene's [solvers.NAME])")  # fmt: skip
+
+
+def solver_options(values: Sequence[str], backends: Sequence[str]) -> dict[str, dict[str, Any]]:
+    """The settings given, by backend, each checked against the backend (nothing run yet).
+
+    A value is read as a TOML value (``1e-6``, ``true``, ``"qdldl"``), else taken as text.
+
+    Raises
+    ------
+    ParameterError
+        ``--solver-option: osqp.eps_abs: …`` (not ``NAME.KEY=VALUE``, a backend not run).
+    BackendError
+        A setting the backend does not take (its accepted settings listed).
+    """
+    options: dict[str, dict[str, Any]] = {}
+    for text in values:
+        target, sep, raw = text.partition("=")
+        name, dot, key = target.strip().rpartition(".")
+        if not (sep and dot and name and key):
+            raise ParameterError(FLAG, f"{text!r}: expected NAME.KEY=VALUE, e.g. osqp.eps_abs=1e-6")
+        if name not in backends:
+            raise ParameterError(FLAG, f"{text!r}: {name} is not run here "
+                                 f"(backends: {', '.join(backends)})")  # fmt: skip
+        try:
+            value = tomllib.loads(f"v = {raw.strip()}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = raw.strip()
+        if not setting_value(value):
+            raise ParameterError(FLAG, f"{text!r}: expected a finite number, a boolean or text")
+        options.setdefault(name, {})[key] = value
+    for name, settings in options.items():
+        check_options(name, settings)
+    return options
