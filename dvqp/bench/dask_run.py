@@ -14,6 +14,7 @@ backends) installed; they give the same outcomes as a local run, only their timi
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import logging
 import time
@@ -150,12 +151,14 @@ def run_dask(
 
 
 def _rows(dd: ModuleType, future: Any, job: Job) -> list[Row]:
-    """The rows of a finished job: its result, or ``worker lost`` if its workers died."""
+    """The rows of a finished job: its result, or ``worker lost`` if its workers died (also
+    when the result was held by a worker that left before it was fetched: the scheduler would
+    wait for a worker to compute it again, for ever if none is left)."""
     try:
-        return future.result()
+        return future.result(timeout=WORKER_WAIT)
     except DvqpError:
         raise
-    except dd.KilledWorker:
+    except (dd.KilledWorker, TimeoutError, asyncio.TimeoutError):
         return lost_rows(job)
     except Exception as exc:
         reason = f"{type(exc).__name__}: {one_line(str(exc))}"

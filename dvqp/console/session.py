@@ -66,7 +66,7 @@ class ConsoleSession:
 
     def __init__(self, scene: Scene, backend: str = "daqp") -> None:
         self.scene, self.backend = scene, check_name(backend)
-        self.resolver = make_resolver(backend, scene.spec())
+        self.resolver = make_resolver(backend, scene.spec(), scene.solver_options.get(backend))
         self.verify = self.resolver.holds_limits
         self.stepper = Stepper(scene.robot, scene.pipe_radius, self.resolver, scene.q0, scene.dt,
                                scene.obstacles)  # fmt: skip
