@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon, Shape
 from dvqp.geometry.shapes.band import band_point, band_segment
 from dvqp.geometry.shapes.circle import circle_point, circle_segment
+from dvqp.geometry.shapes.inlet import inlet_point, inlet_segment
 from dvqp.geometry.shapes.polygon import polygon_point, polygon_segment
 from dvqp.kinematics.developed_view import wrap_period
 from dvqp.workspace import ProximityBuffers
@@ -26,7 +27,7 @@ from solvers.jit import njit
 
 Array = NDArray[np.float64]
 
-CIRCLE, BAND, POLYGON, OTHER = 0, 1, 2, 3
+CIRCLE, BAND, POLYGON, OTHER, INLET = 0, 1, 2, 3, 4
 """Codes of the compiled shape kinds; OTHER is a shape of your own (measured in NumPy)."""
 
 
@@ -39,14 +40,15 @@ class ShapeArrays:
     period : float
         ``2πR``, m.
     code : (J,) int64
-        :data:`CIRCLE`, :data:`BAND`, :data:`POLYGON` (an inlet is its outline polygon) or
-        :data:`OTHER`.
-    data : (J, 3)
-        A circle's ``[l, z, r]``, a band's ``[z_min, z_max, 0]``, a polygon's ``[l_ref, 0, 0]``.
+        :data:`CIRCLE`, :data:`BAND`, :data:`POLYGON`, :data:`INLET` or :data:`OTHER`.
+    data : (J, 4)
+        A circle's ``[l, z, r, 0]``, a band's ``[z_min, z_max, 0, 0]``, a polygon's
+        ``[l_ref, 0, 0, 0]``, an inlet's ``[l0, z0, r, R]``.
     start, stop : (J,) int64
-        A polygon's vertices ``vl, vz[start:stop]``.
+        A polygon's vertices ``vl, vz[start:stop]``, an inlet's outline samples.
     vl, vz : (V,)
-        Every polygon's vertices, l measured from its ``l_ref``.
+        Every polygon's vertices, l measured from its ``l_ref``; every inlet's samples
+        (:attr:`~dvqp.geometry.shapes.Inlet.samples`, from its centre).
     size : (J,)
         ``ρ`` of each obstacle's penalty, m.
     refine : (J,)
@@ -69,20 +71,23 @@ class ShapeArrays:
     def of(cls, shapes: Sequence[Shape], period: float) -> ShapeArrays:
         """Pack ``shapes`` (dvqp's own classes compiled, any other :data:`OTHER`)."""
         count = len(shapes)
-        code, data = np.full(count, OTHER, np.int64), np.zeros((count, 3))
+        code, data = np.full(count, OTHER, np.int64), np.zeros((count, 4))
         start, stop = np.zeros(count, np.int64), np.zeros(count, np.int64)
         vertices: list[Array] = []
         at = 0
         for j, shape in enumerate(shapes):
             kind = type(shape)
             if kind is Circle:
-                code[j], data[j] = CIRCLE, (*shape.center, shape.radius)  # type: ignore[attr-defined]
+                code[j], data[j] = CIRCLE, (*shape.center, shape.radius, 0.0)  # type: ignore[attr-defined]
             elif kind is Band:
-                code[j], data[j] = BAND, (shape.z_min, shape.z_max, 0.0)  # type: ignore[attr-defined]
-            elif kind in (Polygon, Inlet):
-                polygon = shape.polygon if kind is Inlet else shape  # type: ignore[attr-defined]
-                local = polygon.local_vertices
-                code[j], data[j, 0] = POLYGON, polygon.l_ref
+                code[j], data[j] = BAND, (shape.z_min, shape.z_max, 0.0, 0.0)  # type: ignore[attr-defined]
+            elif kind is Inlet:
+                code[j], data[j] = INLET, (*shape.center, shape.radius, shape.pipe_radius)  # type: ignore[attr-defined]
+                local = shape.samples  # type: ignore[attr-defined]
+            elif kind is Polygon:
+                local = shape.local_vertices  # type: ignore[attr-defined]
+                code[j], data[j, 0] = POLYGON, shape.l_ref  # type: ignore[attr-defined]
+            if kind in (Polygon, Inlet):
                 start[j], stop[j] = at, at + local.shape[0]
                 vertices.append(local)
                 at += local.shape[0]
@@ -102,6 +107,9 @@ def _point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
         d, nz = band_point(data[0], data[1], pz)
         return d, 0.0, nz
     a, b = shapes.start[j], shapes.stop[j]
+    if code == INLET:
+        return inlet_point(wrap_period(pl - data[0], period), pz - data[1], data[2], data[3],
+                           shapes.vl[a:b], shapes.vz[a:b])  # fmt: skip
     return polygon_point(wrap_period(pl - data[0], period), pz, shapes.vl[a:b], shapes.vz[a:b])
 
 
@@ -117,6 +125,9 @@ def shape_segment(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
     a, b = shapes.start[j], shapes.stop[j]
     la = wrap_period(al - data[0], period)
     lb = la + wrap_period(bl - al, period)
+    if code == INLET:
+        return inlet_segment(la, az - data[1], lb, bz - data[1], data[2], data[3],
+                             shapes.vl[a:b], shapes.vz[a:b])  # fmt: skip
     return polygon_segment(la, az, lb, bz, shapes.vl[a:b], shapes.vz[a:b])
 
 
