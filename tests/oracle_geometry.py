@@ -3,9 +3,10 @@ and shapes of one's own (:class:`Shape` subclasses) built on them.
 
 dvqp measures its own shapes with compiled kernels only. These functions are the tests'
 second implementation (the circle and band from the package's NumPy code before the
-redesign, the polygon from plain edge geometry), and :class:`UserCircle`, :class:`UserBand`,
-:class:`UserPolygon` are what a user writes: a :class:`Shape` with NumPy ``point_distance``
-and ``segment_distance``. :func:`twin` gives the user shape of the same geometry as one of
+redesign, the polygon from plain edge geometry, the inlet's curve by a derivative-free
+search), and :class:`UserCircle`, :class:`UserBand`, :class:`UserPolygon`,
+:class:`UserInlet` are what a user writes: a :class:`Shape` with NumPy ``point_distance`` and
+``segment_distance``. :func:`twin` gives the user shape of the same geometry as one of
 dvqp's, so that a set of both can be compared row by row.
 """
 
@@ -278,15 +279,105 @@ class UserPolygon(Shape):
         return polygon_segments(self.vertices, a, b, period)
 
 
+# ---- inlet: the exact curve l = R asin(r cos φ / R), z = r sin φ, searched without derivatives --
+
+INLET_GRID = 512
+"""Outline points of the first search; the golden section refines the best one's bracket."""
+
+
+def _inlet_curve(phi: Array, r: float, big: float) -> Array:
+    return np.stack([big * np.arcsin(r * np.cos(phi) / big), r * np.sin(phi)], axis=-1)
+
+
+def inlet_points(center: Array, r: float, big: float, lz: Array, period: float
+                 ) -> tuple[Array, Array]:  # fmt: skip
+    """Nearest outline point of each point by a grid of φ then golden section on the squared
+    distance; inside where ``(R sin(Δl/R))² + Δz² < r²`` (|Δl| < πR/2)."""
+    p = np.asarray(lz, dtype=np.float64) - center
+    p[:, 0] = wrap(p[:, 0], period)
+    h = 2 * np.pi / INLET_GRID
+    grid = np.arange(INLET_GRID) * h
+    sq = ((_inlet_curve(grid, r, big)[None] - p[:, None]) ** 2).sum(axis=-1)
+    lo = grid[sq.argmin(axis=1)] - h
+    hi = lo + 2 * h
+    g = (math.sqrt(5) - 1) / 2
+
+    def dist2(phi: Array) -> Array:
+        return ((_inlet_curve(phi, r, big) - p) ** 2).sum(axis=-1)
+
+    for _ in range(64):
+        x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+        left = dist2(x1) < dist2(x2)
+        hi, lo = np.where(left, x2, hi), np.where(left, lo, x1)
+    off = p - _inlet_curve(0.5 * (lo + hi), r, big)
+    d = np.sqrt((off**2).sum(axis=1))
+    inside = (np.abs(p[:, 0]) < 0.5 * np.pi * big) & (
+        (big * np.sin(p[:, 0] / big)) ** 2 + p[:, 1] ** 2 < r * r)  # fmt: skip
+    sign = np.where(inside, -1.0, 1.0)
+    return sign * d, sign[:, None] * off / np.maximum(d, 1e-300)[:, None]
+
+
+def inlet_segments(center: Array, r: float, big: float, a: Array, b: Array, period: float
+                   ) -> tuple[Array, Array, Array]:  # fmt: skip
+    """Least signed distance along each segment: 129 samples, then golden section between the
+    best one's neighbours (the signed distance of a convex region is convex along a line)."""
+    b = short_way(a, b, period)
+    m = a.shape[0]
+
+    def along(t: Array) -> Array:  # t (m, s): the signed distances there, (m, s)
+        p = a[:, None] + t[..., None] * (b - a)[:, None]
+        return inlet_points(center, r, big, p.reshape(-1, 2), period)[0].reshape(t.shape)
+
+    ts = np.linspace(0, 1, 129)
+    k = along(np.tile(ts, (m, 1))).argmin(axis=1)
+    lo, hi = ts[np.maximum(k - 1, 0)], ts[np.minimum(k + 1, 128)]
+    g = (math.sqrt(5) - 1) / 2
+    for _ in range(60):
+        x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+        f = along(np.column_stack([x1, x2]))
+        left = f[:, 0] < f[:, 1]
+        hi, lo = np.where(left, x2, hi), np.where(left, lo, x1)
+    t = 0.5 * (lo + hi)
+    d, n = inlet_points(center, r, big, a + t[:, None] * (b - a), period)
+    return d, t, n
+
+
+@dataclass(frozen=True, eq=False)
+class UserInlet(Shape):
+    """An inlet of one's own (the curve of :class:`Inlet`), measured in NumPy."""
+
+    center: Array
+    radius: float
+    pipe_radius: float
+    weight: float = 1.0
+
+    @property
+    def size(self) -> float:
+        return self.radius
+
+    @property
+    def z_range(self) -> tuple[float, float]:
+        return self.center[1] - self.radius, self.center[1] + self.radius
+
+    def outline(self) -> Array:
+        return self.center + _inlet_curve(np.linspace(0, 2 * np.pi, 200), self.radius,
+                                          self.pipe_radius)  # fmt: skip
+
+    def point_distance(self, lz: Array, period: float) -> tuple[Array, Array]:
+        return inlet_points(self.center, self.radius, self.pipe_radius, lz, period)
+
+    def segment_distance(self, a: Array, b: Array, period: float) -> tuple[Array, Array, Array]:
+        return inlet_segments(self.center, self.radius, self.pipe_radius, a, b, period)
+
+
 def twin(shape: Shape) -> Shape:
-    """The user shape of the same geometry, weight and penalty size as one of dvqp's (an inlet
-    is its outline polygon, with the branch radius as its size)."""
+    """The user shape of the same geometry, weight and penalty size as one of dvqp's."""
     if isinstance(shape, Circle):
         return UserCircle(np.array(shape.center), shape.radius, shape.weight)
     if isinstance(shape, Band):
         return UserBand(shape.z_min, shape.z_max, shape.weight)
     if isinstance(shape, Inlet):
-        return UserPolygon(np.array(shape.polygon.vertices), shape.size, shape.weight)
+        return UserInlet(np.array(shape.center), shape.radius, shape.pipe_radius, shape.weight)
     if isinstance(shape, Polygon):
         return UserPolygon(np.array(shape.vertices), shape.size, shape.weight)
     raise TypeError(f"no twin for {type(shape).__name__}")

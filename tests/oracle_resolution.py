@@ -35,6 +35,7 @@ from dvqp.limits import (
     SurfaceHeight,
     TiltLimit,
 )
+from tests.oracle_geometry import inlet_points
 from tests.oracle_limits import (
     chord_low,
     closest_parts,
@@ -162,8 +163,8 @@ def point_distances(obstacles: Sequence[Shape], p: Array, period: float) -> Arra
             out.append(np.maximum(shape.z_min - p[:, 1], p[:, 1] - shape.z_max))
         elif type(shape) is Polygon:
             out.append(_polygon(np.asarray(shape.vertices), p, period))
-        elif type(shape) is Inlet:  # dvqp's outline polygon of the exact intersection curve
-            out.append(_polygon(np.asarray(shape.polygon.vertices), p, period))
+        elif type(shape) is Inlet:  # the exact intersection curve, searched in NumPy
+            out.append(inlet_points(shape.center, shape.radius, shape.pipe_radius, p, period)[0])
         else:
             raise TypeError(f"no oracle for {type(shape).__name__}")
     return np.array(out).reshape(len(out), p.shape[0])

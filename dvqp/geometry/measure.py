@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon, Shape
 from dvqp.geometry.shapes.band import band_point, band_segment
 from dvqp.geometry.shapes.circle import circle_point, circle_segment
+from dvqp.geometry.shapes.inlet import inlet_point, inlet_segment
 from dvqp.geometry.shapes.polygon import polygon_point, polygon_segment
 from dvqp.kinematics.developed_view import wrap_period
 from dvqp.workspace import ProximityBuffers
@@ -26,7 +27,7 @@ from solvers.jit import njit
 
 Array = NDArray[np.float64]
 
-CIRCLE, BAND, POLYGON, OTHER = 0, 1, 2, 3
+CIRCLE, BAND, POLYGON, OTHER, INLET = 0, 1, 2, 3, 4
 """Codes of the compiled shape kinds; OTHER is a shape of your own (measured in NumPy)."""
 
 
@@ -39,20 +40,29 @@ class ShapeArrays:
     period : float
         ``2πR``, m.
     code : (J,) int64
-        :data:`CIRCLE`, :data:`BAND`, :data:`POLYGON` (an inlet is its outline polygon) or
-        :data:`OTHER`.
-    data : (J, 3)
-        A circle's ``[l, z, r]``, a band's ``[z_min, z_max, 0]``, a polygon's ``[l_ref, 0, 0]``.
+        :data:`CIRCLE`, :data:`BAND`, :data:`POLYGON`, :data:`INLET` or :data:`OTHER`.
+    data : (J, 4)
+        A circle's ``[l, z, r, 0]``, a band's ``[z_min, z_max, 0, 0]``, a polygon's
+        ``[l_ref, 0, 0, 0]``, an inlet's ``[l0, z0, r, R]``.
     start, stop : (J,) int64
-        A polygon's vertices ``vl, vz[start:stop]``.
+        A polygon's vertices ``vl, vz[start:stop]``, an inlet's outline samples.
     vl, vz : (V,)
-        Every polygon's vertices, l measured from its ``l_ref``.
+        Every polygon's vertices, l measured from its ``l_ref``; every inlet's samples
+        (:attr:`~dvqp.geometry.shapes.Inlet.samples`, from its centre).
     size : (J,)
         ``ρ`` of each obstacle's penalty, m.
     refine : (J,)
         Below what clearance (m) a link's to each obstacle is measured on its real DV image to
         the last :data:`~dvqp.geometry.real_links.PRECISION` (its obstacle damper's margin,
         0 if none: ``inf`` until set; see :func:`~dvqp.geometry.real_links.real_links`).
+    box : (J, 4)
+        ``[l_lo, l_hi, z_lo, z_hi]`` (m) of each polygon and inlet, l from ``data[0]`` (a
+        circle's or a band's distance costs less than a box's: they have none).
+    far : (J,)
+        The broad phase (m): a part farther than this from a polygon's or an inlet's box gets
+        the box's distance and direction (a lower bound) instead of the exact row, unless
+        :func:`~dvqp.geometry.real_links.real_links` finds that the row may matter (``inf``,
+        the default: every row exact).
     """
 
     period: float
@@ -64,32 +74,42 @@ class ShapeArrays:
     vz: Array
     size: Array
     refine: Array
+    box: Array
+    far: Array
 
     @classmethod
     def of(cls, shapes: Sequence[Shape], period: float) -> ShapeArrays:
         """Pack ``shapes`` (dvqp's own classes compiled, any other :data:`OTHER`)."""
         count = len(shapes)
-        code, data = np.full(count, OTHER, np.int64), np.zeros((count, 3))
+        code, data = np.full(count, OTHER, np.int64), np.zeros((count, 4))
         start, stop = np.zeros(count, np.int64), np.zeros(count, np.int64)
         vertices: list[Array] = []
-        at = 0
+        box, at = np.zeros((count, 4)), 0
         for j, shape in enumerate(shapes):
             kind = type(shape)
             if kind is Circle:
-                code[j], data[j] = CIRCLE, (*shape.center, shape.radius)  # type: ignore[attr-defined]
+                code[j], data[j] = CIRCLE, (*shape.center, shape.radius, 0.0)  # type: ignore[attr-defined]
             elif kind is Band:
-                code[j], data[j] = BAND, (shape.z_min, shape.z_max, 0.0)  # type: ignore[attr-defined]
-            elif kind in (Polygon, Inlet):
-                polygon = shape.polygon if kind is Inlet else shape  # type: ignore[attr-defined]
-                local = polygon.local_vertices
-                code[j], data[j, 0] = POLYGON, polygon.l_ref
+                code[j], data[j] = BAND, (shape.z_min, shape.z_max, 0.0, 0.0)  # type: ignore[attr-defined]
+            elif kind is Inlet:
+                code[j], data[j] = INLET, (*shape.center, shape.radius, shape.pipe_radius)  # type: ignore[attr-defined]
+                local = shape.samples  # type: ignore[attr-defined]
+            elif kind is Polygon:
+                local = shape.local_vertices  # type: ignore[attr-defined]
+                code[j], data[j, 0] = POLYGON, shape.l_ref  # type: ignore[attr-defined]
+            if kind in (Polygon, Inlet):
+                low, high = local.min(axis=0), local.max(axis=0)
+                box[j] = (low[0], high[0], low[1], high[1])
+                if kind is Inlet:  # its samples hold the tips (φ = 0, π): the box is exact
+                    box[j, 2:] += data[j, 1]
                 start[j], stop[j] = at, at + local.shape[0]
                 vertices.append(local)
                 at += local.shape[0]
         packed = np.concatenate(vertices) if vertices else np.zeros((0, 2))
         vl, vz = np.ascontiguousarray(packed[:, 0]), np.ascontiguousarray(packed[:, 1])
         return cls(float(period), code, data, start, stop, vl, vz,
-                   np.array([s.size for s in shapes], float), np.full(count, math.inf))  # fmt: skip
+                   np.array([s.size for s in shapes], float), np.full(count, math.inf), box,
+                   np.full(count, math.inf))  # fmt: skip
 
 
 @njit
@@ -102,6 +122,9 @@ def _point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
         d, nz = band_point(data[0], data[1], pz)
         return d, 0.0, nz
     a, b = shapes.start[j], shapes.stop[j]
+    if code == INLET:
+        return inlet_point(wrap_period(pl - data[0], period), pz - data[1], data[2], data[3],
+                           shapes.vl[a:b], shapes.vz[a:b])  # fmt: skip
     return polygon_point(wrap_period(pl - data[0], period), pz, shapes.vl[a:b], shapes.vz[a:b])
 
 
@@ -117,28 +140,78 @@ def shape_segment(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
     a, b = shapes.start[j], shapes.stop[j]
     la = wrap_period(al - data[0], period)
     lb = la + wrap_period(bl - al, period)
+    if code == INLET:
+        return inlet_segment(la, az - data[1], lb, bz - data[1], data[2], data[3],
+                             shapes.vl[a:b], shapes.vz[a:b])  # fmt: skip
     return polygon_segment(la, az, lb, bz, shapes.vl[a:b], shapes.vz[a:b])
+
+
+@njit(inline="always")
+def _gap(lo, hi, a, b):  # type: ignore[no-untyped-def]
+    """How far the interval ``[min(a, b), max(a, b)]`` is from ``[lo, hi]`` (m), signed by
+    its side (0: they overlap)."""
+    if min(a, b) > hi:
+        return min(a, b) - hi
+    if max(a, b) < lo:
+        return max(a, b) - lo
+    return 0.0
+
+
+@njit
+def box_bound(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
+    """``(b, n_l, n_z)``: the distance (m) from the box of the segment ``a → b`` (a point if
+    ``a = b``) to obstacle j's box, a lower bound of its clearance, and its direction."""
+    box = shapes.box[j]
+    la = wrap_period(al - shapes.data[j, 0], shapes.period)
+    gl = _gap(box[0], box[1], la, la + wrap_period(bl - al, shapes.period))
+    gz = _gap(box[2], box[3], az, bz)
+    b = math.hypot(gl, gz)
+    return (b, gl / b, gz / b) if b > 0.0 else (0.0, 0.0, 0.0)
+
+
+@njit
+def point_row(shapes, j, chain, i, near, exact) -> None:  # type: ignore[no-untyped-def]
+    """Point i's row to obstacle j: exact, or (unless ``exact``) its box bound if that is
+    beyond ``shapes.far[j]``."""
+    pl, pz = chain[i, 0], chain[i, 1]
+    d, nl, nz = -1.0, 0.0, 0.0
+    if not exact and (shapes.code[j] == POLYGON or shapes.code[j] == INLET):
+        d, nl, nz = box_bound(shapes, j, pl, pz, pl, pz)
+    if d <= shapes.far[j]:
+        d, nl, nz = _point(shapes, j, pl, pz)
+    near.point_distance[j, i] = d
+    near.point_normal[j, i, 0], near.point_normal[j, i, 1] = nl, nz
+
+
+@njit
+def link_row(shapes, j, chain, i, near, exact) -> None:  # type: ignore[no-untyped-def]
+    """Link i's row to obstacle j, as :func:`point_row` (a box bound has ``t = 0``)."""
+    a, b = near.ends[i, 0], near.ends[i, 1]
+    al, az, bl, bz = chain[a, 0], chain[a, 1], chain[b, 0], chain[b, 1]
+    d, t, nl, nz = -1.0, 0.0, 0.0, 0.0
+    if not exact and (shapes.code[j] == POLYGON or shapes.code[j] == INLET):
+        d, nl, nz = box_bound(shapes, j, al, az, bl, bz)
+    if d <= shapes.far[j]:
+        d, t, nl, nz = shape_segment(shapes, j, al, az, bl, bz)
+    near.link_distance[j, i], near.link_t[j, i] = d, t
+    near.link_normal[j, i, 0], near.link_normal[j, i, 1] = nl, nz
 
 
 @njit
 def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
     """Distances and normals of the points ``chain`` (m; columns l, z, ...) and of the links
     ``near.ends`` between them to every compiled obstacle, into ``near`` (a packed
-    :class:`~dvqp.workspace.ProximityBuffers`); rows of :data:`OTHER` shapes are left alone."""
-    m, ends = chain.shape[0], near.ends
+    :class:`~dvqp.workspace.ProximityBuffers`); rows of :data:`OTHER` shapes are left alone.
+    A row farther than ``shapes.far`` from a polygon's or an inlet's box holds the box's
+    distance (the broad phase; :func:`~dvqp.geometry.real_links.real_links` measures those
+    that may matter)."""
     for j in range(shapes.code.shape[0]):
         if shapes.code[j] == OTHER:
             continue
-        for i in range(m):
-            d, nl, nz = _point(shapes, j, chain[i, 0], chain[i, 1])
-            near.point_distance[j, i] = d
-            near.point_normal[j, i, 0], near.point_normal[j, i, 1] = nl, nz
-        for i in range(ends.shape[0]):
-            a, b = ends[i, 0], ends[i, 1]
-            al, az, bl, bz = chain[a, 0], chain[a, 1], chain[b, 0], chain[b, 1]
-            d, t, nl, nz = shape_segment(shapes, j, al, az, bl, bz)
-            near.link_distance[j, i], near.link_t[j, i] = d, t
-            near.link_normal[j, i, 0], near.link_normal[j, i, 1] = nl, nz
+        for i in range(chain.shape[0]):
+            point_row(shapes, j, chain, i, near, False)
+        for i in range(near.ends.shape[0]):
+            link_row(shapes, j, chain, i, near, False)
 
 
 @njit

@@ -29,7 +29,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp.geometry.measure import OTHER, shape_segment
+from dvqp.geometry.measure import OTHER, link_row, point_row, shape_segment
 from dvqp.kinematics.state import KinematicState
 from dvqp.workspace import link_ends
 from solvers.jit import njit
@@ -91,25 +91,16 @@ def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ign
     (or, the probe's holder, of the probe and its holder: both are reported). Elsewhere, and
     for shapes of your own (:data:`OTHER`), the whole link is one piece: the straight row less
     the link's ``δ`` (in ``near.bends``), a bound below the truth by at most ``2 δ``, above
-    the margin and above the arm's closest part."""
-    ends, bends, points = near.ends, near.bends, near.point_distance
+    the margin and above the arm's closest part. Rows that the broad phase left at their box's
+    bound (beyond ``shapes.far``) are measured exactly first wherever they may matter."""
+    ends, bends = near.ends, near.bends
     for i in range(ends.shape[0]):
         a, b = origins[ends[i, 0]], origins[ends[i, 1]]
         bends[i] = radius * abs(link_bend(a[0], a[1], b[0], b[1])[0])
-    arm, probe = math.inf, math.inf  # above the closest part (the probe's), and its holder
-    for j in range(near.real_distance.shape[0]):
-        probe = min(probe, points[j, tool])
-        for p in range(points.shape[1]):
-            arm = min(arm, points[j, p])
-        for i in range(ends.shape[0]):
-            near.real_distance[j, i] = near.link_distance[j, i] - bends[i]
-            near.real_normal[j, i, 0] = near.link_normal[j, i, 0]
-            near.real_normal[j, i, 1] = near.link_normal[j, i, 1]
-            near.real_at[j, i], near.real_t0[j, i], near.real_t1[j, i] = (
-                near.link_t[j, i], 0.0, 1.0)  # fmt: skip
-            arm = min(arm, near.link_distance[j, i] + bends[i])
-            if ends[i, 1] == tool:
-                probe = min(probe, near.link_distance[j, i] + bends[i])
+    arm, probe = _closest(shapes, near, tool)
+    if np.isfinite(shapes.far).any():
+        arm, probe = _seed(shapes, chain, near, tool, arm, probe)
+        arm, probe = _broad(shapes, chain, near, tool, arm, probe)
     for j in range(near.real_distance.shape[0]):
         if shapes.code[j] == OTHER:
             continue
@@ -120,6 +111,86 @@ def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ign
             ):
                 a, b = origins[ends[i, 0]], origins[ends[i, 1]]
                 _pieces(shapes, j, i, a, b, chain[ends[i, 0], 0], radius, near)
+
+
+@njit
+def _closest(shapes, near, tool):  # type: ignore[no-untyped-def]
+    """Every link's row as one piece (its straight row less its bend), and ``(arm, probe)``:
+    bounds above the clearance of the arm's closest part and of the probe or its holder, over
+    the exact rows (those not beyond ``shapes.far``)."""
+    ends, bends, points = near.ends, near.bends, near.point_distance
+    arm, probe = math.inf, math.inf
+    for j in range(near.real_distance.shape[0]):
+        far = shapes.far[j]
+        for p in range(points.shape[1]):
+            if points[j, p] <= far:
+                arm = min(arm, points[j, p])
+                probe = min(probe, points[j, p]) if p == tool else probe
+        for i in range(ends.shape[0]):
+            _one_piece(near, j, i)
+            if near.link_distance[j, i] <= far:
+                arm = min(arm, near.link_distance[j, i] + bends[i])
+                if ends[i, 1] == tool:
+                    probe = min(probe, near.link_distance[j, i] + bends[i])
+    return arm, probe
+
+
+@njit(inline="always")
+def _one_piece(near, j, i) -> None:  # type: ignore[no-untyped-def]
+    """Link i's real row to obstacle j as one piece: its straight row less its bend."""
+    near.real_distance[j, i] = near.link_distance[j, i] - near.bends[i]
+    near.real_normal[j, i, 0] = near.link_normal[j, i, 0]
+    near.real_normal[j, i, 1] = near.link_normal[j, i, 1]
+    near.real_at[j, i], near.real_t0[j, i], near.real_t1[j, i] = near.link_t[j, i], 0.0, 1.0
+
+
+@njit
+def _seed(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-def]
+    """Where no exact row bounds the arm (or the probe): the point row of least box bound
+    measured exactly, so that :func:`_broad` has a bound to compare with."""
+    points = near.point_distance
+    for which in range(2):
+        if (arm if which == 0 else probe) < math.inf:
+            continue
+        best, bj, bp = math.inf, -1, -1
+        lo, hi = (0, points.shape[1]) if which == 0 else (tool, tool + 1)
+        for j in range(points.shape[0]):
+            for p in range(lo, hi):
+                if points[j, p] > shapes.far[j] and points[j, p] < best:
+                    best, bj, bp = points[j, p], j, p
+        if bj >= 0:
+            point_row(shapes, bj, chain, bp, near, True)
+            arm = min(arm, points[bj, bp])
+            probe = min(probe, points[bj, bp]) if bp == tool else probe
+    return arm, probe
+
+
+@njit
+def _broad(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-def]
+    """Measure exactly every row left at its box's bound (beyond ``shapes.far``) that may
+    matter: a point whose bound is below the arm's (probe's) closest part, a link whose bound
+    less its bend is below that, below ``far`` or may need refining (:func:`real_links`)."""
+    ends, bends, points, links = near.ends, near.bends, near.point_distance, near.link_distance
+    for j in range(points.shape[0]):
+        far = shapes.far[j]
+        if far == math.inf:
+            continue
+        for p in range(points.shape[1]):
+            if far < points[j, p] < (probe if p == tool else arm):
+                point_row(shapes, j, chain, p, near, True)
+                arm = min(arm, points[j, p])
+                probe = min(probe, points[j, p]) if p == tool else probe
+        for i in range(ends.shape[0]):
+            d = links[j, i] - bends[i]
+            reported = probe if ends[i, 1] == tool else arm
+            if links[j, i] > far and (d <= far or d < shapes.refine[j] + 2.0 * bends[i]
+                                      or d < reported):  # fmt: skip
+                link_row(shapes, j, chain, i, near, True)
+                _one_piece(near, j, i)
+                arm = min(arm, links[j, i] + bends[i])
+                if ends[i, 1] == tool:
+                    probe = min(probe, links[j, i] + bends[i])
+    return arm, probe
 
 
 @njit

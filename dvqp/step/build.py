@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from dvqp.errors import ParameterError
-from dvqp.geometry.measure import ShapeArrays
+from dvqp.geometry.measure import INLET, POLYGON, ShapeArrays
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.shapes import Shape
 from dvqp.kinematics.robot import Robot
@@ -254,9 +254,14 @@ def lay_out(robot: Robot, radius: float, resolver: Resolver, q0: ArrayLike, dt: 
     m = layout.measures  # each obstacle's links measured to the last precision below its margin
     dampers = [d for d in spec.limits if type(d) is ObstacleDamper and len(d.obstacles)]
     shapes.refine[:] = 0.0
+    far = np.zeros(len(layout.shapes))  # the broad phase: exact rows up to every damper's reach
     for o, damper in enumerate(dampers):
         rows = m.obstacle_members[m.obstacle_offsets[o] : m.obstacle_offsets[o + 1]]
         shapes.refine[rows] = np.maximum(shapes.refine[rows], damper.safe)
+        far[rows] = np.maximum(far[rows], damper.reach)
+    if not layout.hooks.active:  # parts of your own may read any row: every row exact
+        boxed = (shapes.code == POLYGON) | (shapes.code == INLET)
+        shapes.far[boxed] = far[boxed]
     layout.hooks.finalize(layout.shapes, shapes.code, layout.params, layout.damper_values)
     fields = [f for f in RecordArrays.__dataclass_fields__ if f != "index"]
     record = (RecordArrays.none(n, k) if samples is None else

@@ -2,13 +2,15 @@
 
 A tube of radius ``r < R`` whose axis meets the pipe axis at ``(l0, z0)`` at a right angle
 cuts the pipe surface along ``(R sin((l − l0)/R))² + (z − z0)² = r²``: a circle stretched in l,
-``Δl = R asin(r cos φ / R)``, ``Δz = r sin φ``. The outline is represented by a polygon of
-:data:`VERTICES` points on that curve, whose chords lie within ``r (1 − cos(π/N))`` of it
-(5.6 µm for r = 7.5 cm): distances are exact to that.
+``Δl = R asin(r cos φ / R)``, ``Δz = r sin φ``: a convex curve (each direction is the
+tangent at exactly two points, see :func:`inlet_segment`). Its compiled distances
+(:func:`inlet_point`, :func:`inlet_segment`) measure that curve itself, in the inlet's local
+frame (l and z from its centre, l wrapped): no polygon stands for it.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -17,11 +19,18 @@ from numpy.typing import NDArray
 
 from dvqp import _validate
 from dvqp.errors import ParameterError
-from dvqp.geometry.shapes.polygon import Polygon
 from dvqp.geometry.shapes.shape import Array, Shape
+from solvers.jit import njit
 
-VERTICES = 256
-"""Points of the polygon that stands for the outline."""
+SAMPLES = 32
+"""Outline points, at ``φ = 2πk/SAMPLES``, that bracket the nearest point's parameter."""
+NEWTON_STEPS = 40
+GOLDEN_STEPS = 60
+INV_PHI = (math.sqrt(5.0) - 1.0) / 2.0
+_ON = 1e-14
+"""m: a point this close to the outline is on it (its normal: the outline's)."""
+_POINT2 = 1e-18
+"""m²: a shorter segment is a point (its nearer end)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -48,7 +57,7 @@ class Inlet(Shape):
     SCENE_FIELDS: ClassVar[dict[str, tuple[str, Any]]] = {
         "center": ("point", None), "radius": ("length", None), "weight": ("weight", 1.0),
     }  # fmt: skip
-    polygon: Polygon = field(init=False, repr=False)
+    samples: Array = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         center = _validate.readonly(_validate.vector("center", self.center, 2))
@@ -60,7 +69,8 @@ class Inlet(Shape):
                                  f"{big:g} m")  # fmt: skip
         object.__setattr__(self, "radius", r)
         object.__setattr__(self, "weight", _validate.positive("weight", self.weight, strict=False))
-        object.__setattr__(self, "polygon", Polygon(self.curve(VERTICES), self.weight))
+        samples = _validate.readonly(self.curve(SAMPLES) - self.center)
+        object.__setattr__(self, "samples", samples)
 
     def curve(self, count: int) -> Array:
         """``count`` points of the exact outline, counter-clockwise, not closed, m."""
@@ -88,3 +98,156 @@ class Inlet(Shape):
         """512 points of the exact outline, closed."""
         points = self.curve(512)
         return np.vstack([points, points[:1]])
+
+
+@njit(inline="always")
+def _curve(phi, r, big):  # type: ignore[no-untyped-def]
+    """``(Δl, Δz, Δl', Δz', Δl'', Δz'')`` of the outline at ``φ`` (m, m/rad, m/rad²)."""
+    c, s = math.cos(phi), math.sin(phi)
+    k = r * c / big
+    root = math.sqrt(1.0 - k * k)
+    dl1 = -r * s / root
+    dl2 = -r * c / root + r * r * r * c * s * s / (big * big * root * root * root)
+    return big * math.asin(k), r * s, dl1, r * c, dl2, -r * s
+
+
+@njit(inline="always")
+def _slope(phi, pl, pz, r, big):  # type: ignore[no-untyped-def]
+    """``(½ D', ½ D'')`` of ``D(φ) = ‖c(φ) − p‖²``."""
+    dl, dz, l1, z1, l2, z2 = _curve(phi, r, big)
+    ol, oz = dl - pl, dz - pz
+    return ol * l1 + oz * z1, l1 * l1 + z1 * z1 + ol * l2 + oz * z2
+
+
+@njit
+def _nearest(pl, pz, r, big, x, lo, hi):  # type: ignore[no-untyped-def]
+    """The ``φ`` in ``(lo, hi)`` where ``D' = 0``, by Newton's method from ``x``; ``nan`` if a
+    step would leave the bracket or ``D'' ≤ 0`` (then :func:`_golden` searches it)."""
+    for _ in range(NEWTON_STEPS):
+        f, fp = _slope(x, pl, pz, r, big)
+        if not fp > 0.0:
+            return math.nan
+        step = f / fp
+        x -= step
+        if not lo < x < hi:
+            return math.nan
+        if abs(step) < 1e-10:
+            return x
+    return x
+
+
+@njit
+def _golden(pl, pz, r, big, lo, hi):  # type: ignore[no-untyped-def]
+    """A least ``D`` in ``[lo, hi]`` by golden section (where the bracket is not clean)."""
+    for _ in range(GOLDEN_STEPS):
+        x1, x2 = hi - INV_PHI * (hi - lo), lo + INV_PHI * (hi - lo)
+        a1, b1 = _curve(x1, r, big)[:2]
+        a2, b2 = _curve(x2, r, big)[:2]
+        if (a1 - pl) ** 2 + (b1 - pz) ** 2 < (a2 - pl) ** 2 + (b2 - pz) ** 2:
+            hi = x2
+        else:
+            lo = x1
+    return 0.5 * (lo + hi)
+
+
+@njit
+def inlet_point(pl, pz, r, big, sl, sz):  # type: ignore[no-untyped-def]
+    """``(d, ∂d/∂l, ∂d/∂z)`` of the point ``(pl, pz)`` (m, from the centre, l wrapped) to the
+    outline of branch radius ``r`` on a pipe of radius ``big``, negative inside. ``sl, sz``
+    ((S,) each) are its points at ``φ_k = 2πk/S``: each one nearer than both neighbours
+    brackets a local least distance, found by Newton's method on ``D'(φ) = 0``; the least of
+    them is the distance, its normal ``(p − c)/‖p − c‖`` (the outline's outward normal on it).
+    ``p − c`` is normal to the outline at the nearest point ``c``: ``p`` is inside where it
+    points along the inward normal (the region is convex)."""
+    n, h = sl.shape[0], 2.0 * math.pi / sl.shape[0]
+    best, phi = math.inf, 0.0
+    before = (sl[n - 1] - pl) ** 2 + (sz[n - 1] - pz) ** 2
+    here = (sl[0] - pl) ** 2 + (sz[0] - pz) ** 2
+    for k in range(n):
+        j = k + 1 if k + 1 < n else 0
+        after = (sl[j] - pl) ** 2 + (sz[j] - pz) ** 2
+        if here <= before and here <= after:
+            x = _nearest(pl, pz, r, big, k * h, (k - 1) * h, (k + 1) * h)
+            if x != x:  # nan: no clean Newton's step
+                x = _golden(pl, pz, r, big, (k - 1) * h, (k + 1) * h)
+            dl, dz = _curve(x, r, big)[:2]
+            d2 = (dl - pl) ** 2 + (dz - pz) ** 2
+            if d2 < best:
+                best, phi = d2, x
+        before, here = here, after
+    dl, dz, l1, z1, _, _ = _curve(phi, r, big)
+    d = math.sqrt(best)
+    sign = -1.0 if (pl - dl) * z1 - (pz - dz) * l1 < 0.0 else 1.0  # p − c along the normal?
+    if d > _ON:
+        return sign * d, sign * (pl - dl) / d, sign * (pz - dz) / d
+    norm = math.hypot(l1, z1)
+    return 0.0, z1 / norm, -l1 / norm
+
+
+@njit
+def _support(nl, nz, r, big):  # type: ignore[no-untyped-def]
+    """``(Δl, Δz)`` of the outline point whose tangent is perpendicular to the unit ``n`` and
+    where ``n`` points out (the other is ``(−Δl, −Δz)``)."""
+    k2 = (r / big) ** 2 * nz * nz
+    x2 = min(2.0 * nl * nl / (1.0 + math.sqrt(max(1.0 - 4.0 * k2 * nl * nl, 0.0))), 1.0)
+    c = math.sqrt(x2)
+    s = math.sqrt(1.0 - x2)
+    if nz * nl < 0.0:
+        s = -s
+    dl, dz = big * math.asin(r * c / big), r * s
+    return (dl, dz) if nl * dl + nz * dz >= 0.0 else (-dl, -dz)
+
+
+@njit
+def _deepest(al, az, el, ez, r, big, sl, sz):  # type: ignore[no-untyped-def]
+    """A segment that enters: the least signed distance along it (convex, the region being
+    convex: golden section), ``(d, t, ∂d/∂l, ∂d/∂z)``."""
+    lo, hi = 0.0, 1.0
+    for _ in range(GOLDEN_STEPS):
+        x1, x2 = hi - INV_PHI * (hi - lo), lo + INV_PHI * (hi - lo)
+        f1 = inlet_point(al + x1 * el, az + x1 * ez, r, big, sl, sz)[0]
+        f2 = inlet_point(al + x2 * el, az + x2 * ez, r, big, sl, sz)[0]
+        if f1 < f2:
+            hi = x2
+        else:
+            lo = x1
+    t = 0.5 * (lo + hi)
+    d, nl, nz = inlet_point(al + t * el, az + t * ez, r, big, sl, sz)
+    return d, t, nl, nz
+
+
+@njit
+def inlet_segment(al, az, bl, bz, r, big, sl, sz):  # type: ignore[no-untyped-def]
+    """``(d, t, ∂d/∂l, ∂d/∂z)`` of the segment ``a → b`` (local, as :func:`inlet_point`).
+
+    The tangent is parallel to ``e = b − a`` where ``cos² φ = X`` solves
+    ``k² n_z² X² − X + n_l² = 0`` (``n ⊥ e`` a unit vector, ``k = r/R``): one root in
+    [0, 1], two antipodal points, so the outline is convex. Outside it, the segment is closest
+    at an end or, at an interior point, to one of those two points. It enters the region if an
+    end is inside, or if its line passes between the two points while ``a``'s normal faces
+    along ``e`` and ``b``'s against it (the region then lies on the line between them); then
+    the deepest point is found by golden section (to 1e-12 of the length)."""
+    da, nal, naz = inlet_point(al, az, r, big, sl, sz)
+    db, nbl, nbz = inlet_point(bl, bz, r, big, sl, sz)
+    el, ez = bl - al, bz - az
+    res = (da, 0.0, nal, naz) if da <= db else (db, 1.0, nbl, nbz)
+    if el * el + ez * ez < _POINT2:
+        return res
+    length = math.hypot(el, ez)
+    if da <= 0.0 or db <= 0.0:
+        return _deepest(al, az, el, ez, r, big, sl, sz)
+    nl, nz = -ez / length, el / length
+    cl, cz = _support(nl, nz, r, big)
+    ga = el * (cz - az) - ez * (cl - al)  # sides of the line of the two support points
+    gb = el * (-cz - az) - ez * (-cl - al)
+    if ga * gb < 0.0 and nal * el + naz * ez < 0.0 and nbl * el + nbz * ez > 0.0:
+        return _deepest(al, az, el, ez, r, big, sl, sz)
+    for side in (1.0, -1.0):
+        ql, qz = side * cl, side * cz
+        t = ((ql - al) * el + (qz - az) * ez) / (length * length)
+        if 0.0 < t < 1.0:
+            ol, oz = al + t * el - ql, az + t * ez - qz
+            d = math.hypot(ol, oz)
+            if d < res[0]:  # touching (d <= _ON): the outline's normal there, ±n
+                res = (d, t, ol / d, oz / d) if d > _ON else (d, t, side * nl, side * nz)
+    return res
