@@ -86,10 +86,8 @@ def dask_client(scheduler: str, workers: int = 1) -> Iterator[tuple[Any, Where]]
         ``scheduler <address>: cannot connect: <reason>``, or ``… no worker within 10 s``.
     """
     dd = import_distributed()
-    logger = logging.getLogger("distributed")
     with contextlib.ExitStack() as stack:
-        stack.callback(logger.setLevel, logger.level)
-        logger.setLevel(logging.ERROR)  # no info lines on the cluster's start and stop
+        _quiet_logs(stack)
         try:
             if scheduler == "local":
                 cluster = stack.enter_context(
@@ -108,6 +106,19 @@ def dask_client(scheduler: str, workers: int = 1) -> Iterator[tuple[Any, Where]]
             raise DvqpError(f"scheduler {scheduler}: no worker within {WORKER_WAIT:g} s") from exc
         threads = int(sum(client.nthreads().values()))
         yield client, Where("dask", threads, scheduler)
+
+
+def _quiet_logs(stack: contextlib.ExitStack) -> None:
+    """Distributed's loggers (each has its own level) to ERROR and asyncio's off for the
+    stack's life: no info lines on the cluster's start and stop, no warning when a result must
+    be recomputed, no "Task exception was never retrieved" for a fetch given up; what matters
+    reaches the user as dvqp's own lines."""
+    names = [n for n in logging.root.manager.loggerDict if n.split(".")[0] == "distributed"]
+    for name, level in [*((n, logging.ERROR) for n in ["distributed", *names]),
+                        ("asyncio", logging.CRITICAL + 1)]:  # fmt: skip
+        logger = logging.getLogger(name)
+        stack.callback(logger.setLevel, logger.level)
+        logger.setLevel(level)
 
 
 def run_dask(
