@@ -107,7 +107,8 @@ def make_resolver(name: str, spec: StepSpec, options: dict[str, Any] | None = No
     BackendError
         Unknown or not installed (see :func:`check_name`), or settings it does not take.
     """
-    check_options(name, options or {})
+    check_name(name)
     if name == PINV:
+        check_options(name, options or {})  # none
         return PseudoinverseResolver(spec)
-    return QPResolver(spec, name, options)
+    return QPResolver(spec, name, options)  # makes its backend once: the settings checked there
