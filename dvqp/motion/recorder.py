@@ -65,12 +65,14 @@ class TrajectoryRecorder:
     def trajectory(self, dt: float, pipe_radius: float, backend: str, steps: int | None = None,
                    brake_start: int = -1,
                    start_broken: tuple[StartBroken, ...] = (),
-                   refusals: dict[str, int] | None = None) -> Trajectory:  # fmt: skip
+                   refusals: dict[str, int] | None = None,
+                   accuracy: dict[str, float] | None = None) -> Trajectory:  # fmt: skip
         """The first ``steps`` (default all) recorded steps and their samples (l and α
         unwrapped), with ``qddot``: the change of joint velocity at the start of each step over
         dt (the run starts at rest), rad/s²; ``brake_start`` the first braking step (−1: none);
         the limits the start broke (:meth:`dvqp.step.Stepper.start_broken`); the backend calls
-        refused, by kind (:attr:`dvqp.resolution.qp.QPSolver.refusals`)."""
+        refused, by kind (:attr:`dvqp.resolution.qp.QPSolver.refusals`), and their accuracy
+        (:meth:`solvers.accuracy.AccuracyTally.to_dict`)."""
         n = self.arrays["qdot"].shape[0]
         steps = n if steps is None else steps
         kept = {name: a[: max(steps + a.shape[0] - n, 0)] for name, a in self.arrays.items()}
@@ -79,5 +81,5 @@ class TrajectoryRecorder:
         return Trajectory.from_samples(
             dt=dt, pipe_radius=pipe_radius, backend=backend, status=self.status[:steps],
             qddot=(qdot - before) / dt, brake_start=brake_start, start_broken=start_broken,
-            refusals=dict(refusals or {}), **kept,
+            refusals=dict(refusals or {}), accuracy=dict(accuracy or {}), **kept,
         )  # fmt: skip

@@ -165,7 +165,9 @@ def simulate(
             progress(i + 1, cmd.shape[0])
     steps = brake(stepper, record, cmd.shape[0], dt, verify=check,
                   max_halvings=max_halvings) if stop else 0  # fmt: skip
-    refused = {} if stepper.solver is None else dict(stepper.solver.refusals)
+    solver = stepper.solver
+    refused = {} if solver is None else dict(solver.refusals)
+    accuracy = {} if solver is None else solver.accuracy.to_dict()
     braked = cmd.shape[0] if stop else -1
     return record.trajectory(dt, radius, resolver.name, cmd.shape[0] + steps, braked,
-                             stepper.start_broken(), refused)  # fmt: skip
+                             stepper.start_broken(), refused, accuracy)  # fmt: skip

@@ -114,6 +114,10 @@ class Trajectory:
         QP backend calls that gave no accepted answer, by kind (``"infeasible"``,
         ``"iteration limit"``, ``"inaccurate"``…, :data:`solvers.REFUSALS`); the step then
         took the relaxed or braking path (empty: none, the baseline, or an older file).
+    accuracy : dict of str to float
+        qpbenchmark's accuracy of the QP backend calls (:mod:`solvers.accuracy`): ``solves``,
+        ``unanswered`` and the shifted geometric means ``primal_residual``, ``dual_residual``,
+        ``duality_gap`` (empty: the baseline, or an older file).
     """
 
     t: NDArray[np.float64]
@@ -147,6 +151,7 @@ class Trajectory:
     start_broken: tuple[StartBroken, ...] = ()
     brake_start: int = -1
     refusals: dict[str, int] = field(default_factory=dict)
+    accuracy: dict[str, float] = field(default_factory=dict)
 
     @classmethod
     def from_samples(
@@ -232,6 +237,7 @@ class Trajectory:
                     start_broken=np.str_(json.dumps([asdict(b) for b in self.start_broken])),
                     brake_start=np.int64(self.brake_start),
                     refusals=np.str_(json.dumps(self.refusals)),
+                    accuracy=np.str_(json.dumps(self.accuracy)),
                     meta=np.str_(json.dumps({"versions": versions(), **CONVENTIONS})),
                 )
             else:
@@ -269,7 +275,8 @@ class Trajectory:
                     pipe_radius=float(data["pipe_radius"]),
                     scene_text=str(data["scene"]),
                     brake_start=int(data["brake_start"]) if "brake_start" in data else -1,
-                    refusals=_refusals(data),
+                    refusals=_counts(data, "refusals"),
+                    accuracy=_counts(data, "accuracy"),
                 )
         except OSError as exc:
             reason = exc.strerror or type(exc).__name__
@@ -280,11 +287,13 @@ class Trajectory:
             raise DvqpError(f"{path}: not a dvqp trajectory ({reason})") from exc
 
 
-def _refusals(data: Any) -> dict[str, int]:
-    """The ``refusals`` of a loaded file (none in a file written before they were counted)."""
-    if "refusals" not in data:
+def _counts(data: Any, name: str) -> dict[str, Any]:
+    """The JSON object ``name`` of a loaded file, values as numbers (``{}``: a file written
+    before it was recorded)."""
+    if name not in data:
         return {}
-    counts = json.loads(str(data["refusals"]))
+    counts = json.loads(str(data[name]))
     if not isinstance(counts, dict):
-        raise ValueError("refusals")
-    return {str(kind): int(count) for kind, count in counts.items()}
+        raise ValueError(name)
+    number = int if name == "refusals" else float
+    return {str(key): number(value) for key, value in counts.items()}

@@ -35,6 +35,10 @@ from dvqp.errors import BackendError
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 from dvqp.workspace import QPBuffers
+from solvers.accuracy import AccuracyTally
+
+#: A watcher of the backend calls: ``(kind, problem, solution)``, kind ``"strict"``/``"relaxed"``.
+Watcher = Callable[[str, solvers.Problem, solvers.Solution], None]
 
 
 def make_backend(name: str, **options: Any) -> solvers.Backend:
@@ -127,6 +131,11 @@ class QPSolver:
         self.refusals: Counter[str] = Counter()
         """Backend calls that gave no accepted answer, by :attr:`solvers.Solution.refusal`
         (the step then took the relaxed or braking path)."""
+        self.accuracy = AccuracyTally()
+        """qpbenchmark's accuracy metrics of every backend call (:mod:`solvers.accuracy`)."""
+        self.watchers: list[Watcher] = []
+        """Called after every backend call with ``("strict" | "relaxed", problem, solution)``;
+        the problem's arrays are rewritten by the next step: a watcher copies what it keeps."""
 
     def solve(self, rest: bool = False) -> Answer:
         """Strict, else relaxed, else braking (``x`` a view, valid until the next solve).
@@ -141,19 +150,26 @@ class QPSolver:
             return Answer(np.zeros_like(qp.cost), "optimal", 0, 0.0)
         strict, relaxed = self.backends
         solution = strict.solve(self.strict)
+        self._count("strict", self.strict, solution)
         spent, status = solution.solver_time, "optimal"
         if not solution.found:
-            self.refusals[solution.refusal] += 1
             self._load_relaxed()
             solution = relaxed.solve(self.relaxed)
+            self._count("relaxed", self.relaxed, solution)
             spent, status = spent + solution.solver_time, "relaxed"
-            if not solution.found:
-                self.refusals[solution.refusal] += 1
         if solution.found and solution.x is not None:
             return Answer(solution.x[: qp.cost.shape[0]], status, solution.iterations, spent)
         if np.any(qp.lb > qp.ub):
             return Answer(None, f"failed: {solution.message}", solution.iterations, spent)
         return Answer(np.clip(0.0, qp.lb, qp.ub), "braking", solution.iterations, spent)
+
+    def _count(self, kind: str, problem: solvers.Problem, solution: solvers.Solution) -> None:
+        """Tally one backend call (refusal, accuracy) and show it to the watchers."""
+        if not solution.found:
+            self.refusals[solution.refusal] += 1
+        self.accuracy.add(solution)
+        for watch in self.watchers:
+            watch(kind, problem, solution)
 
     def _load_relaxed(self) -> None:
         """Copy the strict problem's data into the relaxed one's ``Q̇`` columns."""
@@ -165,7 +181,8 @@ class QPSolver:
             r.G[:, :n] = qp.G
 
     def reset(self) -> None:
-        """Forget the backends' warm starts and the refusals counted (a run starts)."""
+        """Forget the backends' warm starts, the refusals and accuracy counted (a run starts)."""
         self.refusals.clear()
+        self.accuracy = AccuracyTally()
         for backend in self.backends:
             backend.reset()

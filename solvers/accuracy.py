@@ -1,0 +1,160 @@
+r"""qpbenchmark's accuracy metrics of a solve, and their shifted geometric means.
+
+For a solution ``(x, y, z, z_box)`` of ``min ½xᵀPx + qᵀx  s.t.  Ax = b, Gx ≤ h, lb ≤ x ≤ ub``
+(the multiplier signs of :mod:`solvers.residuals`), as qpbenchmark defines them:
+
+.. math::
+
+    r_p &= \max(\|Ax - b\|_\infty, [Gx - h]^+, [lb - x]^+, [x - ub]^+) \\
+    r_d &= \|Px + q + A^T y + G^T z + z_{box}\|_\infty \\
+    r_g &= |x^T P x + q^T x + b^T y + h^T z + lb^T z_{box}^- + ub^T z_{box}^+|
+
+Rows with an infinite ``h`` or bound are left out of ``r_g`` (their multiplier must be 0; the
+complementarity check of :func:`solvers.residuals.failed_checks` refuses one that is not).
+All three are computed from the problem data, never taken from the solver.
+
+A run's figure is the shifted geometric mean ``exp(mean(log(v + s))) − s`` with qpbenchmark's
+shift ``s = 10``; a solve without an accepted answer counts as the tolerance of its check
+(qpbenchmark counts an unsolved problem at its tier's tolerance). :class:`AccuracyTally` keeps
+the sums, so tallies of many runs merge exactly.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .solution import Solution
+
+#: qpbenchmark's shift of the shifted geometric mean.
+SHIFT = 10.0
+
+#: The metrics, in order: primal residual, dual residual, duality gap.
+METRICS = ("primal_residual", "dual_residual", "duality_gap")
+
+
+def duality_gap(solution: Solution) -> float | None:
+    """``r_g`` of an answer from its problem's data (None without ``x`` or a multiplier).
+
+    Parameters
+    ----------
+    solution : Solution
+        An answer with ``x`` and every multiplier its problem needs.
+
+    Returns
+    -------
+    float or None
+        The absolute duality gap, in the cost's units.
+    """
+    p, x = solution.problem, solution.x
+    if x is None:
+        return None
+    gap = float(x @ p.P @ x + p.q @ x)
+    if p.A is not None:
+        if solution.y is None:
+            return None
+        gap += float(p.b @ solution.y)
+    if p.G is not None:
+        if solution.z is None:
+            return None
+        finite = np.isfinite(p.h)
+        gap += float(p.h[finite] @ solution.z[finite])
+    if p.lb is not None or p.ub is not None:
+        if solution.z_box is None:
+            return None
+        gap += _bound_term(p.lb, np.minimum(solution.z_box, 0.0))
+        gap += _bound_term(p.ub, np.maximum(solution.z_box, 0.0))
+    return abs(gap)
+
+
+def _bound_term(bound: np.ndarray | None, multiplier: np.ndarray) -> float:
+    if bound is None:
+        return 0.0
+    finite = np.isfinite(bound)
+    return float(bound[finite] @ multiplier[finite])
+
+
+def metrics(solution: Solution) -> tuple[float, float, float] | None:
+    """``(r_p, r_d, r_g)`` of an accepted answer; None if it was not accepted or lacks a
+    multiplier (it then counts at its tolerance, see :meth:`AccuracyTally.add`)."""
+    res = solution.residuals
+    if not solution.found or res is None or res.stationarity is None:
+        return None
+    gap = duality_gap(solution)
+    if gap is None:
+        return None
+    return max(res.equality, res.inequality, res.bounds), res.stationarity, gap
+
+
+def shifted_geometric_mean(values: np.ndarray | list[float], shift: float = SHIFT) -> float:
+    """``exp(mean(log(v + shift))) − shift``, computed as ``shift·expm1(mean(log1p(v/shift)))``
+    so that residuals far below ``shift`` keep their digits.
+
+    Raises
+    ------
+    ValueError
+        No value, a negative or non-finite one, or ``shift < 1`` (qpbenchmark's condition).
+    """
+    array = np.asarray(values, dtype=np.float64)
+    if array.size == 0 or not np.all(np.isfinite(array)) or np.any(array < 0.0):
+        raise ValueError("shifted geometric mean: needs finite values >= 0")
+    if shift < 1.0:
+        raise ValueError(f"shifted geometric mean: shift {shift} < 1")
+    return float(shift * math.expm1(float(np.mean(np.log1p(array / shift)))))
+
+
+@dataclass
+class AccuracyTally:
+    """Running shifted geometric means of the metrics over solves (and over runs, merged).
+
+    Attributes
+    ----------
+    solves : int
+        Backend calls counted.
+    unanswered : int
+        Of those, the calls counted at their tolerance (no accepted answer with multipliers).
+    log_sums : list of float
+        ``Σ log1p(v / SHIFT)`` per metric, in :data:`METRICS` order.
+    """
+
+    solves: int = 0
+    unanswered: int = 0
+    log_sums: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+    def add(self, solution: Solution) -> None:
+        """Count one backend call: its metrics, or its check's tolerance if unanswered."""
+        values = metrics(solution)
+        if values is None:
+            self.unanswered += 1
+            values = (solution.tolerance,) * 3
+        self.solves += 1
+        for i, value in enumerate(values):
+            self.log_sums[i] += math.log1p(value / SHIFT)
+
+    def merge(self, other: AccuracyTally) -> None:
+        """Add another tally's solves (e.g. another run's)."""
+        self.solves += other.solves
+        self.unanswered += other.unanswered
+        self.log_sums = [a + b for a, b in zip(self.log_sums, other.log_sums, strict=True)]
+
+    def means(self) -> dict[str, float] | None:
+        """Shifted geometric mean of each metric (None: no solve counted)."""
+        if not self.solves:
+            return None
+        return {name: SHIFT * math.expm1(total / self.solves)
+                for name, total in zip(METRICS, self.log_sums, strict=True)}  # fmt: skip
+
+    def to_dict(self) -> dict[str, float | int]:
+        """JSON-ready: ``solves``, ``unanswered`` and the three means (none if no solve)."""
+        return {"solves": self.solves, "unanswered": self.unanswered, **(self.means() or {})}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, float | int]) -> AccuracyTally:
+        """The tally :meth:`to_dict` wrote (its means turned back into sums)."""
+        solves = int(data.get("solves", 0))
+        tally = cls(solves, int(data.get("unanswered", 0)))
+        if solves:
+            tally.log_sums = [solves * math.log1p(float(data[name]) / SHIFT) for name in METRICS]
+        return tally
