@@ -16,7 +16,7 @@ from .jit import compiled_on_first_call, njit
 
 _VEC = types.Array(types.float64, 1, "C", readonly=True)
 _MAT = types.Array(types.float64, 2, "C", readonly=True)
-_SIGNATURE = types.UniTuple(types.float64, 7)(
+_SIGNATURE = types.UniTuple(types.float64, 8)(
     _MAT, _VEC, _MAT, _VEC, _MAT, _VEC, _VEC, _VEC, _VEC, _VEC, _VEC, _VEC, types.int64
 )
 
@@ -26,7 +26,7 @@ HAS_LB, HAS_UB, HAS_Y, HAS_Z, HAS_BOX = 1, 2, 4, 8, 16
 #: problem needs is given; ``MISFIT`` (-1) when an array's size does not fit the others.
 FINITE, DUALS, MISFIT = 1, 2, -1
 #: The kernels' values on a misfit.
-MISFITTING = (float(MISFIT),) + (math.nan,) * 6
+MISFITTING = (float(MISFIT),) + (math.nan,) * 7
 #: Reassociation only, so that the dot products vectorise (~0.15 µs a call); no finite-math
 #: assumption: NaN and inf keep their meaning. Both kernels inline the same body, so they
 #: give bitwise the same values on the same data (tests/test_solvers_daqp_fast.py holds them
@@ -70,8 +70,9 @@ def _fit(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags):  # type: ignore[no-un
 
 @njit(inline="always")
 def _bounds(lb, ub, x, z_box, flags, duals, grad):  # type: ignore[no-untyped-def]
-    """``(bounds, complementarity of the bounds)``, adding ``z_box`` to ``grad``."""
-    bounds = complementarity = 0.0
+    """``(bounds, complementarity of the bounds, lbᵀz_box⁻ + ubᵀz_box⁺ over finite bounds)``,
+    adding ``z_box`` to ``grad``."""
+    bounds = complementarity = gap = 0.0
     for j in range(x.shape[0]):
         if flags & HAS_UB:
             bounds = _max(bounds, -(ub[j] - x[j]))
@@ -81,6 +82,10 @@ def _bounds(lb, ub, x, z_box, flags, duals, grad):  # type: ignore[no-untyped-de
             continue
         zj = z_box[j]
         grad[j] += zj
+        if flags & HAS_UB and zj > 0.0 and math.isfinite(ub[j]):
+            gap += ub[j] * zj
+        if flags & HAS_LB and zj < 0.0 and math.isfinite(lb[j]):
+            gap += lb[j] * zj
         if flags & HAS_UB:  # z_box > 0 pairs with the upper slack
             complementarity = _max(complementarity, max(zj, 0.0) * _weight(ub[j] - x[j]))
         else:  # a multiplier on a missing bound is all error
@@ -89,7 +94,7 @@ def _bounds(lb, ub, x, z_box, flags, duals, grad):  # type: ignore[no-untyped-de
             complementarity = _max(complementarity, max(-zj, 0.0) * _weight(x[j] - lb[j]))
         else:
             complementarity = _max(complementarity, -zj)
-    return bounds, complementarity
+    return bounds, complementarity, gap
 
 
 @njit(inline="always")
@@ -102,7 +107,7 @@ def _residuals(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags):  # type: ignore
     n = x.shape[0]
     code |= FINITE
     grad = np.empty(n)
-    scale = 0.0
+    scale = gap = 0.0  # gap: xᵀPx + qᵀx + bᵀy + hᵀz (+ the bounds' terms), finite rows only
     for j in range(n):
         if not math.isfinite(x[j]):
             code &= ~FINITE
@@ -111,6 +116,7 @@ def _residuals(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags):  # type: ignore
             s += P[j, k] * x[k]
         scale = _max(_max(scale, abs(s)), abs(q[j]))
         grad[j] = s + q[j]
+        gap += (s + q[j]) * x[j]
     equality = inequality = complementarity = 0.0
     for i in range(A.shape[0]):
         r = -b[i]
@@ -119,6 +125,8 @@ def _residuals(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags):  # type: ignore
             if duals:
                 grad[j] += y[i] * A[i, j]
         equality = _max(equality, abs(r))
+        if duals:
+            gap += b[i] * y[i]
     for i in range(G.shape[0]):
         s = 0.0
         for j in range(n):
@@ -129,14 +137,17 @@ def _residuals(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags):  # type: ignore
         if duals:
             complementarity = _max(complementarity, -z[i])
             complementarity = _max(complementarity, max(z[i], 0.0) * _weight(h[i] - s))
-    bounds, box = _bounds(lb, ub, x, z_box, flags, duals, grad)
+            if math.isfinite(h[i]):
+                gap += h[i] * z[i]
+    bounds, box, box_gap = _bounds(lb, ub, x, z_box, flags, duals, grad)
     if not duals:
-        return float(code), equality, inequality, bounds, math.nan, math.nan, scale
+        return float(code), equality, inequality, bounds, math.nan, math.nan, scale, math.nan
     stationarity = 0.0
     for j in range(n):
         stationarity = _max(stationarity, abs(grad[j]))
     complementarity = _max(complementarity, box)
-    return float(code), equality, inequality, bounds, stationarity, complementarity, scale
+    gap = abs(gap + box_gap)
+    return float(code), equality, inequality, bounds, stationarity, complementarity, scale, gap
 
 
 @compiled_on_first_call(_SIGNATURE, fastmath=_FASTMATH)
@@ -154,24 +165,24 @@ def kernel(
     z: np.ndarray,
     z_box: np.ndarray,
     flags: int,
-) -> tuple[float, float, float, float, float, float, float]:
-    """``(code, equality, inequality, bounds, stationarity, complementarity, scale)``.
+) -> tuple[float, float, float, float, float, float, float, float]:
+    """``(code, equality, inequality, bounds, stationarity, complementarity, scale, gap)``.
 
     ``code`` is :data:`MISFIT` (the rest NaN), or the bits :data:`FINITE` and
-    :data:`DUALS`; stationarity and complementarity are NaN placeholders without
-    :data:`DUALS`.
+    :data:`DUALS`; stationarity, complementarity and the duality gap are NaN placeholders
+    without :data:`DUALS`.
     """
     return _residuals(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags)
 
 
 @compiled_on_first_call(
     # Writable arrays (DAQP's buffer and answers): an exact match, the quickest dispatch.
-    types.UniTuple(types.float64, 7)(*(types.float64[::1],) * 3, *(types.int64,) * 5),
+    types.UniTuple(types.float64, 8)(*(types.float64[::1],) * 3, *(types.int64,) * 5),
     fastmath=_FASTMATH,
 )
 def stacked(
     data: np.ndarray, x: np.ndarray, lam: np.ndarray, n: int, p: int, m: int, ms: int, flags: int
-) -> tuple[float, float, float, float, float, float, float]:
+) -> tuple[float, float, float, float, float, float, float, float]:
     """:func:`kernel` on DAQP's stacked copy of a problem, with DAQP's multipliers.
 
     ``data`` is laid out as :func:`solvers._fast.stack` writes it (``P`` as ``H``, ``q`` as

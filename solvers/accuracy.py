@@ -11,7 +11,9 @@ For a solution ``(x, y, z, z_box)`` of ``min ½xᵀPx + qᵀx  s.t.  Ax = b, Gx 
 
 Rows with an infinite ``h`` or bound are left out of ``r_g`` (their multiplier must be 0; the
 complementarity check of :func:`solvers.residuals.failed_checks` refuses one that is not).
-All three are computed from the problem data, never taken from the solver.
+All three are computed from the problem data by the one KKT kernel (:mod:`solvers.kkt`) with
+the answer's check (:attr:`Solution.residuals <solvers.Solution.residuals>`), never taken from
+the solver.
 
 A run's figure is the shifted geometric mean ``exp(mean(log(v + s))) − s`` with qpbenchmark's
 shift ``s = 10``; a solve without an accepted answer counts as the tolerance of its check
@@ -35,57 +37,13 @@ SHIFT = 10.0
 METRICS = ("primal_residual", "dual_residual", "duality_gap")
 
 
-def duality_gap(solution: Solution) -> float | None:
-    """``r_g`` of an answer from its problem's data (None without ``x`` or a multiplier).
-
-    Parameters
-    ----------
-    solution : Solution
-        An answer with ``x`` and every multiplier its problem needs.
-
-    Returns
-    -------
-    float or None
-        The absolute duality gap, in the cost's units.
-    """
-    p, x = solution.problem, solution.x
-    if x is None:
-        return None
-    gap = float(x @ p.P @ x + p.q @ x)
-    if p.A is not None:
-        if solution.y is None:
-            return None
-        gap += float(p.b @ solution.y)
-    if p.G is not None:
-        if solution.z is None:
-            return None
-        finite = np.isfinite(p.h)
-        gap += float(p.h[finite] @ solution.z[finite])
-    if p.lb is not None or p.ub is not None:
-        if solution.z_box is None:
-            return None
-        gap += _bound_term(p.lb, np.minimum(solution.z_box, 0.0))
-        gap += _bound_term(p.ub, np.maximum(solution.z_box, 0.0))
-    return abs(gap)
-
-
-def _bound_term(bound: np.ndarray | None, multiplier: np.ndarray) -> float:
-    if bound is None:
-        return 0.0
-    finite = np.isfinite(bound)
-    return float(bound[finite] @ multiplier[finite])
-
-
 def metrics(solution: Solution) -> tuple[float, float, float] | None:
     """``(r_p, r_d, r_g)`` of an accepted answer; None if it was not accepted or lacks a
     multiplier (it then counts at its tolerance, see :meth:`AccuracyTally.add`)."""
     res = solution.residuals
-    if not solution.found or res is None or res.stationarity is None:
+    if not solution.found or res is None or res.stationarity is None or res.duality_gap is None:
         return None
-    gap = duality_gap(solution)
-    if gap is None:
-        return None
-    return max(res.equality, res.inequality, res.bounds), res.stationarity, gap
+    return max(res.equality, res.inequality, res.bounds), res.stationarity, res.duality_gap
 
 
 def shifted_geometric_mean(values: np.ndarray | list[float], shift: float = SHIFT) -> float:

@@ -53,7 +53,7 @@ def quick(
     y: np.ndarray | None = None,
     z: np.ndarray | None = None,
     z_box: np.ndarray | None = None,
-) -> tuple[float, float, float, float, float, float, float] | None:
+) -> tuple[float, float, float, float, float, float, float, float] | None:
     """Raw kernel output if every array fits as given, else None (then use :func:`evaluate`).
 
     Fits: ``x`` and the given multipliers are float64 C-contiguous vectors (any other dtype,
@@ -63,7 +63,7 @@ def quick(
     Returns
     -------
     tuple of float or None
-        ``(code, equality, inequality, bounds, stationarity, complementarity, scale)``,
+        ``(code, equality, inequality, bounds, stationarity, complementarity, scale, gap)``,
         ``code`` holding the bits :data:`~solvers._kkt.FINITE` and :data:`~solvers._kkt.DUALS`.
     """
     p = problem
@@ -99,7 +99,7 @@ def evaluate(
     y: np.ndarray | None = None,
     z: np.ndarray | None = None,
     z_box: np.ndarray | None = None,
-) -> tuple[float, float, float, float, float, float, float]:
+) -> tuple[float, float, float, float, float, float, float, float]:
     """Raw kernel output for ``problem`` at ``x`` (shape ``(n,)``, float64, C-contiguous).
 
     Multipliers are converted to float64 C-contiguous arrays and checked first (a multiplier
@@ -108,7 +108,7 @@ def evaluate(
     Returns
     -------
     tuple of float
-        ``(code, equality, inequality, bounds, stationarity, complementarity, scale)``:
+        ``(code, equality, inequality, bounds, stationarity, complementarity, scale, gap)``:
         ``code`` holds the bits :data:`~solvers._kkt.FINITE` (``x`` is finite) and
         :data:`~solvers._kkt.DUALS` (every multiplier the problem needs is given; else the
         dual residuals are NaN placeholders); see :class:`~solvers.Residuals` for the others.

@@ -48,6 +48,10 @@ class Residuals:
         Largest ``|multiplier| * slack`` over inequality and bound rows, or
         wrong-signed multiplier ``max(-z, 0)``; a non-zero multiplier on a row
         with infinite slack counts as its own size. None without multipliers.
+    duality_gap : float or None
+        ``|xᵀPx + qᵀx + bᵀy + hᵀz + lbᵀz_box⁻ + ubᵀz_box⁺|`` over the rows and bounds with a
+        finite right-hand side (qpbenchmark's duality gap; an infinite row's multiplier must
+        be 0, which complementarity checks). None without multipliers.
     """
 
     equality: float
@@ -55,6 +59,7 @@ class Residuals:
     bounds: float
     stationarity: float | None = None
     complementarity: float | None = None
+    duality_gap: float | None = None
 
 
 def _multiplier(name: str, value: npt.ArrayLike | None, size: int) -> np.ndarray | None:
@@ -97,10 +102,10 @@ def kkt_residuals(
     z = None if p.G is None else _multiplier("z", z, p.G.shape[0])
     z_box = None if p.lb is None and p.ub is None else _multiplier("z_box", z_box, p.n)
     point = np.ascontiguousarray(point)  # for the kernel; evaluate sees to the multipliers
-    code, equality, inequality, bounds, stat, comp, scale = evaluate(p, point, y, z, z_box)
+    code, equality, inequality, bounds, stat, comp, scale, gap = evaluate(p, point, y, z, z_box)
     if not int(code) & DUALS:
         return Residuals(equality, inequality, bounds), scale
-    return Residuals(equality, inequality, bounds, stat, comp), scale
+    return Residuals(equality, inequality, bounds, stat, comp, gap), scale
 
 
 def residuals(
@@ -188,7 +193,7 @@ def passing(values: tuple[float, ...], tolerance: float) -> Residuals | None:
     they pass when ``x`` is finite, every needed multiplier was given, and every residual
     is within its tolerance (as :func:`failed_checks` has it); a NaN never passes.
     """
-    code, equality, inequality, bounds, stationarity, complementarity, scale = values
+    code, equality, inequality, bounds, stationarity, complementarity, scale, gap = values
     dual_tol = tolerance * (1.0 + scale)
     if not (
         code == ACCEPTABLE
@@ -202,6 +207,6 @@ def passing(values: tuple[float, ...], tolerance: float) -> Residuals | None:
     residuals = _new(Residuals)  # a frozen dataclass, filled without its slower __init__
     residuals.__dict__.update(
         equality=equality, inequality=inequality, bounds=bounds,
-        stationarity=stationarity, complementarity=complementarity,
+        stationarity=stationarity, complementarity=complementarity, duality_gap=gap,
     )  # fmt: skip
     return residuals

@@ -221,7 +221,7 @@ class Solution:
 
 
 #: Kernel values standing for a non-finite ``x`` whose multipliers could not be checked.
-_NOT_FINITE = (0.0,) + (math.nan,) * 6
+_NOT_FINITE = (0.0,) + (math.nan,) * 7
 
 
 class SolverFailure(SolverError):
@@ -245,9 +245,11 @@ def _verdict(solution: Solution, values: tuple[float, ...]) -> Solution:
     if residuals is not None:
         solution.residuals, solution.found = residuals, True
         return solution
-    code, equality, inequality, bounds, stationarity, complementarity, scale = values
+    code, equality, inequality, bounds, stationarity, complementarity, scale, gap = values
     if code == ACCEPTABLE:
-        solution.residuals = Residuals(equality, inequality, bounds, stationarity, complementarity)
+        solution.residuals = Residuals(
+            equality, inequality, bounds, stationarity, complementarity, gap
+        )
     elif code == FINITE:
         solution.residuals = Residuals(equality, inequality, bounds)
     else:
