@@ -47,7 +47,9 @@ def test_duality_gap_equals_qpsolvers_own_on_each_backends_answer(backend: str, 
     assert answer.residuals.stationarity == pytest.approx(theirs.dual_residual(), rel=1e-9,
                                                           abs=1e-13)  # fmt: skip
     assert metrics(answer) == pytest.approx(
-        (theirs.primal_residual(), theirs.dual_residual(), theirs.duality_gap()), rel=1e-9, abs=1e-13
+        (theirs.primal_residual(), theirs.dual_residual(), theirs.duality_gap()),
+        rel=1e-9,
+        abs=1e-13,
     )
 
 
@@ -83,9 +85,7 @@ def test_shifted_geometric_mean_refuses_what_qpbenchmark_refuses() -> None:
         shifted_geometric_mean([1.0], shift=0.5)
 
 
-def test_tallies_merge_exactly_and_an_unanswered_call_counts_at_its_tolerance() -> (
-    None
-):
+def test_tallies_merge_exactly_and_an_unanswered_call_counts_at_its_tolerance() -> None:
     answers = [make_backend("daqp").solve(_problem(seed)) for seed in range(6)]
     infeasible = Problem(np.eye(2), np.zeros(2), G=np.array([[1.0, 0.0], [-1.0, 0.0]]),
                          h=np.array([-1.0, -1.0]))  # fmt: skip
