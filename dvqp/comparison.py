@@ -25,14 +25,17 @@ from dvqp.limits import lowest_link, self_distance, start_broken_lines
 from dvqp.planning import check_run, final_errors, worst_sample_excess
 from dvqp.resolution.registry import PINV
 from dvqp.table_text import csv_text
+from solvers.accuracy import METRICS
 
 if TYPE_CHECKING:
     from dvqp import Scene, Trajectory
 
 FIELDS = (
-    "scene", "file", "backend", "success", "steps", "failures", "relaxed", "braking", "substepped",
+    "scene", "file", "backend", "settings", "success", "steps", "failures", "relaxed", "braking",
+    "substepped",
     "median_step_us", "p95_step_us", "median_solver_us", "median_rest_us", "median_iterations",
-    "refused_calls", "refusals", "ratio_to_pinv", "max_task_error", "min_clearance", "closest",
+    "refused_calls", "refusals", "qp_solves", "unanswered_solves", "primal_residual",
+    "dual_residual", "duality_gap", "ratio_to_pinv", "max_task_error", "min_clearance", "closest",
     "min_probe_clearance", "min_tilt", "min_self_distance", "closest_pair", "min_link_height",
     "lowest_link",
     "max_joint_acceleration", "max_limit_excess", "worst_limit", "start_broken",
@@ -54,8 +57,9 @@ def _least(values: NDArray[np.float64]) -> float | None:
     return _finite(np.min(values)) if values.size else None
 
 
-def summarize(scene: Scene, traj: Trajectory) -> Row:
-    """The figures of one run of ``scene`` (``traj`` from :func:`dvqp.plan`), as a dict:
+def summarize(scene: Scene, traj: Trajectory, settings: str = "default") -> Row:
+    """The figures of one run of ``scene`` (``traj`` from :func:`dvqp.plan` under the
+    ``settings`` tier, :mod:`solvers.tiers`), as a dict:
 
     ``success``: the run can be sent to the arm (:func:`dvqp.planning.check_run`); ``error``
     says why not. ``steps``; ``failures`` (steps not solved or that broke a limit even in
@@ -63,7 +67,10 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
     conflicted and the arm slowed toward rest); ``substepped`` (steps split to keep a limit);
     median and 95th-percentile full step time (µs), the medians of the solver call alone and
     of the rest of the step (µs) and of the solver's iterations; the backend calls refused (no
-    accepted answer: the step relaxed or braked) and by kind (``refusals``); the largest task error
+    accepted answer: the step relaxed or braked) and by kind (``refusals``); the backend calls
+    (``qp_solves``), of those ``unanswered_solves``, and qpbenchmark's shifted geometric means
+    of their primal and dual residuals and duality gaps (an unanswered call counted at its
+    check's tolerance; :mod:`solvers.accuracy`; None for the baseline); the largest task error
     ``‖J̄Q̇ − ẋ‖∞`` of the succeeded steps; the smallest clearance of any guarded part (m) and
     the part and obstacle that have it (``closest``); the probe's own smallest clearance (m);
     the smallest probe tilt from radial (rad); the smallest distance between non-adjacent
@@ -84,6 +91,7 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
         "scene": scene.name,
         "file": scene.source,
         "backend": traj.backend,
+        "settings": settings,
         "success": (why := run_error(scene, traj)) is None,
         "steps": traj.n_steps,
         "failures": int(np.sum(~ok)),
@@ -95,6 +103,7 @@ def summarize(scene: Scene, traj: Trajectory) -> Row:
         **_solver_figures(traj),
         "refused_calls": sum(traj.refusals.values()),
         "refusals": traj.refused or None,
+        **_accuracy(traj),
         "ratio_to_pinv": None,
         "max_task_error": _finite(np.max(traj.task_error[ok])) if np.any(ok) else None,
         **_clearances(scene, traj),
@@ -124,6 +133,17 @@ def _solver_figures(traj: Trajectory) -> Row:
         "median_solver_us": _finite(np.median(solver_us)),
         "median_rest_us": _finite(np.median(traj.step_time * 1e6 - solver_us)),
         "median_iterations": _finite(np.median(counted)) if counted.size else None,
+    }
+
+
+def _accuracy(traj: Trajectory) -> Row:
+    """The QP backend calls' count and accuracy (:attr:`Trajectory.accuracy`; None: baseline)."""
+    a = traj.accuracy
+    solves = int(a["solves"]) if "solves" in a else None
+    return {
+        "qp_solves": solves,
+        "unanswered_solves": int(a["unanswered"]) if solves is not None else None,
+        **{name: _finite(a[name]) if name in a else None for name in METRICS},
     }
 
 
@@ -181,9 +201,10 @@ def run_error(scene: Scene, traj: Trajectory) -> str | None:
 
 def run_scene(
     path: str, backends: Sequence[str], progress: Callable[[str], None] | None = None,
-    options: dict[str, dict[str, Any]] | None = None,
+    options: dict[str, dict[str, Any]] | None = None, tier: str = "default",
 ) -> list[Row]:  # fmt: skip
-    """Load a scene and run it with every backend (``options``: settings by backend); the rows
+    """Load a scene and run it with every backend (``options``: settings by backend, over the
+    ``tier``'s, :mod:`solvers.tiers`); the rows
     in ``backends`` order. A run that raises a :class:`~dvqp.errors.DvqpError` gives an
     :func:`error_row`. ``progress(backend)`` is called after each run.
     """
@@ -191,7 +212,8 @@ def run_scene(
     rows = []
     for backend in backends:
         try:
-            rows.append(summarize(scene, plan(scene, backend, options=given.get(backend))))
+            traj = plan(scene, backend, options=given.get(backend), tier=tier)
+            rows.append(summarize(scene, traj, tier))
         except DvqpError as exc:
             rows.append(error_row(scene, backend, exc))
         if progress is not None:
@@ -222,13 +244,14 @@ def compare(
     jobs: int = 1,
     progress: Callable[[int, int, str], None] | None = None,
     options: dict[str, dict[str, Any]] | None = None,
+    tier: str = "default",
 ) -> list[Row]:
     """Run every scene with every backend; rows grouped by scene in ``paths`` order.
 
     The scene files and backend names are checked by the caller (else scene errors surface
     here; an unknown backend gives failed rows). ``jobs`` worker processes run one scene each
     (1: all in this process). ``progress(done, total, label)`` counts runs (scene × backend);
-    ``options``: backends' settings, over each scene's own.
+    ``options``: backends' settings, over each scene's own, over the settings ``tier``'s.
     """
     total, done = len(paths) * len(backends), 0
     results: dict[str, list[Row]] = {}
@@ -242,10 +265,10 @@ def compare(
     if jobs <= 1 or len(paths) <= 1:
         for path in paths:
             results[path] = run_scene(path, backends, lambda b, p=path: tick(1, f"{p} {b}"),
-                                      options)  # fmt: skip
+                                      options, tier)  # fmt: skip
     else:
         with ProcessPoolExecutor(max_workers=jobs, initializer=quiet_worker) as pool:
-            futures = {pool.submit(run_scene, path, list(backends), None, options): path
+            futures = {pool.submit(run_scene, path, list(backends), None, options, tier): path
                        for path in paths}  # fmt: skip
             for future in as_completed(futures):
                 results[futures[future]] = future.result()

@@ -23,7 +23,7 @@ from dvqp.motion.jog import box_average, jog_commands
 from dvqp.motion.simulate import dv_error, simulate
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.pinv import PseudoinverseResolver
-from dvqp.resolution.registry import make_resolver
+from dvqp.resolution.registry import make_resolver, tier_options
 from dvqp.scenes.scene import Scene
 from dvqp.step import Stepper
 from dvqp.tasks import Task
@@ -83,6 +83,7 @@ def plan(
     notice: Callable[[str], None] | None = None,
     stop: bool = True,
     options: dict[str, Any] | None = None,
+    tier: str = "default",
 ) -> Trajectory:
     """Run a scene with a resolver and return its trajectory, ended at rest.
 
@@ -105,16 +106,23 @@ def plan(
         Brake after the last command (JOG) or the path's end until every joint has stopped
         (:mod:`dvqp.motion.stop`); False: end with the last command.
     options
-        Settings of the QP backend, over the scene's ``[solvers.<backend>]`` ones.
+        Settings of the QP backend, over the scene's ``[solvers.<backend>]`` ones, over the
+        settings ``tier``'s.
+    tier
+        ``"default"``, ``"high_accuracy"`` or ``"low_accuracy"``: the QP backend's accuracy
+        settings and the tolerance its answers are checked to (:mod:`solvers.tiers`).
 
     Raises
     ------
     BackendError
         Unknown backend, or a setting it does not take.
+    ParameterError
+        An unknown ``tier``.
     SingularConfigurationError
         The baseline met a singular task Jacobian.
     """
-    settings = {**scene.solver_options.get(backend, {}), **(options or {})}
+    settings = {**tier_options(backend, tier), **scene.solver_options.get(backend, {}),
+                **(options or {})}  # fmt: skip
     resolver = make_resolver(backend, scene.spec().with_extra(tasks, limits), settings)
     c = scene_commands(scene)
     traj = simulate(

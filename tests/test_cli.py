@@ -208,8 +208,8 @@ def test_compare_reports_a_failed_run_in_its_table_and_exits_1_only_when_strict(
     out = capsys.readouterr().out
     assert out.splitlines()[2].split()[:3] == ["far", "daqp", "NO"]
     assert "far / daqp: " in out and "target not reached" in out
-    assert main(["compare", scene, "--backends", "daqp", "--strict"]) == 1
-    assert main(["compare", write_scene(tmp_path), "--backends", "daqp", "--strict"]) == 0
+    assert main(["compare", scene, "--backends", "daqp", "--check"]) == 1
+    assert main(["compare", write_scene(tmp_path), "--backends", "daqp", "--check"]) == 0
 
 
 def test_compare_with_an_invalid_scene_exits_2_and_writes_nothing(

@@ -129,7 +129,7 @@ def test_compare_names_it_in_its_table_and_json_with_the_true_excess(
 ) -> None:
     pytest.importorskip("daqp")
     path, out = high_scene(tmp_path), tmp_path / "c.json"
-    assert main(["compare", str(path), "--backends", "daqp", "--json", str(out), "--strict"]) == 1
+    assert main(["compare", str(path), "--backends", "daqp", "--json", str(out), "--check"]) == 1
     table = capsys.readouterr().out
     (row,) = json.loads(out.read_text(encoding="utf-8"))["results"]
     traj = plan(loads(HIGH, str(path)), "daqp")

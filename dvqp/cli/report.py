@@ -31,7 +31,9 @@ TABLE = (  # (row key, header, format)
     ("max_joint_acceleration", "qdd", "{:.3g}"), ("max_limit_excess", "excess", "{:.2g}"),
     ("max_joint_limit_violation", "q viol rad", "{:.3g}"),
     ("max_velocity_limit_violation", "qd viol rad/s", "{:.3g}"), ("relaxed", "relaxed", "{}"),
-    ("refused_calls", "refused", "{}"), ("substepped", "split", "{}"), ("failures", "fails", "{}"),
+    ("refused_calls", "refused", "{}"), ("primal_residual", "r_prim", "{:.1e}"),
+    ("dual_residual", "r_dual", "{:.1e}"), ("duality_gap", "gap", "{:.1e}"),
+    ("substepped", "split", "{}"), ("failures", "fails", "{}"),
     ("final_joint_speed", "end qd", "{:.3g}"), ("braking_time", "brake s", "{:.3f}"),
 )  # fmt: skip
 """Columns of :func:`format_table`: (row key, header, format of a defined value)."""
@@ -68,6 +70,7 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         f"calls, {cell(row['median_rest_us'], '{:.1f}')} us the rest, "
         f"{cell(row['median_iterations'], '{:.0f}')} iterations (medians)"
         + (f"; {row['refused_calls']} calls refused ({traj.refused})" if traj.refusals else ""),
+        *([_accuracy(row)] if row["qp_solves"] else []),
         f"final tool DV   l = {tool[0]:.4f} m, z = {tool[1]:.4f} m, h = {tool[2]:.4f} m, "
         f"alpha = {tool[3]:.4f} rad",
     ]
@@ -79,6 +82,15 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
     if output is not None:
         lines.append(f"saved           {output}")
     return "\n".join(lines)
+
+
+def _accuracy(row: Row) -> str:
+    """qpbenchmark's figures of the backend calls (shifted geometric means)."""
+    return (
+        f"accuracy        primal residual {row['primal_residual']:.1e}, dual residual "
+        f"{row['dual_residual']:.1e}, duality gap {row['duality_gap']:.1e} (shifted geometric "
+        f"means over {row['qp_solves']} calls, {row['settings']} settings)"
+    )
 
 
 def _heights(row: Row, traj: Trajectory) -> str:

@@ -1,4 +1,5 @@
-"""``--solver-option NAME.KEY=VALUE``: a QP backend's setting from the command line."""
+"""``--solver-option NAME.KEY=VALUE`` and ``--settings TIER``: QP backends' settings from the
+command line."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from typing import Any
 from dvqp.errors import ParameterError
 from dvqp.resolution.registry import check_options
 from dvqp.scenes.solver_options import setting_value
+from solvers.tiers import TIERS
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -20,10 +22,15 @@ FLAG = "--solver-option"
 
 
 def add_argument(parser: argparse.ArgumentParser) -> None:
-    """The repeatable ``--solver-option`` of ``plan``, ``compare`` and ``bench``."""
+    """The repeatable ``--solver-option`` and the ``--settings`` tier of ``plan``, ``compare``
+    and ``bench``."""
     parser.add_argument(FLAG, action="append", default=[], metavar="NAME.KEY=VALUE",
                         help="a setting of a QP backend, e.g. osqp.eps_abs=1e-6 (repeatable; "
                         "over the scene's [solvers.NAME])")  # fmt: skip
+    parser.add_argument("--settings", choices=TIERS, default=TIERS[0],
+                        help="accuracy tier of every QP backend, as qpbenchmark's: its solver "
+                        "settings and the tolerance answers are checked to (default: default; "
+                        "see docs/cli.md)")  # fmt: skip
 
 
 def solver_options(values: Sequence[str], backends: Sequence[str]) -> dict[str, dict[str, Any]]:

@@ -12,11 +12,12 @@ from typing import Any
 
 import solvers
 from dvqp._versions import __version__
-from dvqp.errors import BackendError
+from dvqp.errors import BackendError, ParameterError
 from dvqp.resolution.pinv import PseudoinverseResolver
 from dvqp.resolution.qp import QPResolver, make_backend
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
+from solvers.tiers import TIERS, tier_settings
 
 PINV = "pinv"
 """Name of the paper's pseudoinverse baseline (eq. 18)."""
@@ -88,6 +89,20 @@ def check_options(name: str, options: dict[str, Any]) -> dict[str, Any]:
         return options
     make_backend(name, **options)
     return options
+
+
+def tier_options(name: str, tier: str) -> dict[str, Any]:
+    """The settings of backend ``name`` under the settings ``tier`` (:mod:`solvers.tiers`;
+    none for the baseline, which has no settings).
+
+    Raises
+    ------
+    ParameterError
+        ``settings: unknown tier 'x' (tiers: default, high_accuracy, low_accuracy)``.
+    """
+    if tier not in TIERS:
+        raise ParameterError("settings", f"unknown tier {tier!r} (tiers: {', '.join(TIERS)})")
+    return {} if name == PINV else tier_settings(name, tier)
 
 
 def make_resolver(name: str, spec: StepSpec, options: dict[str, Any] | None = None) -> Resolver:
