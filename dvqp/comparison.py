@@ -67,10 +67,11 @@ def summarize(scene: Scene, traj: Trajectory, settings: str = "default") -> Row:
     conflicted and the arm slowed toward rest); ``substepped`` (steps split to keep a limit);
     median and 95th-percentile full step time (µs), the medians of the solver call alone and
     of the rest of the step (µs) and of the solver's iterations; the backend calls refused (no
-    accepted answer: the step relaxed or braked) and by kind (``refusals``); the backend calls
-    (``qp_solves``), of those ``unanswered_solves``, and qpbenchmark's shifted geometric means
-    of their primal and dual residuals and duality gaps (an unanswered call counted at its
-    check's tolerance; :mod:`solvers.accuracy`; None for the baseline); the largest task error
+    accepted answer: the step relaxed or braked) and by kind (``refusals``); the steps' QP
+    answers counted (``qp_solves``, :attr:`dvqp.resolution.qp.QPSolver.accuracy`), of those
+    ``unanswered_solves``, and qpbenchmark's shifted geometric means of their primal and dual
+    residuals and duality gaps (an unanswered one counted at its check's tolerance;
+    :mod:`solvers.accuracy`; None for the baseline); the largest task error
     ``‖J̄Q̇ − ẋ‖∞`` of the succeeded steps; the smallest clearance of any guarded part (m) and
     the part and obstacle that have it (``closest``); the probe's own smallest clearance (m);
     the smallest probe tilt from radial (rad); the smallest distance between non-adjacent
@@ -137,7 +138,7 @@ def _solver_figures(traj: Trajectory) -> Row:
 
 
 def _accuracy(traj: Trajectory) -> Row:
-    """The QP backend calls' count and accuracy (:attr:`Trajectory.accuracy`; None: baseline)."""
+    """The steps' QP answers' count and accuracy (:attr:`Trajectory.accuracy`; None: baseline)."""
     a = traj.accuracy
     solves = int(a["solves"]) if "solves" in a else None
     return {

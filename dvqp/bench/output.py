@@ -28,6 +28,8 @@ COLUMNS = (  # (summary key, header, format of a defined value)
     ("worst_limit_excess", "worst excess", "{:.2g}"),
     ("worst_task_error", "worst task err", "{:.1e}"),
     ("max_distance_to_qp_median_m", "off QP median m", "{:.1e}"),
+    ("primal_residual", "r_prim", "{:.1e}"), ("dual_residual", "r_dual", "{:.1e}"),
+    ("duality_gap", "gap", "{:.1e}"),
 )  # fmt: skip
 """Columns of :func:`format_summary` after the backend's name."""
 
@@ -71,6 +73,8 @@ def format_summary(suite: Suite) -> str:
         f"timing          {suite.where.describe()}",
         f"sgm             shifted geometric mean over the {timed} scenes every backend ran, of "
         f"each run's mean step time; shift {suite.shift_us:g} us; x best: over the fastest",
+        f"accuracy        r_prim, r_dual, gap: shifted geometric means (shift 10) of every "
+        f"step's QP answer's primal and dual residual and duality gap, {_tier(suite)} settings",
         "QP agreement    "
         + (
             f"final tool positions of successful QP runs differ by at most "
@@ -84,6 +88,11 @@ def format_summary(suite: Suite) -> str:
         lines.append(f"lost            {len(lost)} scene{'s' * (len(lost) > 1)} (worker lost or "
                      f"timed out: no figures): {', '.join(lost)}")  # fmt: skip
     return "\n".join(lines)
+
+
+def _tier(suite: Suite) -> str:
+    """The settings tier the rows ran under (``default`` before any ran)."""
+    return str(next((r["settings"] for r in suite.rows if r.get("settings")), "default"))
 
 
 def _marked(suite: Suite) -> list[Row]:

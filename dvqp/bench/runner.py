@@ -34,13 +34,14 @@ LOST = (WORKER_LOST, "timed out")
 class Job:
     """One scene to run: its ``index`` in the suite, its ``name`` (it is loaded as
     ``<name>.toml``), the scene file's ``text`` and the ``backends``, run in this order, with
-    ``options`` (settings by backend, ``--solver-option``)."""
+    ``options`` (settings by backend, ``--solver-option``) over the settings ``tier``'s."""
 
     index: int
     name: str
     text: str
     backends: tuple[str, ...]
     options: dict[str, dict[str, Any]] = field(default_factory=dict)
+    tier: str = "default"
 
 
 def run_job(job: Job, on_run: Callable[[str], None] | None = None) -> list[Row]:
@@ -54,11 +55,11 @@ def run_job(job: Job, on_run: Callable[[str], None] | None = None) -> list[Row]:
     rows = []
     for backend in job.backends:
         try:
-            traj = plan(scene, backend, options=job.options.get(backend))
+            traj = plan(scene, backend, options=job.options.get(backend), tier=job.tier)
         except DvqpError as exc:
             row = error_row(scene, backend, exc, EXTRA_FIELDS)
         else:
-            row = _figures(scene, traj)
+            row = _figures(scene, traj, job.tier)
         rows.append(_with_scene(job, scene, row))
         if on_run is not None:
             on_run(backend)
@@ -85,11 +86,11 @@ def _with_scene(job: Job, scene: Scene, row: Row) -> Row:
     return {"index": job.index, **row, "mode": scene.mode, "dt": scene.dt, "obstacles": shapes}
 
 
-def _figures(scene: Scene, traj: Trajectory) -> Row:
+def _figures(scene: Scene, traj: Trajectory, tier: str) -> Row:
     """:func:`dvqp.comparison.summarize`'s figures, then the bench's timings (µs, s)."""
     steps_us, solve_us = traj.step_time * 1e6, traj.solve_time * 1e6
     return {
-        **summarize(scene, traj),
+        **summarize(scene, traj, tier),
         "mean_step_us": float(np.mean(steps_us)) if steps_us.size else None,
         "mean_solve_us": float(np.mean(solve_us)) if solve_us.size else None,
         "median_solve_us": float(np.median(solve_us)) if solve_us.size else None,

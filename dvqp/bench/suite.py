@@ -36,6 +36,7 @@ def run_suite(
     scene_timeout: float = SCENE_TIMEOUT,
     shift: float = SHIFT_US,
     options: dict[str, dict[str, Any]] | None = None,
+    tier: str = "default",
 ) -> Suite:
     """Run every scene with every backend and sum the runs up per backend.
 
@@ -46,7 +47,8 @@ def run_suite(
     is called once where the runs go is ready (a scheduler reached), before the first run;
     ``on_scene(rows)`` with the rows of each scene as it finishes (e.g. to save them at once).
     ``scene_timeout``: on Dask, how long a scene may run (s); ``shift``: of the shifted
-    geometric means, µs; ``options``: settings by backend (``--solver-option``).
+    geometric means, µs; ``options``: settings by backend (``--solver-option``) over the
+    settings ``tier``'s (:mod:`solvers.tiers`).
 
     Raises
     ------
@@ -57,7 +59,8 @@ def run_suite(
     DaskUnavailableError, DvqpError
         Dask is missing, or the scheduler cannot be reached.
     """
-    jobs = [Job(s.index, s.name, s.text, tuple(backends), dict(options or {})) for s in scenes]
+    jobs = [Job(s.index, s.name, s.text, tuple(backends), dict(options or {}), tier)
+            for s in scenes]  # fmt: skip
     rows: list[Row] = []
 
     def finished(scene_rows: list[Row]) -> None:

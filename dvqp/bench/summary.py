@@ -17,6 +17,8 @@ import numpy as np
 from dvqp.bench.runner import Row, is_lost
 from dvqp.errors import ParameterError
 from dvqp.resolution.registry import PINV
+from solvers.accuracy import METRICS, AccuracyTally
+from solvers.accuracy import shifted_geometric_mean as sgm
 
 SHIFT_US = 10.0
 """Shift of the shifted geometric means of times, µs."""
@@ -25,12 +27,13 @@ OUTCOME_KEYS = ("success", "steps", "failures", "relaxed", "substepped", "error"
 
 
 def shifted_geometric_mean(values: Sequence[float], shift: float = SHIFT_US) -> float:
-    """``exp(mean(log(v + shift))) − shift`` of non-negative ``values`` (same unit as shift);
-    ParameterError for no value, a negative or non-finite value, or a shift <= 0."""
-    v = np.asarray(values, dtype=float)
-    if v.size == 0 or not np.all(np.isfinite(v)) or np.any(v < 0) or not shift > 0:
-        raise ParameterError("values", "need finite values >= 0 and a shift > 0")
-    return float(np.exp(np.mean(np.log(v + shift))) - shift)
+    """``exp(mean(log(v + shift))) − shift`` of non-negative ``values`` (same unit as shift,
+    :func:`solvers.accuracy.shifted_geometric_mean`); ParameterError for no value, a negative
+    or non-finite value, or a shift < 1."""
+    try:
+        return sgm(values, shift)
+    except ValueError as exc:
+        raise ParameterError("values", "need finite values >= 0 and a shift >= 1") from exc
 
 
 def _max(values: Sequence[float | None]) -> float | None:
@@ -50,7 +53,9 @@ def summarize_backends(
     ``step_time_sgm_us`` and ``solve_time_sgm_us`` (shifted geometric mean over the timed
     scenes of each run's mean full step time and mean solver time, µs) and their ``_ratio``
     to the best backend; ``timed_scenes``; ``worst_limit_excess`` (m or rad);
-    ``worst_task_error``; ``max_distance_to_qp_median_m`` (final tool position, m).
+    ``worst_task_error``; ``max_distance_to_qp_median_m`` (final tool position, m);
+    ``qp_solves``, ``unanswered_solves`` and the shifted geometric means ``primal_residual``,
+    ``dual_residual``, ``duality_gap`` over every step's QP answer of its runs (None: baseline).
     """
     timed = _timed_scenes(rows, backends)
     step = _sgm_column(rows, backends, timed, "mean_step_us", shift)
@@ -79,8 +84,25 @@ def summarize_backends(
             "worst_limit_excess": _max([r["max_limit_excess"] for r in runs]),
             "worst_task_error": _max([r["max_task_error"] for r in runs]),
             "max_distance_to_qp_median_m": distance.get(b),
+            **_accuracy(runs),
         }
     return out
+
+
+def _accuracy(runs: Sequence[Row]) -> dict[str, Any]:
+    """The runs' accuracy tallies merged: every QP answer of every run counted once."""
+    tally = AccuracyTally()
+    for r in runs:
+        if r.get("qp_solves"):
+            tally.merge(AccuracyTally.from_dict({"solves": r["qp_solves"],
+                                                 "unanswered": r["unanswered_solves"],
+                                                 **{m: r[m] for m in METRICS}}))  # fmt: skip
+    means = tally.means()
+    return {
+        "qp_solves": tally.solves if means else None,
+        "unanswered_solves": tally.unanswered if means else None,
+        **{m: means[m] if means else None for m in METRICS},
+    }
 
 
 def _timed_scenes(rows: Sequence[Row], backends: Sequence[str]) -> list[str]:

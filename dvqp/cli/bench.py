@@ -38,7 +38,7 @@ from dvqp.cli.progress import ProgressBar
 from dvqp.cli.report import write_text
 from dvqp.cli.solver_option import solver_options
 from dvqp.errors import DvqpError, ParameterError
-from dvqp.resolution.registry import check_name, default_resolvers
+from dvqp.resolution.registry import PINV, check_name, default_resolvers
 
 
 @dataclass(frozen=True)
@@ -57,6 +57,8 @@ class Options:
     csv: Path | None
     scenes_dir: Path | None
     solver_options: dict[str, dict[str, Any]]
+    tier: str = "default"
+    check: bool = False
 
 
 def register(subparsers: Any) -> argparse.ArgumentParser:
@@ -81,14 +83,17 @@ def register(subparsers: Any) -> argparse.ArgumentParser:
                    help="on Dask, give a scene up after running this long "
                    f"(default: {SCENE_TIMEOUT:g})")  # fmt: skip
     solver_option.add_argument(p)
+    p.add_argument("--check", action="store_true",
+                   help="exit 1 unless every QP backend's run is ok (safe to send)")  # fmt: skip
     p.set_defaults(run=run)
     return p
 
 
 def run(args: argparse.Namespace) -> int:
     """Run ``dvqp bench``; return 0, or 1 when every Dask worker left (the finished scenes
-    written). Bad input raises a DvqpError before any run (exit 2); Ctrl-C a
-    KeyboardInterrupt, after the finished scenes were summed up and written."""
+    written) or, with ``--check``, a QP backend's run is not ok. Bad input raises a DvqpError
+    before any run (exit 2); Ctrl-C a KeyboardInterrupt, after the finished scenes were summed
+    up and written."""
     options = check_options(args)
     scenes = generate_scenes(options.seed, options.count)
     partial: list[PartialFile] = []
@@ -107,6 +112,7 @@ def run(args: argparse.Namespace) -> int:
                 scheduler=options.scheduler, progress=bar.show, ready=ready,
                 on_scene=lambda rows: [p.add(rows) for p in partial],
                 scene_timeout=options.scene_timeout, options=options.solver_options,
+                tier=options.tier,
             )  # fmt: skip
     except BenchInterrupted as exc:
         _report(exc.suite, options, partial)  # what finished is still written
@@ -116,7 +122,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"dvqp: scheduler {options.scheduler}: {exc}", file=sys.stderr)
         return 1
     _report(suite, options, partial)
-    return 0
+    failed = [r for r in suite.rows if r["backend"] != PINV and not r["success"]]
+    return 1 if options.check and failed else 0
 
 
 def _report(suite: Suite, options: Options, partial: list[PartialFile]) -> None:
@@ -156,7 +163,7 @@ def check_options(args: argparse.Namespace) -> Options:
             raise DvqpError(f"--scheduler {exc}") from exc
     settings = solver_options(args.solver_option, backends)
     return Options(count, seed, backends, workers, args.scheduler, timeout, json_out, csv_out,
-                   scenes_dir, settings)  # fmt: skip
+                   scenes_dir, settings, args.settings, args.check)  # fmt: skip
 
 
 def _integer(option: str, text: str, minimum: int) -> int:

@@ -89,7 +89,7 @@ def _accuracy(row: Row) -> str:
     return (
         f"accuracy        primal residual {row['primal_residual']:.1e}, dual residual "
         f"{row['dual_residual']:.1e}, duality gap {row['duality_gap']:.1e} (shifted geometric "
-        f"means over {row['qp_solves']} calls, {row['settings']} settings)"
+        f"means over {row['qp_solves']} QP answers, {row['settings']} settings)"
     )
 
 

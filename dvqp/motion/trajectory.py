@@ -115,7 +115,8 @@ class Trajectory:
         ``"iteration limit"``, ``"inaccurate"``…, :data:`solvers.REFUSALS`); the step then
         took the relaxed or braking path (empty: none, the baseline, or an older file).
     accuracy : dict of str to float
-        qpbenchmark's accuracy of the QP backend calls (:mod:`solvers.accuracy`): ``solves``,
+        qpbenchmark's accuracy of the steps' QP answers (:mod:`solvers.accuracy`,
+        :attr:`dvqp.resolution.qp.QPSolver.accuracy`): ``solves``,
         ``unanswered`` and the shifted geometric means ``primal_residual``, ``dual_residual``,
         ``duality_gap`` (empty: the baseline, or an older file).
     """

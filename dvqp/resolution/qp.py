@@ -132,7 +132,10 @@ class QPSolver:
         """Backend calls that gave no accepted answer, by :attr:`solvers.Solution.refusal`
         (the step then took the relaxed or braking path)."""
         self.accuracy = AccuracyTally()
-        """qpbenchmark's accuracy metrics of every backend call (:mod:`solvers.accuracy`)."""
+        """qpbenchmark's accuracy metrics (:mod:`solvers.accuracy`) of each step's QP answer:
+        the strict problem's, or the relaxed one's when the strict one had no accepted answer
+        (an infeasible strict problem has no optimum to be accurate about: its refusal is
+        counted in :attr:`refusals`); a step with neither counts at the check's tolerance."""
         self.watchers: list[Watcher] = []
         """Called after every backend call with ``("strict" | "relaxed", problem, solution)``;
         the problem's arrays are rewritten by the next step: a watcher copies what it keeps."""
@@ -167,7 +170,8 @@ class QPSolver:
         """Tally one backend call (refusal, accuracy) and show it to the watchers."""
         if not solution.found:
             self.refusals[solution.refusal] += 1
-        self.accuracy.add(solution)
+        if solution.found or kind == "relaxed":  # the step's answer, or its last attempt
+            self.accuracy.add(solution)
         for watch in self.watchers:
             watch(kind, problem, solution)
 
