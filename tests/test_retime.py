@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dvqp import ParameterError, Scene
+from dvqp import ParameterError, Scene, ShapeError
 from dvqp.errors import RetimingError
 from dvqp.limits import AccelerationLimit
 from dvqp.retime import DEFAULT_RATE, Retimed, retime
@@ -194,3 +194,14 @@ def test_a_path_past_a_limit_is_retimed_but_reported_broken() -> None:
     assert r.excess.value == pytest.approx(np.max(r.q[:, 0]) - s.robot.q_max[0], abs=1e-12)
     assert r.excess.value >= 0.05 - 1e-9
     assert "BROKEN: joint1 joint position" in r.summary()
+
+
+def test_samples_of_the_wrong_shape_or_times_that_do_not_increase_are_refused() -> None:
+    s, planned = scene("paper-two-inlets"), run("paper-two-inlets", "daqp")
+    with pytest.raises(ShapeError, match=r"^q: expected shape \(761, 13\), got \(761, 12\)"):
+        retime(s, planned.q[:, 1:], planned.t)
+    backwards = planned.t.copy()
+    backwards[5] = backwards[4]
+    for q, t in ((planned.q, backwards), (planned.q + np.nan, planned.t)):
+        with pytest.raises(ParameterError, match=r"^q, t: must be finite, t increasing"):
+            retime(s, q, t)

@@ -8,8 +8,9 @@ from pathlib import Path
 from dvqp import _validate
 from dvqp.errors import ParameterError, one_line
 from dvqp.motion.trajectory import Trajectory
-from dvqp.retime import DEFAULT_RATE, FORMATS, RunScene
+from dvqp.retime import DEFAULT_RATE, FORMATS
 from dvqp.retime.parameterise import toppra
+from dvqp.scenes import Scene
 
 __all__ = ["FORMATS", "checked_rate", "retimed"]
 
@@ -34,7 +35,7 @@ def checked_rate(retime: bool, rate: float | None) -> float | None:
     return rate
 
 
-def retimed(scene: RunScene, traj: Trajectory, rate: float, output: Path | None) -> int:
+def retimed(scene: Scene, traj: Trajectory, rate: float, output: Path | None) -> int:
     """Retime a run that is safe to send, print ``retimed  2.31 s (planned 4.00 s), 1156
     samples at 500 Hz, limits kept`` (and ``saved  FILE``), save it to ``output``; the exit
     code: 1 if a retimed sample breaks a limit (the file is still written, to look at)."""
@@ -45,7 +46,6 @@ def retimed(scene: RunScene, traj: Trajectory, rate: float, output: Path | None)
     if output is not None:
         print(f"saved           {output}")
     if not motion.kept:
-        source = one_line(getattr(scene, "source", "scene"))
-        print(f"dvqp: {source}: retimed: {motion.summary()}", file=sys.stderr)
+        print(f"dvqp: {one_line(scene.source)}: retimed: {motion.summary()}", file=sys.stderr)
         return 1
     return 0

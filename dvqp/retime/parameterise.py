@@ -73,8 +73,10 @@ def parameterise(q: Array, t: Array, qd_max: Array, qdd_max: Array, rate: float)
     """
     rate = _validate.positive("rate", rate)
     q, t = np.asarray(q, dtype=float), np.asarray(t, dtype=float)
-    if q.ndim != 2 or t.shape != q.shape[:1]:
-        raise ShapeError("q", (t.shape[0], -1), q.shape)
+    if q.ndim != 2 or t.ndim != 1 or q.shape != (t.size, np.size(qd_max)):
+        raise ShapeError("q", (t.size, np.size(qd_max)), q.shape)
+    if not (np.all(np.isfinite(q)) and np.all(np.diff(t) > 0.0)):
+        raise ParameterError("q, t", "must be finite, t increasing")
     moved = np.flatnonzero(np.any(np.diff(q, axis=0) != 0.0, axis=1)) + 1
     kept = np.concatenate([[0], moved])
     if kept.shape[0] < 2:

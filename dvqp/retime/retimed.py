@@ -148,15 +148,15 @@ def retime(scene: RunScene, q: ArrayLike, t: ArrayLike, rate: float = DEFAULT_RA
     if not accelerations:
         raise RetimingError("the step has no acceleration limit: nothing bounds the retiming")
     qdd_max = accelerations[0].qdd_max
-    samples = parameterise(np.asarray(q, dtype=float), np.asarray(t, dtype=float),
-                           robot.qd_max, qdd_max, rate)  # fmt: skip
+    q, t = np.asarray(q, dtype=float), np.asarray(t, dtype=float)
+    samples = parameterise(q, t, robot.qd_max, qdd_max, rate)
     return Retimed(
         samples.t, samples.q, samples.qdot, samples.qddot,
         joint_names=tuple(robot.model.names[1:]), rate=float(rate),
-        planned_duration=float(np.asarray(t)[-1] - np.asarray(t)[0]),
+        planned_duration=float(t[-1] - t[0]),
         velocity_use=float(np.max(np.abs(samples.qdot) / robot.qd_max)),
         acceleration_use=float(np.max(np.abs(samples.qddot) / qdd_max)),
-        excess=verified(scene, spec, np.asarray(q, dtype=float)[0], samples.q),
+        excess=verified(scene, spec, q[0], samples.q),
     )  # fmt: skip
 
 
