@@ -126,3 +126,8 @@ class LimitViolationError(DvqpError):
         self.sample = sample
         self.excess = excess
         super().__init__(message)
+
+
+class RetimingError(DvqpError, ValueError):
+    """A planned path cannot be retimed: it does not move, no parameterisation keeps the joint
+    velocity and acceleration limits, or the library that does it (toppra) is missing."""

@@ -30,6 +30,7 @@ from dvqp._versions import versions
 from dvqp.cli import bench as bench_cmd
 from dvqp.cli import cache as cache_cmd
 from dvqp.cli import console as console_cli
+from dvqp.cli import retime as retime_cli
 from dvqp.cli import solver_option
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
@@ -91,7 +92,19 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("plan", help="run a scene and save its trajectory")
     p.add_argument("scene", help="scene file (.toml)")
     p.add_argument("--backend", default="daqp", help="pinv or a QP backend (default: daqp)")
-    p.add_argument("-o", "--output", help="trajectory file to write (.npz or .csv)")
+    p.add_argument(
+        "-o",
+        "--output",
+        help="trajectory file to write (.npz or .csv; with "
+        "--retime the retimed one: .npz, .csv or .json, a ROS JointTrajectory)",
+    )
+    p.add_argument(
+        "--retime",
+        action="store_true",
+        help="retime the planned path: as fast as "
+        "qd_max and qdd_max allow, at rest at both ends (needs dvqp[retime])",
+    )
+    p.add_argument("--rate", type=float, help="controller rate of --retime, Hz (default 500)")
     solver_option.add_argument(p)
     p.set_defaults(run=_plan)
     c = sub.add_parser("compare", help="run scenes with several backends, print one table")
@@ -138,7 +151,9 @@ def _notice(bar: ProgressBar, text: str) -> None:
 
 def _plan(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
-    output = output_path(args.output, (".npz", ".csv")) if args.output is not None else None
+    formats = retime_cli.FORMATS if args.retime else (".npz", ".csv")
+    output = output_path(args.output, formats) if args.output is not None else None
+    rate = retime_cli.checked_rate(args.retime, args.rate)  # before any work, as the backend
     check_name(args.backend)  # unknown backend: exit 2 before any work
     options = solver_options(args.solver_option, [args.backend]).get(args.backend)
     check_size([scene], 1)
@@ -150,14 +165,14 @@ def _plan(args: argparse.Namespace) -> int:
     except SingularConfigurationError as exc:
         print(f"dvqp: {one_line(scene.source)}: {args.backend}: {exc}", file=sys.stderr)
         return 1
-    if output is not None:
+    if output is not None and rate is None:
         traj.save(output)  # written even for a failed run, to look at it
     row = cmp.summarize(scene, traj, args.settings)
-    print(format_summary(scene, traj, row, output))
-    if row["error"]:  # why check_run failed the run
+    print(format_summary(scene, traj, row, None if rate is not None else output))
+    if row["error"]:  # why check_run failed the run (with --retime: not retimed, not written)
         print(f"dvqp: {row['error']}", file=sys.stderr)
         return 1
-    return 0
+    return 0 if rate is None else retime_cli.retimed(scene, traj, rate, output)
 
 
 def _compare(args: argparse.Namespace) -> int:

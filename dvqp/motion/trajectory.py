@@ -7,7 +7,7 @@ import zipfile
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -17,6 +17,9 @@ from dvqp._versions import versions
 from dvqp.errors import DvqpError
 from dvqp.kinematics.developed_view import unwrap
 from dvqp.limits.excess import StartBroken
+
+if TYPE_CHECKING:
+    from dvqp.retime import Retimed, RunScene
 
 ARRAYS = ("t", "q", "qdot", "tool", "points", "w", "min_clearance", "solve_time", "step_time",
           "task_error", "iterations", "success", "status")  # fmt: skip
@@ -155,17 +158,9 @@ class Trajectory:
     accuracy: dict[str, float] = field(default_factory=dict)
 
     @classmethod
-    def from_samples(
-        cls,
-        *,
-        dt: float,
-        pipe_radius: float,
-        backend: str,
-        tool: NDArray[np.float64],
-        points: NDArray[np.float64],
-        status: Sequence[str],
-        **arrays: NDArray[np.float64],
-    ) -> Trajectory:
+    def from_samples(cls, *, dt: float, pipe_radius: float, backend: str, tool: NDArray[np.float64],
+                     points: NDArray[np.float64], status: Sequence[str],
+                     **arrays: NDArray[np.float64]) -> Trajectory:  # fmt: skip
         """Build from raw samples, unwrapping l (period 2πR) and α (period 2π).
 
         ``arrays`` are the other fields (``q``, ``qdot``, ``w``, ...), taken as they are.
@@ -180,15 +175,9 @@ class Trajectory:
         unwrapped[0, 0] = first[-1]
         unwrapped[:, 0] = unwrap(unwrapped[:, 0], period)
         unwrapped[:, 3] = unwrap(tool[:, 3], 2.0 * np.pi)
-        return cls(
-            t=dt * np.arange(tool.shape[0]),
-            tool=unwrapped,
-            points=pts,
-            status=np.asarray(list(status), dtype=np.str_),
-            backend=backend,
-            pipe_radius=float(pipe_radius),
-            **arrays,  # type: ignore[arg-type]
-        )
+        return cls(t=dt * np.arange(tool.shape[0]), tool=unwrapped, points=pts,
+                   status=np.asarray(list(status), dtype=np.str_), backend=backend,
+                   pipe_radius=float(pipe_radius), **arrays)  # type: ignore[arg-type]  # fmt: skip
 
     @property
     def n_steps(self) -> int:
@@ -213,6 +202,15 @@ class Trajectory:
     def ok(self) -> bool:
         """Every step succeeded."""
         return bool(np.all(self.success))
+
+    def retimed(self, scene: RunScene, rate: float | None = None) -> Retimed:
+        """This run's path as fast as ``scene``'s joint velocity and acceleration limits
+        allow, from rest to rest, sampled at ``rate`` Hz (default
+        :data:`dvqp.retime.DEFAULT_RATE`) and verified exactly: :func:`dvqp.retime.retime`
+        (needs toppra, ``pip install 'dvqp[retime]'``)."""
+        from dvqp.retime import DEFAULT_RATE, retime
+
+        return retime(scene, self.q, self.t, DEFAULT_RATE if rate is None else rate)
 
     def save(self, path: str | Path) -> Path:
         """Write ``.npz`` (all arrays, metadata, scene text) or ``.csv`` atomically.

@@ -4,7 +4,7 @@
 step of a run (split into substeps where a limit would break).
 """
 
-from dvqp.step.advance import JOINT_STRIDE, MAX_HALVINGS, Advance, advance
+from dvqp.step.advance import JOINT_STRIDE, MAX_HALVINGS, Advance, advance, straight_excess
 from dvqp.step.engine import Stepper
 
-__all__ = ["JOINT_STRIDE", "MAX_HALVINGS", "Advance", "Stepper", "advance"]
+__all__ = ["JOINT_STRIDE", "MAX_HALVINGS", "Advance", "Stepper", "advance", "straight_excess"]

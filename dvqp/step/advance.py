@@ -69,7 +69,7 @@ def advance(stepper: Stepper, command: NDArray[np.float64], dt: float, *, verify
     if moved.substeps > 1 and moved.step.success:
         end = stepper.state.q.copy()
         stepper.record_at[0] = -1
-        broken = _straight(stepper, start, end, verify)
+        broken = straight_excess(stepper, start, end)
         if verify and broken.broken:
             stepper.observe(np.zeros_like(start), dt)
             moved = _failed(moved.step, broken, moved.substeps, "the straight motion: ")
@@ -101,7 +101,7 @@ def _attempt(stepper: Stepper, q: NDArray[np.float64], command: NDArray[np.float
     elif reached and verify and motion[1] > JOINT_STRIDE:
         record, end = int(stepper.record_at[0]), stepper.state.q.copy()
         stepper.record_at[0] = -1
-        broken = _straight(stepper, q, end, verify)
+        broken = straight_excess(stepper, q, end)
         stepper.record_at[0] = record
         stepper.load(end)
     if not reached and (not verify or depth >= halvings):
@@ -126,8 +126,7 @@ def _attempt(stepper: Stepper, q: NDArray[np.float64], command: NDArray[np.float
     return _joined(q, stepper.state.q, first, second, dt)
 
 
-def _straight(stepper: Stepper, q: NDArray[np.float64], end: NDArray[np.float64],
-              verify: bool) -> Excess:  # fmt: skip
+def straight_excess(stepper: Stepper, q: NDArray[np.float64], end: NDArray[np.float64]) -> Excess:
     """What the straight motion from ``q`` to ``end`` breaks at interior points spaced at most
     :data:`JOINT_STRIDE` rad apart in every joint (none for a small step: there the deviation
     of the limits from their linearisation is far below their tolerances): the worst excess if
