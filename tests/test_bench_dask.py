@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import os
 import time
+from dataclasses import replace
+from pathlib import Path
 
 import pytest
 
 pytest.importorskip("dask.distributed")
 
-from dvqp.bench import dask_run, generate_scenes, outcome_differences, run_suite
+from dvqp.bench import dask_run, execution, generate_scenes, outcome_differences, run_suite
 
 BACKENDS = ("pinv", "daqp", "osqp")
 
@@ -25,7 +28,8 @@ def test_a_local_cluster_gives_the_same_outcomes_as_a_local_run() -> None:
     ]
     where = on_dask.where
     assert (where.kind, where.scheduler, where.workers) == ("dask", "local", 1)
-    assert ready == [where] and not where.parallel
+    assert ready == [replace(where, startup=())] and not where.parallel
+    assert len(where.startup) == 1 and where.startup[0] >= 0
     assert on_dask.summary.keys() == local.summary.keys()
     for backend in BACKENDS:
         mine, theirs = local.summary[backend], on_dask.summary[backend]
@@ -51,3 +55,29 @@ def test_a_scene_running_past_the_timeout_is_given_up_and_reported(
     ]
     assert [r["index"] for r in suite.rows] == [0, 1, 2] and not suite.interrupted
     assert suite.summary["pinv"]["lost"] == suite.summary["pinv"]["raised"] == 1
+
+
+def test_a_local_cluster_runs_every_scene_once_in_worker_processes_forked_warm(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    log, real = tmp_path / "runs.txt", execution.run_job
+
+    def logged(job: dask_run.Job, *args: object) -> list:
+        with log.open("a") as file:
+            file.write(f"{os.getpid()} {job.index}\n")
+        return real(job, *args)
+
+    monkeypatch.setattr(execution, "_WARM", set())  # as in a fresh process
+    for module in (execution, dask_run):  # here and in warm_up / the tasks (pickled)
+        monkeypatch.setattr(module, "run_job", logged)
+    scenes = generate_scenes(11, 6)
+    suite = run_suite(scenes, ["pinv", "daqp"], seed=11, scheduler="local", workers=2)
+    runs = [tuple(map(int, line.split())) for line in log.read_text().splitlines()]
+    assert runs[0] == (os.getpid(), 0)  # the first scene here, before the cluster forked
+    assert sorted(index for _, index in runs) == list(range(6))  # no scene twice, no warm-up
+    assert all(pid != os.getpid() for pid, _ in runs[1:])
+    assert [(r["index"], r["backend"]) for r in suite.rows] == [
+        (i, b) for i in range(6) for b in ("pinv", "daqp")
+    ]
+    assert len(suite.where.startup) == 2 and min(suite.where.startup) >= 0
+    assert "worker start-up" in suite.where.describe()

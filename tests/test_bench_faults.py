@@ -199,3 +199,15 @@ def test_ctrl_c_stops_a_dask_bench_at_once_and_keeps_what_finished(
     check_interrupted(out, err, before, proc.returncode)
     print(f"SIGINT answered in {took:.2f} s")
     assert took < 5.0
+
+
+def test_ctrl_c_stops_a_local_cluster_bench_at_once_and_keeps_what_finished(
+    tmp_path: Path,
+) -> None:
+    out = tmp_path / "a.json"
+    proc = start("--count", "40", "--scheduler", "local", "--workers", "2", "--json", str(out))
+    took, err, before = interrupt(proc, tmp_path / "a.json.partial")
+    check_interrupted(out, err, before, proc.returncode)
+    print(f"SIGINT answered in {took:.2f} s")
+    assert took < 5.0
+    assert children(proc.pid) == []  # the worker processes ended with the cluster

@@ -10,6 +10,10 @@ Dask is optional (``pip install 'dvqp[dask]'``): it is imported only by
 :func:`import_distributed`, when a cluster is asked for. The workers run
 :func:`dvqp.bench.runner.run_job` on the scene text, so they need dvqp (and the named
 backends) installed; they give the same outcomes as a local run, only their timings differ.
+Before the first scene, :func:`warm_workers` has every worker load dvqp's compiled kernels
+(``Client.run``) and reports each one's start-up; a LocalCluster's worker processes are forked
+from this process (where the platform has ``fork``), which has run the first scene already,
+so they start with its kernels loaded.
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ from collections.abc import Iterator, Sequence
 from types import ModuleType
 from typing import Any
 
-from dvqp.bench.execution import OnRows, Progress, Where
+from dvqp.bench.execution import OnRows, Progress, Where, pool_context, warm_up
 from dvqp.bench.runner import Job, Row, lost_rows, run_job
 from dvqp.errors import DvqpError, one_line
 
@@ -73,8 +77,8 @@ def dask_client(scheduler: str, workers: int = 1) -> Iterator[tuple[Any, Where]]
     ----------
     scheduler
         A scheduler's address (``tcp://host:8786``), or ``"local"`` to start a
-        ``LocalCluster`` of ``workers`` single-threaded workers in this process (threads:
-        quick to start and stopped cleanly by Ctrl-C, but sharing the interpreter).
+        ``LocalCluster`` of ``workers`` single-threaded worker processes, forked from this one
+        where the platform can (:func:`~dvqp.bench.execution.pool_context`).
     workers
         Workers of a LocalCluster (ignored for an existing scheduler).
 
@@ -86,14 +90,18 @@ def dask_client(scheduler: str, workers: int = 1) -> Iterator[tuple[Any, Where]]
         ``scheduler <address>: cannot connect: <reason>``, or ``… no worker within 10 s``.
     """
     dd = import_distributed()
+    import dask  # present with dask.distributed
+
     with contextlib.ExitStack() as stack:
         _quiet_logs(stack)
         try:
             if scheduler == "local":
-                cluster = stack.enter_context(
-                    dd.LocalCluster(n_workers=workers, threads_per_worker=1,
-                                    processes=False, dashboard_address=None)
-                )  # fmt: skip
+                method = pool_context().get_start_method()
+                with dask.config.set({"distributed.worker.multiprocessing-method": method}):
+                    cluster = stack.enter_context(
+                        dd.LocalCluster(n_workers=workers, threads_per_worker=1,
+                                        processes=True, dashboard_address=None)
+                    )  # fmt: skip
                 client = stack.enter_context(dd.Client(cluster))
             else:
                 client = stack.enter_context(dd.Client(scheduler, timeout=CONNECT_TIMEOUT))
@@ -106,6 +114,24 @@ def dask_client(scheduler: str, workers: int = 1) -> Iterator[tuple[Any, Where]]
             raise DvqpError(f"scheduler {scheduler}: no worker within {WORKER_WAIT:g} s") from exc
         threads = int(sum(client.nthreads().values()))
         yield client, Where("dask", threads, scheduler)
+
+
+def warm_workers(client: Any, job: Job, asked: float) -> tuple[float, ...]:
+    """Warm every worker of ``client`` up on ``job`` (:func:`~dvqp.bench.execution.warm_up`,
+    by ``Client.run``); each one's start-up, s: from ``asked`` (``time.time()`` here, e.g.
+    before the cluster started) until it was warm, in the order of the workers' addresses."""
+    try:
+        done = client.run(_warmed, job, asked)
+    except Exception as exc:  # e.g. dvqp missing on a worker
+        reason = f"{type(exc).__name__}: {one_line(str(exc))}"
+        raise DvqpError(f"dask: warming the workers up on {job.name}: {reason}") from exc
+    return tuple(done[address] for address in sorted(done))
+
+
+def _warmed(job: Job, asked: float) -> float:
+    """On a worker: :func:`~dvqp.bench.execution.warm_up`, then the seconds since ``asked``."""
+    warm_up(job)
+    return max(0.0, time.time() - asked)
 
 
 def _quiet_logs(stack: contextlib.ExitStack) -> None:

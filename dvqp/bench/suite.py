@@ -3,10 +3,12 @@
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from typing import Any
 
-from dvqp.bench.dask_run import SCENE_TIMEOUT, WorkersLostError, dask_client, run_dask
+from dvqp.bench.dask_run import SCENE_TIMEOUT, WorkersLostError, dask_client, run_dask, warm_workers
 from dvqp.bench.execution import Progress, Where, local_where, run_local
 from dvqp.bench.generate import BenchScene
 from dvqp.bench.output import Suite
@@ -68,17 +70,26 @@ def run_suite(
         if on_scene is not None:
             on_scene(scene_rows)
 
-    where = local_where(jobs, workers) if scheduler is None else Where("dask", 0, scheduler)
+    where = local_where(jobs, workers)
+    where = where if scheduler is None else Where("dask", where.workers, scheduler)
     try:
         if scheduler is None:
             if ready is not None:
                 ready(where)
-            run_local(jobs, workers, finished, progress)
+            where = replace(where, startup=run_local(jobs, workers, finished, progress))
         else:
+            here = jobs[:1] if scheduler == "local" else []  # then the workers fork warm
+            if here and ready is not None:
+                ready(where)
+            run_local(here, 1, finished, _shifted(progress, 0, jobs))
+            asked = time.time()
             with dask_client(scheduler, workers) as (client, where):
-                if ready is not None:
+                if not here and ready is not None:
                     ready(where)
-                run_dask(client, jobs, finished, progress, scene_timeout)
+                if jobs:
+                    where = replace(where, startup=warm_workers(client, jobs[0], asked))
+                rest = _shifted(progress, len(here) * len(backends), jobs)
+                run_dask(client, jobs[len(here) :], finished, rest, scene_timeout)
     except KeyboardInterrupt as exc:
         suite = make_suite(rows, backends, seed, len(scenes), where, shift, interrupted=True)
         raise BenchInterrupted(suite) from exc
@@ -86,6 +97,14 @@ def run_suite(
         exc.suite = make_suite(rows, backends, seed, len(scenes), where, shift, interrupted=True)
         raise
     return make_suite(rows, backends, seed, len(scenes), where, shift)
+
+
+def _shifted(progress: Progress | None, before: int, jobs: Sequence[Job]) -> Progress | None:
+    """``progress`` of a part of the runs: ``before`` runs done already, of all ``jobs``'."""
+    total = sum(len(job.backends) for job in jobs)
+    if progress is None:
+        return None
+    return lambda done, _, label: progress(done + before, total, label)
 
 
 def make_suite(

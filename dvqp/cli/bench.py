@@ -25,14 +25,13 @@ from dvqp.bench import (
     Suite,
     bench_json,
     format_summary,
-    generate_scenes,
     import_distributed,
     rows_to_csv,
     run_suite,
     save_scenes,
 )
 from dvqp.bench.dask_run import SCENE_TIMEOUT, WorkersLostError
-from dvqp.bench.execution import Where
+from dvqp.bench.execution import Where, generate_local
 from dvqp.cli import solver_option
 from dvqp.cli.progress import ProgressBar
 from dvqp.cli.report import write_text
@@ -95,7 +94,8 @@ def run(args: argparse.Namespace) -> int:
     before any run (exit 2); Ctrl-C a KeyboardInterrupt, after the finished scenes were summed
     up and written."""
     options = check_options(args)
-    scenes = generate_scenes(options.seed, options.count)
+    here = options.scheduler in (None, "local")  # else --workers is the cluster's business
+    scenes = generate_local(options.seed, options.count, options.workers if here else 1)
     partial: list[PartialFile] = []
 
     def ready(where: Where) -> None:
