@@ -26,6 +26,7 @@ import inspect
 import os
 import pickle
 import sys
+import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -230,8 +231,10 @@ def compiled_on_first_call(
     The hook is the dispatcher's ``_compile_for_args``, which numba calls only when no compiled
     overload fits the arguments and compilation is enabled, i.e. only until the first call
     has compiled. Replacing it returns the dispatcher itself, which numba then calls again with
-    the same arguments: now a typed call of the one overload. Concurrent first calls are safe
-    (the second ``compile`` finds the overload the first one made). Meant for functions called
+    the same arguments: now a typed call of the one overload. Concurrent first calls are safe:
+    a lock lets one thread compile, the others then find compiling done (without it, numba
+    refused their ``compile`` with ``RuntimeError('compilation disabled')``, e.g. in a Dask
+    worker's threads). Meant for functions called
     from Python: numba's typing of a call from other jitted code would compile the callee for
     the caller's argument types instead. ``tests/test_solvers_structure.py`` checks, in a fresh
     interpreter, that importing compiles nothing and that each kernel ends with one overload.
@@ -239,10 +242,13 @@ def compiled_on_first_call(
 
     def decorate(function: Callable[..., Any]) -> Dispatcher:
         dispatcher: Dispatcher = njit(**options)(function)
+        first = threading.Lock()
 
         def compile_declared(*args: Any, **kwargs: Any) -> Dispatcher:
-            dispatcher.compile(signature)
-            dispatcher.disable_compile()
+            with first:  # a thread that waited finds it compiled (compiling is then disabled)
+                if dispatcher._can_compile:
+                    dispatcher.compile(signature)
+                    dispatcher.disable_compile()
             return dispatcher
 
         dispatcher._compile_for_args = compile_declared

@@ -247,3 +247,42 @@ def test_a_plan_over_a_damaged_cache_exits_0_with_a_note_and_the_next_runs_clean
     done = subprocess.run(clear, capture_output=True, text=True, env=env, cwd=ROOT, check=True)
     assert done.stdout.startswith(f"removed {len(files)} compile cache files (")
     assert not [p for p in cache.rglob("*") if p.is_file()]
+
+
+def _shifted_double(offset: float) -> Callable[[float], float]:
+    def kernel(x: float) -> float:
+        return 2.0 * x + offset  # a constant of the compiled code
+
+    return kernel
+
+
+def _first_calls(kernel: Dispatcher, threads: int) -> list[object]:
+    """What ``kernel(1.0)`` gave in each of ``threads`` threads released at once."""
+    import threading
+
+    barrier, answers = threading.Barrier(threads), []
+
+    def first_call() -> None:
+        barrier.wait()
+        try:
+            answers.append(kernel(1.0))
+        except RuntimeError as exc:  # numba's 'compilation disabled' (before the lock)
+            answers.append(exc)
+
+    started = [threading.Thread(target=first_call) for _ in range(threads)]
+    for thread in started:
+        thread.start()
+    for thread in started:
+        thread.join()
+    return answers
+
+
+def test_first_calls_from_many_threads_at_once_all_get_the_answer() -> None:
+    from numba import types
+
+    from solvers.jit import compiled_on_first_call
+
+    for offset in (0.0, 1.0, 2.0):  # a fresh dispatcher each round: a first call each time
+        kernel = compiled_on_first_call(types.float64(types.float64))(_shifted_double(offset))
+        assert _first_calls(kernel, 6) == [2.0 + offset] * 6
+        assert len(kernel.overloads) == 1
