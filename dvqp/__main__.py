@@ -8,17 +8,17 @@ from dvqp.cli import main
 
 
 def command() -> None:
-    """Run :func:`dvqp.cli.main` and exit with its code. After an interrupt (130) the process
-    ends at once, streams flushed, without the interpreter's final clean-up: numba's and LLVM's
-    objects caught mid-way by the interrupt may fail to be destroyed and would print noise (or
+    """Run :func:`dvqp.cli.main` and exit with its code, at once, streams flushed, without the
+    interpreter's final clean-up. Every file is complete by then (written atomically, closed),
+    every pool and cluster shut down by its own ``with``; what is left to tear down is numba's,
+    LLVM's and Pinocchio's objects, which costs 0.2-0.4 s of CPU on every command, and which
+    after an interrupt (130), caught mid-way, may fail to be destroyed and print noise (or
     crash) after ``dvqp: interrupted``."""
     code = main()
-    if code == 130:
-        for stream in (sys.stdout, sys.stderr):
-            with contextlib.suppress(Exception):
-                stream.flush()
-        os._exit(130)
-    sys.exit(code)
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(code)
 
 
 if __name__ == "__main__":
