@@ -1,5 +1,5 @@
-"""The ``dvqp`` command line: ``plan``, ``compare``, ``plot``, ``backends``, ``bench`` and
-``console``.
+"""The ``dvqp`` command line: ``plan``, ``compare``, ``plot``, ``backends``, ``bench``,
+``console``, ``cache`` and ``export-qps``.
 
 Exit codes: 0 success (``compare`` and ``bench``: the comparison ran, whatever its runs'
 verdicts; ``compare --strict``: and every run is ``ok``); 1 a run failed (failed steps, a
@@ -29,6 +29,7 @@ from dvqp._versions import versions
 from dvqp.cli import bench as bench_cmd
 from dvqp.cli import cache as cache_cmd
 from dvqp.cli import console as console_cli
+from dvqp.cli import export as export_cmd
 from dvqp.cli import solver_option
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
@@ -107,6 +108,7 @@ def _parser() -> argparse.ArgumentParser:
     console_cli.register(sub)
     bench_cmd.register(sub)
     cache_cmd.register(sub)
+    export_cmd.register(sub)
     b = sub.add_parser("backends", help="list the installed backends and their versions")
     b.set_defaults(run=_backends)
     return parser
