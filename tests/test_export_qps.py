@@ -65,7 +65,7 @@ X_TOLERANCE = 1e-6
 problem is strictly convex (``P`` positive definite), so its minimiser is unique."""
 
 OSQP = {"eps_abs": 1e-9, "eps_rel": 1e-9, "polish": True, "max_iter": 100000}
-"""qpsolvers' OSQP defaults (eps 1e-3 through qpsolvers) leave errors near 1e-4 on x."""
+"""OSQP's own defaults (eps 1e-3), which qpsolvers keeps, leave errors up to 1e-2 on x."""
 
 
 @pytest.fixture(scope="module")
