@@ -133,7 +133,8 @@ class _Calls:
             "step": step, "call": call, "kind": kind, "variables": p.n,
             "equalities": p.n_eq, "inequalities": p.n_in, "found": found,
             "refusal": "" if found else solution.refusal, "solver_status": str(solution.status),
-            "iterations": solution.iterations, "retried": bool(solution.retried),
+            "iterations": None if solution.iterations is None else int(solution.iterations),
+            "retried": bool(solution.retried),
             "warm_start": self.warm.get(kind), **active_rows(p, solution),
         })  # fmt: skip
         s = solution  # x and the multipliers (empty: absent, or the call refused)
