@@ -12,7 +12,8 @@ The pieces, from the bottom up (one subpackage each):
 - :mod:`dvqp.resolution` — :class:`StepSpec`, the QP and pseudoinverse resolvers, their names;
 - :mod:`dvqp.step` — the compiled step (:class:`Stepper`) and one verified step (``advance``);
 - :mod:`dvqp.motion` — JOG and path commands, :func:`simulate`, :class:`Trajectory`;
-- :mod:`dvqp.scenes` — scene files; :func:`plan` runs one with a named backend.
+- :mod:`dvqp.scenes` — scene files; :func:`plan` runs one with a named backend, and
+  :func:`export_qps` writes each QP of such a run to a file.
 """
 
 from dvqp._versions import __version__
@@ -33,6 +34,7 @@ from dvqp.limits import Bounds, Constraint, Distances, Limit, VelocityDamper
 from dvqp.motion import JogSegment, ToolPath, Trajectory, jog_commands, simulate
 from dvqp.objective import Objective, ObjectiveTerm, Term
 from dvqp.planning import check_run, plan
+from dvqp.qp_export import export_qps
 from dvqp.resolution import PseudoinverseResolver, QPResolver, Resolver, StepSpec, make_resolver
 from dvqp.resolution.step import Step
 from dvqp.scenes import Scene, load_scene
@@ -47,5 +49,5 @@ __all__ = [
     "RobotFileError", "Scene", "SceneError", "ShapeError", "SingularConfigurationError", "Step",
     "StepPlan", "StepSpec", "Stepper", "Task", "TaskRows", "Term", "ToolPath", "ToolTask",
     "Trajectory", "UnreachableTargetError", "VelocityDamper", "__version__", "check_run",
-    "jog_commands", "load_scene", "make_resolver", "plan", "simulate",
+    "export_qps", "jog_commands", "load_scene", "make_resolver", "plan", "simulate",
 ]  # fmt: skip

@@ -20,7 +20,7 @@ from dvqp.errors import LimitViolationError, UnreachableTargetError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits import Excess, Limit, start_broken_lines
 from dvqp.motion.jog import box_average, jog_commands
-from dvqp.motion.simulate import dv_error, simulate
+from dvqp.motion.simulate import StepWatcher, dv_error, simulate
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.pinv import PseudoinverseResolver
 from dvqp.resolution.registry import make_resolver, tier_options
@@ -84,6 +84,7 @@ def plan(
     stop: bool = True,
     options: dict[str, Any] | None = None,
     tier: str = "default",
+    watch: StepWatcher | None = None,
 ) -> Trajectory:
     """Run a scene with a resolver and return its trajectory, ended at rest.
 
@@ -111,6 +112,8 @@ def plan(
     tier
         ``"default"``, ``"high_accuracy"`` or ``"low_accuracy"``: the QP backend's accuracy
         settings and the tolerance its answers are checked to (:mod:`solvers.tiers`).
+    watch
+        Shown every backend call of the run (:func:`dvqp.motion.simulate.simulate`).
 
     Raises
     ------
@@ -128,7 +131,7 @@ def plan(
     traj = simulate(
         scene.robot, scene.pipe_radius, resolver, scene.q0, c.velocity, scene.dt,
         obstacles=scene.obstacles, reference=c.reference[:-1] if c.feedback_gain > 0 else None,
-        feedback_gain=c.feedback_gain, progress=progress, notice=notice, stop=stop,
+        feedback_gain=c.feedback_gain, progress=progress, notice=notice, stop=stop, watch=watch,
     )  # fmt: skip
     held = c.reference[-1:].repeat(traj.t.shape[0] - c.reference.shape[0], axis=0)
     error = dv_error(np.vstack([c.reference, held]), traj.tool, scene.pipe_radius)

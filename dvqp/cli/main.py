@@ -1,5 +1,5 @@
-"""The ``dvqp`` command line: ``plan``, ``compare``, ``plot``, ``backends``, ``bench`` and
-``console``.
+"""The ``dvqp`` command line: ``plan``, ``compare``, ``plot``, ``backends``, ``bench``,
+``console``, ``cache`` and ``export-qps``.
 
 Exit codes: 0 success (``compare`` and ``bench``: the comparison ran, whatever its runs'
 verdicts; ``--check``: and every QP backend's run is ``ok``, the baseline's known limit
@@ -30,6 +30,7 @@ from dvqp._versions import versions
 from dvqp.cli import bench as bench_cmd
 from dvqp.cli import cache as cache_cmd
 from dvqp.cli import console as console_cli
+from dvqp.cli import export as export_cmd
 from dvqp.cli import retime as retime_cli
 from dvqp.cli import solver_option
 from dvqp.cli.figures import FIGURE_FORMATS
@@ -126,6 +127,7 @@ def _parser() -> argparse.ArgumentParser:
     console_cli.register(sub)
     bench_cmd.register(sub)
     cache_cmd.register(sub)
+    export_cmd.register(sub)
     b = sub.add_parser("backends", help="list the installed backends and their versions")
     b.set_defaults(run=_backends)
     return parser

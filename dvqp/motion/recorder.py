@@ -39,10 +39,13 @@ class TrajectoryRecorder:
             "limits_kept": np.ones(n_steps + 1, dtype=bool),
         }
         self.status = np.full(n_steps, "", dtype=object)  # preallocated: no growth per step
+        self.steps = 0
+        """Steps recorded so far: the index of the step being taken."""
 
     def step(self, k: int, moved: Advance, step_time: float) -> None:
         """Step k (from sample k to k + 1) and its full wall time, s."""
         a, step = self.arrays, moved.step
+        self.steps = k + 1
         a["solve_time"][k], a["step_time"][k] = step.solve_time, step_time
         a["solver_time"][k] = step.solver_time
         a["task_error"][k], a["success"][k] = step.task_error, step.success

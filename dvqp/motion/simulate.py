@@ -27,12 +27,16 @@ from dvqp.motion.stop import brake, room
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.step import Resolver
 from dvqp.step import MAX_HALVINGS, Stepper, advance
+from solvers import Problem, Solution
 
 Array = NDArray[np.float64]
 
 COMPILE_NOTICE_SECONDS = 1.0
 """s: compiling the step for longer than this is announced through ``notice``."""
 COMPILE_NOTICE = "compiling: first run only, ~30 s"
+
+#: ``(step, kind, problem, solution)`` of a backend call (:func:`simulate`'s ``watch``).
+StepWatcher = Callable[[int, str, Problem, Solution], None]
 
 __all__ = ["COMPILE_NOTICE", "dv_error", "simulate"]
 
@@ -94,6 +98,7 @@ def simulate(
     progress: Callable[[int, int], None] | None = None,
     notice: Callable[[str], None] | None = None,
     stop: bool = True,
+    watch: StepWatcher | None = None,
 ) -> Trajectory:
     """Run the commands from ``q0`` and return the trajectory.
 
@@ -129,6 +134,11 @@ def simulate(
         After the last command, brake until every joint has stopped (:mod:`dvqp.motion.stop`):
         the run ends at rest, ``qdot[-1] == 0`` exactly, and ``brake_start`` is the first
         braking step. False: end after the last command (e.g. to chain runs).
+    watch
+        A QP run's every backend call (not the one that compiles the step first) is shown to it
+        as ``watch(step, kind, problem, solution)``: ``step`` the recorded step it belongs to
+        (the braking steps continue the count), the rest as a
+        :data:`~dvqp.resolution.qp.Watcher` gets them.
 
     Notes
     -----
@@ -151,6 +161,8 @@ def simulate(
             stepper.resolve(cmd[0], dt)
             stepper.record_at[0] = 0
             stepper.start(q_start)
+    if watch is not None and stepper.solver is not None:
+        stepper.solver.watchers.append(lambda kind, p, s: watch(record.steps, kind, p, s))
     feedback = ref is not None and gain > 0.0
     started = time.perf_counter()
     for i in range(cmd.shape[0]):
