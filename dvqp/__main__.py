@@ -15,6 +15,9 @@ def command() -> None:
     after an interrupt (130), caught mid-way, may fail to be destroyed and print noise (or
     crash) after ``dvqp: interrupted``."""
     code = main()
+    if "multiprocessing.util" in sys.modules:  # its own exit clean-up (atexit's), kept:
+        with contextlib.suppress(Exception):  # children joined, semaphores released (else
+            sys.modules["multiprocessing.util"]._exit_function()  # a tracker warns of leaks)
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):
             stream.flush()

@@ -124,7 +124,7 @@ def test_json_and_csv_of_a_suite_hold_no_nan() -> None:
     doc = json.loads(bench_json(suite))
     assert doc["results"][0]["min_clearance"] is None and doc["results"][0]["parallel"] is True
     assert doc["execution"] == {"kind": "local", "workers": 4, "scheduler": None,
-                                "parallel": True}  # fmt: skip
+                                "startup": [], "parallel": True}  # fmt: skip
     assert {"results", "summary", "machine", "versions", "seed", "count"} <= set(doc)
     lines = rows_to_csv(suite).splitlines()
     assert len(lines) == 2 and "nan" not in lines[1].lower() and "inf" not in lines[1].lower()

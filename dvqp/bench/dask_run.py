@@ -136,13 +136,13 @@ def _warmed(job: Job, asked: float) -> float:
 
 
 def _quiet_logs(stack: contextlib.ExitStack) -> None:
-    """Distributed's loggers (each has its own level) to ERROR and asyncio's off for the
+    """Distributed's loggers (each has its own level) to CRITICAL and asyncio's off for the
     stack's life: no info lines on the cluster's start and stop, no warning when a result must
     be recomputed, no "Task exception was never retrieved" for a fetch given up; what matters
     reaches the user as dvqp's own lines. Dead tasks are collected before the levels return
     (a nanny's start cut short by Ctrl-C leaves a failed task, reported when collected)."""
     names = [n for n in logging.root.manager.loggerDict if n.split(".")[0] == "distributed"]
-    for name, level in [*((n, logging.ERROR) for n in ["distributed", *names]),
+    for name, level in [*((n, logging.CRITICAL) for n in ["distributed", *names]),
                         ("asyncio", logging.CRITICAL + 1)]:  # fmt: skip
         logger = logging.getLogger(name)
         stack.callback(logger.setLevel, logger.level)
