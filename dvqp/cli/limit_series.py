@@ -101,11 +101,14 @@ def limit_series(scene: Scene, traj: Trajectory) -> LimitPage:
     ParameterError
         The trajectory does not fit the scene's arm, or a sample is singular.
     """
-    n = scene.robot.n
+    n, radius = scene.robot.n, scene.pipe_radius
     if traj.q.ndim != 2 or traj.q.shape[1] != n or traj.t.shape[0] < 2:
         raise ParameterError("trajectory", f"needs at least 2 samples of the scene's {n} joints")
-    stepper = Stepper(scene.robot, scene.pipe_radius, PseudoinverseResolver(scene.spec()),
-                      traj.q[0], scene.dt)  # fmt: skip
+    if traj.pipe_radius != radius:
+        raise ParameterError("trajectory", f"its pipe radius is {traj.pipe_radius:.6g} m, the "
+                             f"scene's {radius:.6g} m")  # fmt: skip
+    dt = float(traj.t[1] - traj.t[0])
+    stepper = Stepper(scene.robot, radius, PseudoinverseResolver(scene.spec()), traj.q[0], dt)
     stepper.arrays.shapes.far[:] = np.inf  # every row exact: no box bound far from a shape
     stepper.arrays.shapes.refine[:] = np.inf  # every link's real clearance to the last 10 µm
     c = stepper.arrays.checks
@@ -120,10 +123,10 @@ def limit_series(scene: Scene, traj: Trajectory) -> LimitPage:
             curves += _positions(traj.t, values[:, block.start : block.stop], scene)
         else:
             curves += _damper(traj.t, values, c.safe, c.tolerance, block, scene)
-    curves += _rates(traj, stepper, scene.dt)
+    curves += _rates(traj, stepper, dt)
     order = ["clearance", "self distance", "height", "tilt"]
     curves.sort(key=lambda c: order.index(c.panel) if c.panel in order else len(order))
-    return LimitPage(tuple(curves), _marks(traj), float(scene.dt))
+    return LimitPage(tuple(curves), _marks(traj), dt)
 
 
 def _groups(block: Block, scene: Scene) -> list[tuple[str, str, slice | list[int]]]:

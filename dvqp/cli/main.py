@@ -18,6 +18,7 @@ import json
 import os
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -36,7 +37,7 @@ from dvqp.cli.report import format_summary, format_table, rows_to_csv, write_tex
 from dvqp.cli.solver_option import solver_options
 from dvqp.errors import DvqpError, SingularConfigurationError, one_line
 from dvqp.resolution.registry import check_name, default_resolvers, describe_resolvers
-from dvqp.scenes import environment
+from dvqp.scenes import environment, loads
 
 __all__ = ["format_table", "main"]
 
@@ -103,6 +104,14 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("trajectory", help="trajectory file (.npz) written by 'dvqp plan'")
     g.add_argument("-o", "--output", required=True, help="figure (.png/.svg/.pdf, or .gif)")
     g.add_argument("--gif", action="store_true", help="write an animation (.gif)")
+    g.add_argument("--full", action="store_true",
+                   help="the developed view's whole circumference (default: where the arm and "
+                        "the obstacles are)")  # fmt: skip
+    g.add_argument("--limits", action="store_true",
+                   help="write the limits page: each limit's quantity over time against its "
+                        "bound")  # fmt: skip
+    g.add_argument("--scene", help="with --limits: the scene file to read the arm and limits "
+                                   "from (default: the one stored in the trajectory)")  # fmt: skip
     g.set_defaults(run=_plot)
     console_cli.register(sub)
     bench_cmd.register(sub)
@@ -183,7 +192,9 @@ def _compare(args: argparse.Namespace) -> int:
 
 def _plot(args: argparse.Namespace) -> int:
     traj = _load_trajectory(args.trajectory)
-    drawn_with: dict[str, Any] = {}
+    if args.limits or args.scene is not None:
+        return _plot_limits(args, traj)
+    drawn_with: dict[str, Any] = {"full": args.full}
     if traj.scene_text:  # draw the stored scene's obstacles, levels and weld
         env = environment(traj.scene_text, f"{args.trajectory} (stored scene)")
         drawn_with = {"obstacles": env.obstacles, "orbital_level": env.orbital_level,
@@ -192,6 +203,30 @@ def _plot(args: argparse.Namespace) -> int:
 
     draw = plot.animate_trajectory if args.gif else plot.plot_trajectory
     print(f"wrote {draw(traj, args.output, **drawn_with)}")
+    return 0
+
+
+def _plot_limits(args: argparse.Namespace, traj: Trajectory) -> int:
+    """The limits page of a trajectory, from its stored scene (or ``--scene``)."""
+    if not args.limits or args.gif or args.full:
+        raise DvqpError("--scene goes with --limits, which takes neither --gif nor --full")
+    target = output_path(args.output, FIGURE_FORMATS)
+    if args.scene is not None:
+        scene = load_scene(args.scene)
+    elif traj.scene_text:
+        folder = Path(args.trajectory).parent  # a relative URDF: beside the trajectory
+        scene = loads(traj.scene_text, f"{args.trajectory} (stored scene)", base_dir=folder)
+    else:
+        raise DvqpError(f"{args.trajectory}: no stored scene: give the run's --scene")
+    from dvqp.cli.limit_series import limit_series
+    from dvqp.cli.plot_limits import plot_limits
+
+    try:
+        page = limit_series(scene, traj)
+    except DvqpError as exc:
+        raise DvqpError(f"{args.trajectory}: not a run of {scene.source}: {exc}") from exc
+    title = f"{scene.name} / {traj.backend or 'unknown resolver'}: limits over time"
+    print(f"wrote {plot_limits(page, target, title)}")
     return 0
 
 
