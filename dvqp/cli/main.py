@@ -197,7 +197,7 @@ def _plot(args: argparse.Namespace) -> int:
     drawn_with: dict[str, Any] = {"full": args.full}
     if traj.scene_text:  # draw the stored scene's obstacles, levels and weld
         env = environment(traj.scene_text, f"{args.trajectory} (stored scene)")
-        drawn_with = {"obstacles": env.obstacles, "orbital_level": env.orbital_level,
+        drawn_with |= {"obstacles": env.obstacles, "orbital_level": env.orbital_level,
                       "weld_z": env.weld, "min_height": env.min_height}  # fmt: skip
     from dvqp.cli import plot
 
