@@ -71,16 +71,35 @@ def test_the_zoom_moves_with_the_scene_across_the_seam(paper: tuple, by: float) 
     assert inside(occupied(moved, circles), mlo, mhi)
 
 
-def test_an_obstacle_across_the_seam_is_one_stretch() -> None:
-    """A circle on the seam whose outline passes 2πR covers the start of the circumference:
-    the empty stretch is not taken from under it."""
-    traj, _ = run("paper-two-inlets", "daqp"), None
-    on_seam = Obstacle([np.pi * RADIUS, 0.3], 0.1, 1.0)
-    moved, _ = shifted(traj, [], np.pi * RADIUS - 0.35)  # the arm just left of the seam
-    lo, hi = arc_extent(moved, [on_seam], RADIUS)
-    assert inside(occupied(moved, [on_seam]), lo, hi)
-    assert hi > np.pi * RADIUS > lo  # drawn across the seam, not round the back of the pipe
-    assert hi - lo < 0.7
+@pytest.mark.parametrize(("at", "by"), [(np.pi * RADIUS, np.pi * RADIUS - 0.35), (0.0, 0.12)])
+def test_an_obstacle_across_a_period_is_one_stretch(at: float, by: float) -> None:
+    """A circle on the seam (or on l = 0, where l modulo 2πR starts again) with the arm
+    beside it: the arc holds both, the empty stretch is not taken from under the circle."""
+    traj = run("paper-two-inlets", "daqp")
+    circle = Obstacle([at, 0.3], 0.1, 1.0)
+    moved, _ = shifted(traj, [], by)
+    lo, hi = arc_extent(moved, [circle], RADIUS)
+    assert inside(occupied(moved, [circle]), lo, hi)
+    l = occupied(moved, [circle])
+    l = at + (l - at + 0.5 * PERIOD) % PERIOD - 0.5 * PERIOD  # near the circle: no seam between
+    assert hi - lo == pytest.approx(1.16 * np.ptp(l) + 0.06)  # the stretch, 8 % and 3 cm a side
+    assert hi - lo < 0.8  # the arm spans ~0.4 m: not round the back of the pipe
+
+
+def test_what_passes_2pir_hides_the_stretches_it_covers_again() -> None:
+    """A circle on l = 0 (its outline from 2πR − 0.1 past 2πR to 0.1) hides a small one at
+    l = 0.05: the longest empty stretch is the 0.415 m round the back, not the 0.43 m from the
+    small circle to the arm, of which 0.03 m is under the first."""
+    traj = run("paper-two-inlets", "daqp")
+    arm = occupied(traj, [])
+    moved, _ = shifted(traj, [], 0.5 - arm.min())  # the arm from l = 0.5 m
+    top = occupied(moved, []).max()
+    end = PERIOD - 0.1 - 0.415  # a third circle from the arm's end to here
+    shapes = [Obstacle([0.0, 0.3], 0.1, 1.0), Obstacle([0.05, 0.3], 0.02, 1.0),
+              Obstacle([0.5 * (top - 0.02 + end), 0.3], 0.5 * (end - top + 0.02), 1.0)]  # fmt: skip
+    lo, hi = arc_extent(moved, shapes, RADIUS)
+    assert hi - lo == pytest.approx(1.16 * (end + 0.1) + 0.06, abs=1e-3)
+    assert inside(occupied(moved, shapes), lo, hi)
 
 
 def test_a_run_all_round_the_pipe_is_drawn_whole() -> None:
