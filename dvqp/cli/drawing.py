@@ -55,8 +55,12 @@ def make_view(
     orbital_level: float | None = None,
     weld_z: float | None = None,
     min_height: float | None = None,
+    full: bool = False,
 ) -> View:
-    """Check the inputs and fix the developed-view limits (z: everything drawn, padded).
+    """Check the inputs and fix the developed-view limits: z spans everything drawn, l the
+    arc where the arm (rail point, body, tool; over the whole run) and the obstacles are, both
+    padded (:func:`arc_extent`), or with ``full`` (or where that arc is most of the pipe) the
+    whole circumference and a strip beyond each side of the seam.
 
     Raises
     ------
@@ -75,12 +79,46 @@ def make_view(
             raise ParameterError(name, f"must be a finite number, got {value!r}")
     h = None if orbital_level is None else float(orbital_level)
     weld = None if weld_z is None else float(weld_z)
-    z = [traj.points[..., 1].ravel(), traj.tool[:, 1], *(np.array(o.z_range) for o in obstacles)]
+    z = [traj.points[..., 1].ravel(), traj.tool[:, 1], traj.rail[:, 1],  # rail: () if none
+         *(np.array(o.z_range) for o in obstacles)]  # fmt: skip
     zs = np.concatenate([*z, [] if weld is None else [weld]])
     pad, edge = 0.08 * float(np.ptp(zs)) + 0.03, 1.12 * np.pi * radius  # l: beyond the seams
-    limits = (-edge, edge, float(zs.min()) - pad, float(zs.max()) + pad)
+    arc = None if full else arc_extent(traj, obstacles, radius)
+    lo, hi = (-edge, edge) if arc is None else arc
+    limits = (lo, hi, float(zs.min()) - pad, float(zs.max()) + pad)
     floor = None if min_height is None else float(min_height)
     return View(traj, radius, tuple(obstacles), h, weld, limits, floor)
+
+
+def arc_extent(
+    traj: Trajectory, obstacles: Sequence[Shape], radius: float
+) -> tuple[float, float] | None:
+    """The shortest arc ``(l_lo, l_hi)`` (m) that holds every sample's arm (its rail point,
+    body points and tool) and every obstacle's outline but bands, padded by 8 % of its length
+    and 3 cm a side, its middle wrapped into ``(−πR, πR]`` (``l_hi`` may pass the seam); None
+    if it would be 2πR or more. l is periodic: the arc is the circumference less the longest
+    stretch that nothing occupies."""
+    period = 2.0 * np.pi * radius
+    recorded = traj.rail.shape[0] == traj.t.shape[0]
+    rail = traj.rail[:, :1] if recorded else np.zeros((traj.t.shape[0], 0))
+    arm = unwrap(np.hstack([rail, traj.points[..., 0], traj.tool[:, :1]]), period, axis=1)
+    rings = [o.outline()[:, 0] for o in obstacles]
+    rings = [r for r in rings if not np.isnan(r).all()]  # a band occupies every l
+    lo = np.concatenate([arm.min(axis=1), [r.min() for r in rings]])
+    width = np.concatenate([np.ptp(arm, axis=1), [np.ptp(r) for r in rings]])
+    order = np.argsort(lo % period)
+    start, reach = (lo % period)[order], np.maximum.accumulate((lo % period + width)[order])
+    wrapped = reach[-1] - period  # what passes 2πR covers the first stretches again
+    gaps = np.append(start[1:] - np.maximum(reach[:-1], wrapped), start[0] - wrapped)
+    g = int(np.argmax(gaps))  # the longest empty stretch: after reach[g]
+    first = start[(g + 1) % start.shape[0]]
+    length = period - float(gaps[g])
+    margin = 0.08 * length + 0.03
+    if length + 2.0 * margin >= period:
+        return None
+    middle = first + 0.5 * length
+    shift = float(wrap_arc(middle, radius)) - middle
+    return first + shift - margin, first + shift + length + margin
 
 
 def wrap_arc(l: NDArray[np.float64] | float, radius: float) -> NDArray[np.float64]:

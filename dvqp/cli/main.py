@@ -19,11 +19,8 @@ import json
 import os
 import sys
 from collections.abc import Sequence
-from typing import Any
 
-import numpy as np
-
-from dvqp import Trajectory, __version__, load_scene, plan
+from dvqp import __version__, load_scene, plan
 from dvqp import comparison as cmp
 from dvqp._files import output_path
 from dvqp._versions import versions
@@ -31,8 +28,8 @@ from dvqp.cli import bench as bench_cmd
 from dvqp.cli import cache as cache_cmd
 from dvqp.cli import console as console_cli
 from dvqp.cli import export as export_cmd
+from dvqp.cli import plot_command, solver_option
 from dvqp.cli import retime as retime_cli
-from dvqp.cli import solver_option
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
 from dvqp.cli.report import format_summary, format_table, rows_to_csv, write_text
@@ -44,7 +41,6 @@ from dvqp.resolution.registry import (
     default_resolvers,
     describe_resolvers,
 )
-from dvqp.scenes import environment
 
 __all__ = ["format_table", "main"]
 
@@ -119,11 +115,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="exit 1 unless every QP backend's run is ok (safe to send)")  # fmt: skip
     solver_option.add_argument(c)
     c.set_defaults(run=_compare)
-    g = sub.add_parser("plot", help="draw a saved trajectory")
-    g.add_argument("trajectory", help="trajectory file (.npz) written by 'dvqp plan'")
-    g.add_argument("-o", "--output", required=True, help="figure (.png/.svg/.pdf, or .gif)")
-    g.add_argument("--gif", action="store_true", help="write an animation (.gif)")
-    g.set_defaults(run=_plot)
+    plot_command.register(sub)
     console_cli.register(sub)
     bench_cmd.register(sub)
     cache_cmd.register(sub)
@@ -208,55 +200,6 @@ def _compare(args: argparse.Namespace) -> int:
         plot_comparison(rows, plot_out)
     qp_runs = [row for row in rows if row["backend"] != PINV]
     return 1 if args.check and not all(row["success"] for row in qp_runs) else 0
-
-
-def _plot(args: argparse.Namespace) -> int:
-    traj = _load_trajectory(args.trajectory)
-    drawn_with: dict[str, Any] = {}
-    if traj.scene_text:  # draw the stored scene's obstacles, levels and weld
-        env = environment(traj.scene_text, f"{args.trajectory} (stored scene)")
-        drawn_with = {"obstacles": env.obstacles, "orbital_level": env.orbital_level,
-                      "weld_z": env.weld, "min_height": env.min_height}  # fmt: skip
-    from dvqp.cli import plot
-
-    draw = plot.animate_trajectory if args.gif else plot.plot_trajectory
-    print(f"wrote {draw(traj, args.output, **drawn_with)}")
-    return 0
-
-
-def _load_trajectory(path: str) -> Trajectory:
-    """A trajectory file, checked enough to be drawn; else a DvqpError
-    ``<path>: cannot read: <reason>`` or ``<path>: not a dvqp trajectory (<reason>)``."""
-    try:
-        with open(path, "rb") as fh:
-            zipped = fh.read(4) == b"PK\x03\x04"
-    except OSError as exc:
-        raise DvqpError(f"{path}: cannot read: {exc.strerror or exc}") from exc
-    if not zipped:
-        raise DvqpError(f"{path}: not a dvqp trajectory (not an .npz file)")
-    try:
-        traj = Trajectory.load(path)
-    except DvqpError as exc:  # dvqp reads arrays only, never pickled objects
-        raise DvqpError(f"{path}: not a dvqp trajectory (not written by 'dvqp plan')") from exc
-    if not _drawable(traj):
-        raise DvqpError(f"{path}: not a dvqp trajectory (arrays of unexpected shapes)")
-    return traj
-
-
-def _drawable(traj: Trajectory) -> bool:
-    """The arrays a plot reads are float arrays of consistent shapes."""
-    t, q, qdot, tool, points = traj.t, traj.q, traj.qdot, traj.tool, traj.points
-    low, holder = traj.link_height, traj.holder_height  # both, or neither (older files)
-    arrays = (t, q, qdot, tool, points, traj.w, traj.min_clearance, low, holder)
-    if not all(np.asarray(a).dtype.kind == "f" for a in arrays) or t.ndim != 1 or q.ndim != 2:
-        return False
-    n1 = t.shape[0]
-    return (
-        n1 >= 1 and q.shape[0] == n1 and qdot.shape == (n1 - 1, q.shape[1])
-        and tool.shape == (n1, 4) and points.ndim == 3 and points.shape[0] == n1
-        and points.shape[2] == 3 and traj.w.shape == (n1,) and traj.min_clearance.shape == (n1,)
-        and low.shape == holder.shape in ((n1,), (0,))
-    )  # fmt: skip
 
 
 def _backends(args: argparse.Namespace) -> int:

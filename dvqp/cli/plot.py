@@ -48,6 +48,7 @@ def plot_trajectory(
     weld_z: float | None = None,
     min_height: float | None = None,
     instants: int = 6,
+    full: bool = False,
 ) -> Path:
     """Draw a trajectory in three panels and save it (format from the suffix).
 
@@ -70,6 +71,9 @@ def plot_trajectory(
         (m, dashed) and the body's lowest allowed height (m, a dotted line), drawn if given.
     instants
         Number of times at which the body is drawn, >= 1.
+    full
+        Draw the developed view's whole circumference; else only the arc where the arm and
+        the obstacles are (:func:`dvqp.cli.drawing.arc_extent`).
 
     Raises
     ------
@@ -79,9 +83,9 @@ def plot_trajectory(
         matplotlib is not installed.
     """
     target = output_path(path, FIGURE_FORMATS)
-    view = make_view(traj, obstacles, orbital_level, weld_z, min_height)
+    view = make_view(traj, obstacles, orbital_level, weld_z, min_height, full)
     _check_count("instants", instants, 1)
-    top = float(np.clip(7.6 * view.aspect + 1.1, 2.2, 8.0))
+    top = float(np.clip(6.8 * view.aspect + 1.1, 2.2, 8.0))  # axes ~6.8 in wide
     fig = new_figure((11.0, top + 4.6))
     grid = fig.add_gridspec(2, 2, height_ratios=[top, 4.6], width_ratios=[1.3, 1.0])
     ax_dv, ax_h = fig.add_subplot(grid[0, :]), fig.add_subplot(grid[1, 0])
@@ -109,6 +113,7 @@ def animate_trajectory(
     min_height: float | None = None,
     fps: int = 20,
     max_frames: int = 120,
+    full: bool = False,
 ) -> Path:
     """Save a GIF of the developed view with the body moving along the trajectory.
 
@@ -118,11 +123,11 @@ def animate_trajectory(
     :func:`plot_trajectory`.
     """
     target = output_path(path, (".gif",))
-    view = make_view(traj, obstacles, orbital_level, weld_z, min_height)
+    view = make_view(traj, obstacles, orbital_level, weld_z, min_height, full)
     if isinstance(fps, bool) or not isinstance(fps, Real) or not 0 < fps < math.inf:
         raise ParameterError("fps", f"must be > 0, got {fps!r}")
     _check_count("max_frames", max_frames, 2)
-    fig = new_figure((9.5, float(np.clip(6.7 * view.aspect + 1.2, 2.5, 9.0))))
+    fig = new_figure((9.5, float(np.clip(6.0 * view.aspect + 1.2, 2.5, 9.0))))
     show = _animation_axes(fig, view)
     fig.canvas.draw()
     fig.set_layout_engine("none")  # freeze the layout: every frame has the same axes

@@ -1,0 +1,112 @@
+"""``dvqp plot TRAJ.npz -o FIG [--gif] [--full] [--limits [--scene SCENE]]``: draw a saved run.
+
+The trajectory file is checked enough to be drawn before anything is drawn; the figure modules
+(matplotlib) are imported only here, when a figure is asked for.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from dvqp._files import output_path
+from dvqp.cli.figures import FIGURE_FORMATS
+from dvqp.errors import DvqpError
+from dvqp.motion.trajectory import Trajectory
+from dvqp.scenes import environment, load_scene, loads
+
+
+def register(subparsers: Any) -> None:
+    """Add ``plot`` to ``subparsers`` (of ``dvqp``'s parser)."""
+    g = subparsers.add_parser("plot", help="draw a saved trajectory")
+    g.add_argument("trajectory", help="trajectory file (.npz) written by 'dvqp plan'")
+    g.add_argument("-o", "--output", required=True, help="figure (.png/.svg/.pdf, or .gif)")
+    g.add_argument("--gif", action="store_true", help="write an animation (.gif)")
+    g.add_argument("--full", action="store_true",
+                   help="the developed view's whole circumference (default: where the arm and "
+                        "the obstacles are)")  # fmt: skip
+    g.add_argument("--limits", action="store_true",
+                   help="write the limits page: each limit's quantity over time against its "
+                        "bound")  # fmt: skip
+    g.add_argument("--scene", help="with --limits: the scene file to read the arm and limits "
+                                   "from (default: the one stored in the trajectory)")  # fmt: skip
+    g.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Draw a saved trajectory (or its limits page); 0 once written."""
+    traj = _load_trajectory(args.trajectory)
+    if args.limits or args.scene is not None:
+        return _plot_limits(args, traj)
+    drawn_with: dict[str, Any] = {"full": args.full}
+    if traj.scene_text:  # draw the stored scene's obstacles, levels and weld
+        env = environment(traj.scene_text, f"{args.trajectory} (stored scene)")
+        drawn_with |= {"obstacles": env.obstacles, "orbital_level": env.orbital_level,
+                      "weld_z": env.weld, "min_height": env.min_height}  # fmt: skip
+    from dvqp.cli import plot
+
+    draw = plot.animate_trajectory if args.gif else plot.plot_trajectory
+    print(f"wrote {draw(traj, args.output, **drawn_with)}")
+    return 0
+
+
+def _plot_limits(args: argparse.Namespace, traj: Trajectory) -> int:
+    """The limits page of a trajectory, from its stored scene (or ``--scene``)."""
+    if not args.limits or args.gif or args.full:
+        raise DvqpError("--scene goes with --limits, which takes neither --gif nor --full")
+    target = output_path(args.output, FIGURE_FORMATS)
+    if args.scene is not None:
+        scene = load_scene(args.scene)
+    elif traj.scene_text:
+        folder = Path(args.trajectory).parent  # a relative URDF: beside the trajectory
+        scene = loads(traj.scene_text, f"{args.trajectory} (stored scene)", base_dir=folder)
+    else:
+        raise DvqpError(f"{args.trajectory}: no stored scene: give the run's --scene")
+    from dvqp.cli.limit_series import limit_series
+    from dvqp.cli.plot_limits import plot_limits
+
+    try:
+        page = limit_series(scene, traj)
+    except DvqpError as exc:
+        raise DvqpError(f"{args.trajectory}: not a run of {scene.source}: {exc}") from exc
+    title = f"{scene.name} / {traj.backend or 'unknown resolver'}: limits over time"
+    print(f"wrote {plot_limits(page, target, title)}")
+    return 0
+
+
+def _load_trajectory(path: str) -> Trajectory:
+    """A trajectory file, checked enough to be drawn; else a DvqpError
+    ``<path>: cannot read: <reason>`` or ``<path>: not a dvqp trajectory (<reason>)``."""
+    try:
+        with open(path, "rb") as fh:
+            zipped = fh.read(4) == b"PK\x03\x04"
+    except OSError as exc:
+        raise DvqpError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+    if not zipped:
+        raise DvqpError(f"{path}: not a dvqp trajectory (not an .npz file)")
+    try:
+        traj = Trajectory.load(path)
+    except DvqpError as exc:  # dvqp reads arrays only, never pickled objects
+        raise DvqpError(f"{path}: not a dvqp trajectory (not written by 'dvqp plan')") from exc
+    if not _drawable(traj):
+        raise DvqpError(f"{path}: not a dvqp trajectory (arrays of unexpected shapes)")
+    return traj
+
+
+def _drawable(traj: Trajectory) -> bool:
+    """The arrays a plot reads are float arrays of consistent shapes."""
+    t, q, qdot, tool, points = traj.t, traj.q, traj.qdot, traj.tool, traj.points
+    low, holder = traj.link_height, traj.holder_height  # both, or neither (older files)
+    arrays = (t, q, qdot, tool, points, traj.w, traj.min_clearance, low, holder)
+    if not all(np.asarray(a).dtype.kind == "f" for a in arrays) or t.ndim != 1 or q.ndim != 2:
+        return False
+    n1 = t.shape[0]
+    return (
+        n1 >= 1 and q.shape[0] == n1 and qdot.shape == (n1 - 1, q.shape[1])
+        and tool.shape == (n1, 4) and points.ndim == 3 and points.shape[0] == n1
+        and points.shape[2] == 3 and traj.w.shape == (n1,) and traj.min_clearance.shape == (n1,)
+        and low.shape == holder.shape in ((n1,), (0,))
+    )  # fmt: skip
