@@ -84,8 +84,10 @@ def test_a_killed_pool_worker_costs_nothing_its_scene_is_run_again(tmp_path: Pat
     out = tmp_path / "a.json"
     proc = start("--count", "16", "--workers", "2", "--json", str(out), "--csv",
                  str(tmp_path / "a.csv"))  # fmt: skip
-    scenes_in(tmp_path / "a.json.partial", 1)
-    workers = children(proc.pid)
+    scenes_in(tmp_path / "a.json.partial", 1)  # the first, run here: the pool starts next
+    deadline = time.monotonic() + 30.0
+    while not (workers := children(proc.pid)) and time.monotonic() < deadline:
+        time.sleep(0.02)
     assert workers, "no pool process found"
     os.kill(workers[0], signal.SIGKILL)  # as the OOM killer does
     _, err = proc.communicate(timeout=120)

@@ -14,11 +14,13 @@ each worker's start-up.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import multiprocessing
 import os
+import signal
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass
@@ -90,6 +92,21 @@ def warm_up(job: Job) -> float:
     return time.perf_counter() - started
 
 
+@contextlib.contextmanager
+def sigint_deferred() -> Iterator[None]:
+    """Ctrl-C held back for the duration and raised after it: ``os.fork`` runs Python hooks
+    (logging's lock release) in which a KeyboardInterrupt is printed and ignored, not raised,
+    so a Ctrl-C that landed while the pool forked was lost (the bench ran on to exit 0)."""
+    held: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: held.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        if held:
+            raise KeyboardInterrupt
+
+
 def pool_context() -> BaseContext:
     """``fork`` where the platform has it (workers inherit this process's loaded kernels),
     else the platform's default (each worker warms itself up: :func:`warm_up`)."""
@@ -107,7 +124,9 @@ def generate_local(seed: int, count: int, workers: int) -> list[BenchScene]:
     pool = ProcessPoolExecutor(workers, mp_context=pool_context(), initializer=quiet_worker)
     try:
         draw = functools.partial(generate_scene, seed)
-        scenes += pool.map(draw, range(1, count), chunksize=max(1, count // (4 * workers)))
+        with sigint_deferred():  # the pool forks here
+            drawn = pool.map(draw, range(1, count), chunksize=max(1, count // (4 * workers)))
+        scenes += drawn
     except BaseException:
         _kill(pool)
         raise
@@ -191,9 +210,10 @@ def _pool_round(
                                initializer=_start_worker, initargs=(time.time(), warm))  # fmt: skip
     try:
         while (todo or running) and not broken:
-            while todo and len(running) < 2 * workers:
-                job = todo.pop()
-                running[pool.submit(_run, job)] = job
+            with sigint_deferred():  # the first submit forks the pool's processes
+                while todo and len(running) < 2 * workers:
+                    job = todo.pop()
+                    running[pool.submit(_run, job)] = job
             wait(running, return_when=FIRST_COMPLETED)
             if any(_lost(f) for f in running):
                 wait(running)  # a broken pool fails every job it holds, at once
