@@ -122,13 +122,14 @@ def test_each_obstacle_curve_agrees_with_an_independent_distance(name: str) -> N
     page = limit_series(sc, traj)
     period = 2 * np.pi * sc.pipe_radius
     chain = np.concatenate([traj.rail[:, None], traj.points, traj.tool[:, None, :3]], axis=1)
-    chain = chain[..., :2]
+    rows = np.unique(np.linspace(0, chain.shape[0] - 1, 80).astype(int))  # the oracle is slow
+    chain = chain[rows, :, :2]
     for j, label in enumerate(sc.obstacles.labels):
         shape = twin(sc.obstacles[j])
         points = shape.point_distance(chain.reshape(-1, 2), period)[0]
         links = shape.segment_distance(chain[:, :-1].reshape(-1, 2),
                                        chain[:, 1:].reshape(-1, 2), period)[0]  # fmt: skip
-        curve = curves(page, "clearance")[label].values
+        curve = curves(page, "clearance")[label].values[rows]
         assert (curve <= points.reshape(chain.shape[:2]).min(axis=1) + 1e-9).all(), label
         straight = links.reshape(chain.shape[0], -1).min(axis=1)
         assert np.abs(curve - straight).max() < 1e-3, label
