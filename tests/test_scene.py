@@ -188,7 +188,7 @@ INVALID = [
     ("jog velocity length", ("[0.05, 0.0, 0.0, 0.0]", "[0.05, 0.0]"),
      "motion.jog[0].velocity: expected an array of 4 numbers, got 2 values"),
     ("no motion", ("[[motion.jog]]\nduration = 0.1\nvelocity = [0.05, 0.0, 0.0, 0.0]\n", ""),
-     "motion: give exactly one of [[motion.jog]] segments or a [motion.path]"),
+     "motion: give exactly one of [[motion.jog]] segments, a [motion.path] or a [motion.saddle]"),
     ("singular start", ("[0.334, 0.10, 0.15, 0.15, 0.15, 0.15, 0.06]", "[0, 0, 0, 0, 0, 0, 0]"),
      "robot.q0: singular configuration: frame 'point1' lies on the pipe axis (rho = 0 m)"),
     ("nan", ("orbital_level = 0.08", "orbital_level = nan"),

@@ -23,6 +23,7 @@ from dvqp.kinematics.robot import Robot
 from dvqp.limits import Limit
 from dvqp.motion.jog import JogSegment
 from dvqp.motion.path import ToolPath
+from dvqp.motion.saddle import SaddleWeld
 from dvqp.objective import Objective
 from dvqp.resolution.spec import StepSpec
 from dvqp.scenes import obstacles as obstacle_section
@@ -74,6 +75,8 @@ class Scene:
         The step, and the time JOG velocity changes are spread linearly over (0: steps), s.
     solver_options : dict of str to dict
         ``[solvers.<backend>]``: settings handed to that QP backend when the scene runs on it.
+    saddle : SaddleWeld or None
+        ``[motion.saddle]``: the weld curve round a branch that ``path`` was sampled from.
     """
 
     name: str
@@ -94,6 +97,7 @@ class Scene:
     path: ToolPath | None = field(repr=False)
     ramp: float = 0.0
     solver_options: dict[str, dict[str, Any]] = field(default_factory=dict, repr=False)
+    saddle: SaddleWeld | None = field(default=None, repr=False)
 
     def spec(self) -> StepSpec:
         """The step of this scene: the tool's DV task, the objective, the limits, ``W``."""
@@ -141,7 +145,7 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
     with f.guard("constraints"):
         limits = sec.limits(f, doc, robot, obstacles)
     with f.guard("motion"):
-        dt, jog, path, ramp = sec.motion(f, doc)
+        dt, jog, path, ramp, saddle = sec.motion(f, doc, obstacles)
     with f.guard("solvers"):
         options = solver_options(f, doc)
     with f.guard("robot.q0"):
@@ -155,7 +159,7 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
         source=source, text=text, pipe_radius=radius, weld=weld, robot=robot, q0=q0,
         weights=weights, orbital_level=level, obstacles=obstacles,
         objective=objective, limits=limits, dt=dt, jog=jog, path=path, ramp=ramp,
-        solver_options=options,
+        solver_options=options, saddle=saddle,
     )  # fmt: skip
 
 

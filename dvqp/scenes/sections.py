@@ -14,6 +14,7 @@ import numpy as np
 from dvqp import _validate
 from dvqp.errors import ParameterError
 from dvqp.geometry.obstacle import ObstacleSet
+from dvqp.geometry.shapes.inlet import Inlet
 from dvqp.kinematics.robot import Robot
 from dvqp.limits import (
     DEFAULT_QDD_MAX,
@@ -29,6 +30,7 @@ from dvqp.limits import (
 )
 from dvqp.motion.jog import DEFAULT_RAMP, MAX_STEPS, JogSegment, jog_step_count
 from dvqp.motion.path import ToolPath
+from dvqp.motion.saddle import SaddleWeld
 from dvqp.objective import Objective
 from dvqp.scenes.fields import Bound, Fields, join
 
@@ -52,6 +54,9 @@ TOLERANCE = Bound(0.0, 10.0, "m", strict=True)
 HEADING_TOLERANCE = Bound(0.0, 10.0, "rad", strict=True)
 OBJECTIVE_KEYS = ("orbital_level", "k_height", "k_obstacle", "gain")
 PATH_KEYS = ("waypoints", "speed", "gain", "tolerance", "heading_tolerance")
+FOLLOW_KEYS = PATH_KEYS[1:]
+ONE_MOTION = "give exactly one of [[motion.jog]] segments, a [motion.path] or a [motion.saddle]"
+SADDLE_KEYS = ("branch", "offset", "arc", "heading", "h", *FOLLOW_KEYS)
 SCENE_LIMITS = (ObstacleDamper, SurfaceHeight, ProbeHeight, TiltLimit, SelfCollision)
 """The limits configured by the ``[constraints]`` table, in row order."""
 CONSTRAINT_KEYS = tuple(dict.fromkeys(key for cls in SCENE_LIMITS for key in cls.SCENE_KEYS))
@@ -115,24 +120,26 @@ def _configured(f: Fields, cls: Any, values: dict[str, float], *args: Any) -> An
 
 
 def motion(
-    f: Fields, doc: dict[str, Any]
-) -> tuple[float, tuple[JogSegment, ...], ToolPath | None, float]:
-    """``dt`` (s), the JOG segments or the path, and the JOG ramp time (s)."""
-    motion = f.table(doc, "motion", "", ("dt", "ramp", "jog", "path"))
+    f: Fields, doc: dict[str, Any], obstacles: ObstacleSet
+) -> tuple[float, tuple[JogSegment, ...], ToolPath | None, float, SaddleWeld | None]:
+    """``dt`` (s), the JOG segments or the path, the JOG ramp time (s) and the saddle weld
+    the path was made from (None: none)."""
+    motion = f.table(doc, "motion", "", ("dt", "ramp", "jog", "path", "saddle"))
     dt = f.number(motion, "dt", "motion", within=DT)
     ramp = f.number(motion, "ramp", "motion", DEFAULT_RAMP, within=RAMP)
-    jog, path = _motion(f, motion)
+    if sum(kind in motion for kind in ("jog", "path", "saddle")) != 1:
+        f.fail("motion", ONE_MOTION)
+    saddle = _saddle(f, motion, obstacles) if "saddle" in motion else None
+    jog, path = ((), saddle[1]) if saddle else _motion(f, motion)
     steps = sum(s.duration for s in jog) / dt if path is None else path.step_count(dt)
     if steps <= MAX_STEPS and path is None:  # now the exact count cannot overflow
         steps = jog_step_count(jog, dt)
     if steps > MAX_STEPS:
         f.fail("motion", f"about {steps:.3g} steps of dt: too many (at most {MAX_STEPS:.0e})")
-    return dt, jog, path, ramp
+    return dt, jog, path, ramp, saddle[0] if saddle else None
 
 
 def _motion(f: Fields, motion: dict[str, Any]) -> tuple[tuple[JogSegment, ...], ToolPath | None]:
-    if ("jog" in motion) == ("path" in motion):
-        f.fail("motion", "give exactly one of [[motion.jog]] segments or a [motion.path]")
     if "jog" in motion:
         segments = []
         tables = f.tables(motion, "jog", "motion", ("duration", "velocity"))
@@ -156,7 +163,36 @@ def _motion(f: Fields, motion: dict[str, Any]) -> tuple[tuple[JogSegment, ...], 
             f.fail(join(wp, i), f"h = {h:g} m is inside the pipe (must be >= 0)")
     if not np.any(np.diff(points, axis=0) != 0.0):
         f.fail(wp, "the waypoints are all the same: nothing to follow")
-    speed = f.number(t, "speed", "motion.path", within=Bound(0.0, SPEED.high, "m/s", True))
-    optional = {"gain": GAIN, "tolerance": TOLERANCE, "heading_tolerance": HEADING_TOLERANCE}
-    given = {k: f.number(t, k, "motion.path", within=b) for k, b in optional.items() if k in t}
+    speed, given = _following(f, t, "motion.path")
     return (), ToolPath(_validate.readonly(points), speed, **given)
+
+
+def _following(f: Fields, t: dict[str, Any], prefix: str) -> tuple[float, dict[str, float]]:
+    """A path's ``speed`` (m/s) and its optional ``gain``, ``tolerance``, ``heading_tolerance``."""
+    speed = f.number(t, "speed", prefix, within=Bound(0.0, SPEED.high, "m/s", True))
+    optional = {"gain": GAIN, "tolerance": TOLERANCE, "heading_tolerance": HEADING_TOLERANCE}
+    return speed, {k: f.number(t, k, prefix, within=b) for k, b in optional.items() if k in t}
+
+
+def _saddle(
+    f: Fields, motion: dict[str, Any], obstacles: ObstacleSet
+) -> tuple[SaddleWeld, ToolPath]:
+    """``[motion.saddle]``: the weld round a branch (a named ``inlet`` obstacle) and its path."""
+    t, prefix = f.table(motion, "saddle", "motion", SADDLE_KEYS), "motion.saddle"
+    name = f.string(t, "branch", prefix)
+    pairs = zip(obstacles.labels, obstacles.obstacles, strict=True)
+    inlets = {label: shape for label, shape in pairs if isinstance(shape, Inlet)}
+    if name not in inlets:
+        known = ", ".join(repr(k) for k in inlets if not k.startswith("obstacles[")) or "none"
+        f.fail(join(prefix, "branch"), f"no inlet obstacle named {name!r} (named inlets: "
+               f"{known})")  # fmt: skip
+    branch = inlets[name]
+    offset = f.number(t, "offset", prefix, within=Bound(0.0, SIZE.high, "m"))
+    arc = f.vector(t, "arc", prefix, 2, default=[-0.5 * np.pi, 1.5 * np.pi], within=HEADING)
+    heading = f.string(t, "heading", prefix, "along")
+    height = f.number(t, "h", prefix, within=HEIGHT)
+    speed, given = _following(f, t, prefix)
+    with f.mapped(prefix):
+        weld = SaddleWeld(branch.center, branch.radius, branch.pipe_radius, offset,
+                          (float(arc[0]), float(arc[1])), heading, height)  # fmt: skip
+        return weld, weld.path(speed, **given)
