@@ -23,7 +23,7 @@ import contextlib
 import gc
 import logging
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from types import ModuleType
 from typing import Any
 
@@ -97,12 +97,13 @@ def dask_client(scheduler: str, workers: int = 1) -> Iterator[tuple[Any, Where]]
         _quiet_logs(stack)
         try:
             if scheduler == "local":
-                method = pool_context().get_start_method()
-                with dask.config.set({"distributed.worker.multiprocessing-method": method}):
-                    cluster = stack.enter_context(
-                        dd.LocalCluster(n_workers=workers, threads_per_worker=1,
-                                        processes=True, dashboard_address=None)
-                    )  # fmt: skip
+                method = pool_context().get_start_method()  # for the cluster's whole life:
+                key = "distributed.worker.multiprocessing-method"  # a worker restarted too
+                stack.enter_context(dask.config.set({key: method}))
+                cluster = stack.enter_context(
+                    dd.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                    dashboard_address=None)
+                )  # fmt: skip
                 client = stack.enter_context(dd.Client(cluster))
             else:
                 client = stack.enter_context(dd.Client(scheduler, timeout=CONNECT_TIMEOUT))
@@ -140,14 +141,27 @@ def _quiet_logs(stack: contextlib.ExitStack) -> None:
     stack's life: no info lines on the cluster's start and stop, no warning when a result must
     be recomputed, no "Task exception was never retrieved" for a fetch given up; what matters
     reaches the user as dvqp's own lines. Dead tasks are collected before the levels return
-    (a nanny's start cut short by Ctrl-C leaves a failed task, reported when collected)."""
+    (a nanny's start cut short by Ctrl-C leaves a failed task, reported when collected); after
+    an exception they stay raised (the cut-short start goes on logging in its threads)."""
     names = [n for n in logging.root.manager.loggerDict if n.split(".")[0] == "distributed"]
     for name, level in [*((n, logging.CRITICAL) for n in ["distributed", *names]),
                         ("asyncio", logging.CRITICAL + 1)]:  # fmt: skip
         logger = logging.getLogger(name)
-        stack.callback(logger.setLevel, logger.level)
+        stack.push(_restorer(logger, logger.level))
         logger.setLevel(level)
     stack.callback(gc.collect)  # first on the way out: the levels are still raised
+
+
+def _restorer(logger: logging.Logger, level: int) -> Callable[..., bool]:
+    """An exit callback giving ``logger`` its ``level`` back, unless the block ended in an
+    exception (Ctrl-C while a cluster starts): its threads may still log on the way out."""
+
+    def restore(exc_type: type[BaseException] | None, *_: object) -> bool:
+        if exc_type is None:
+            logger.setLevel(level)
+        return False
+
+    return restore
 
 
 def run_dask(
