@@ -199,3 +199,21 @@ def test_without_stop_a_plan_ends_with_its_last_command_as_before() -> None:
         expected = getattr(moving, field)
         np.testing.assert_array_equal(getattr(stopped, field)[: expected.shape[0]], expected)
     assert list(stopped.status[:k]) == list(moving.status)
+
+
+@pytest.mark.parametrize("backend", ["pinv", "daqp"])
+def test_a_qdd_max_too_small_to_stop_in_any_record_is_one_line_and_nothing_written(
+    backend: str, tmp_path
+) -> None:
+    """Found by tests/test_scene_fuzz.py: qdd_max = 1e-9 asked for a 554 GiB stop record."""
+    from dvqp.cli import main
+
+    text = scene("paper-two-inlets").text.replace("qdd_max = 10.0", "qdd_max = 1e-9")
+    path = tmp_path / "tiny.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(dvqp.ParameterError, match=r"^qdd_max: 1e-09 rad/s\^2: a stop would take"):
+        dvqp.plan(loads(text, str(path)), backend)
+    assert main(["plan", str(path), "--backend", backend, "-o", str(tmp_path / "o.npz")]) == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tiny.toml"]
+    with pytest.raises(dvqp.ParameterError, match="at most 1e"):
+        braking_steps(np.ones(3), np.ones(3), np.full(3, 1e-300), 0.005)

@@ -26,8 +26,10 @@ import time
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp.errors import ParameterError
 from dvqp.kinematics.robot import Robot
 from dvqp.limits import AccelerationLimit, JointVelocityLimit
+from dvqp.motion.jog import MAX_STEPS
 from dvqp.motion.recorder import TrajectoryRecorder
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver, Step
@@ -43,12 +45,24 @@ def braking_steps(qdot: Array, weights: Array, qdd_max: Array | None, dt: float)
     """Most steps of ``dt`` (s) a stop from the joint velocity ``qdot`` (rad/s, (n,)) may take:
     ``2 ‖Q̇‖_W / (√w_min q̈_min) + MARGIN`` seconds, at least one step (``weights`` the
     diagonal of ``W``; ``qdd_max`` rad/s², (n,); None: no acceleration limit, a stop within
-    :data:`MARGIN`)."""
+    :data:`MARGIN`).
+
+    Raises
+    ------
+    ParameterError
+        The stop would take more than :data:`~dvqp.motion.jog.MAX_STEPS` steps (a ``qdd_max``
+        so small that its record could not be held).
+    """
     bound = 0.0
     if qdd_max is not None:
         norm = math.sqrt(float(np.sum(weights * qdot**2)))
         bound = 2.0 * norm / (math.sqrt(float(weights.min())) * float(qdd_max.min()))
-    return max(1, math.ceil((bound + MARGIN) / dt))
+    steps = (bound + MARGIN) / dt
+    if not steps <= MAX_STEPS:  # a tiny qdd_max: a stop that no memory could record
+        least = math.inf if qdd_max is None else float(qdd_max.min())
+        raise ParameterError("qdd_max", f"{least:.3g} rad/s^2: a stop would take about "
+                             f"{steps:.3g} steps of dt (at most {MAX_STEPS:.0e})")  # fmt: skip
+    return max(1, math.ceil(steps))
 
 
 def _qdd_max(spec: StepSpec) -> Array | None:
