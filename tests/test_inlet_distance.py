@@ -120,20 +120,24 @@ def test_a_segment_that_crosses_with_both_ends_outside_enters() -> None:
 @settings(max_examples=60, deadline=None)
 @given(PLACES, unit, unit)
 @example((2, 0.0, 1.0, True), 0.0, 1e-300)  # a segment of 1e-301 m: a point
+@example((0, -6.103515625e-05, 0.0, True), 0.0, 0.0)  # 30 µm off a tip (CI)
 def test_the_gradients_are_the_finite_differences(a: tuple, du: float, dv: float) -> None:
     k, u, v, tip = a
     inlet = INLETS[k]
     p = place(inlet, u, v, tip)
     q = p + 0.08 * np.array([du, dv])
     h = 1e-7
-    _, n = distances([inlet], p[None], PERIOD)
+    d0, n = distances([inlet], p[None], PERIOD)
+    # the normal is (p − closest point) / d: a closest point found to ~1e-9 m turns it by up to
+    # 1e-9 / d (30 µm outside a tip: 2.3e-5), capped at 1 mrad on the outline itself
+    tolerance = 1e-5 + min(1e-3, 1e-9 / max(abs(float(d0[0, 0])), 1e-12))
     d, t, nseg = (x[0, 0] for x in segment_distances([inlet], p[None], q[None], PERIOD))
     for axis in range(2):
         e = np.zeros(2)
         e[axis] = h
         fd = (distances([inlet], (p + e)[None], PERIOD)[0] -
               distances([inlet], (p - e)[None], PERIOD)[0])[0, 0] / (2 * h)  # fmt: skip
-        assert abs(fd - n[0, 0, axis]) < 1e-5 or _kinked(inlet, p)
+        assert abs(fd - n[0, 0, axis]) < tolerance or _kinked(inlet, p)
         e_hat = np.array([du, dv]) / max(math.hypot(du, dv), 1e-300)
         turning = t in (0.0, 1.0) and abs(nseg @ e_hat) < 0.05  # an end about to give way
         if d > 1e-4 and math.hypot(du, dv) > 0.01 and not turning:  # ∂d/∂a = (1 − t) n
