@@ -124,8 +124,7 @@ def plan(
     SingularConfigurationError
         The baseline met a singular task Jacobian.
     """
-    settings = {**tier_options(backend, tier), **scene.solver_options.get(backend, {}),
-                **(options or {})}  # fmt: skip
+    settings = backend_settings(scene, backend, options, tier)
     resolver = make_resolver(backend, scene.spec().with_extra(tasks, limits), settings)
     c = scene_commands(scene)
     traj = simulate(
@@ -136,6 +135,14 @@ def plan(
     held = c.reference[-1:].repeat(traj.t.shape[0] - c.reference.shape[0], axis=0)
     error = dv_error(np.vstack([c.reference, held]), traj.tool, scene.pipe_radius)
     return dataclasses.replace(traj, tracking_error=error, scene_text=scene.text)
+
+
+def backend_settings(scene: Scene, backend: str, options: dict[str, Any] | None = None,
+                     tier: str = "default") -> dict[str, Any]:  # fmt: skip
+    """The settings a run of ``scene`` gives ``backend``: the ``tier``'s
+    (:mod:`solvers.tiers`), under the scene's ``[solvers.<backend>]``, under ``options``."""
+    return {**tier_options(backend, tier), **scene.solver_options.get(backend, {}),
+            **(options or {})}  # fmt: skip
 
 
 def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> None:

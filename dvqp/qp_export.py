@@ -25,8 +25,8 @@ import solvers
 from dvqp._versions import __version__
 from dvqp.errors import LimitViolationError, OutputError, ParameterError, UnreachableTargetError
 from dvqp.motion.trajectory import Trajectory
-from dvqp.planning import check_run, plan
-from dvqp.resolution.registry import PINV, check_name, tier_options
+from dvqp.planning import backend_settings, check_run, plan
+from dvqp.resolution.registry import PINV, check_name
 from dvqp.scenes.scene import Scene
 
 INDEX = "index.json"
@@ -96,8 +96,7 @@ def export_qps(
         calls = _Calls(work, re.sub(r"[^A-Za-z0-9._-]", "_", scene.name))
         traj = plan(scene, backend, progress=progress, notice=notice, options=options, watch=calls,
                     tier=tier)  # fmt: skip
-        settings = {**tier_options(backend, tier), **scene.solver_options.get(backend, {}),
-                    **(options or {})}  # fmt: skip
+        settings = backend_settings(scene, backend, options, tier)
         index = calls.finish(scene, traj, backend, tier, settings)
         _put_in_place(work, target)
     except BaseException as exc:
