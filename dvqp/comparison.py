@@ -1,8 +1,7 @@
 """Run scenes with several backends on the same commands; their rows as a table or CSV.
 
-Each scene is loaded once per worker and run with every backend in turn, so ``ratio_to_pinv``
-compares runs made one after the other in the same process. :func:`compare` runs scenes in
-parallel processes when ``jobs > 1`` (noisier timings). The row helpers serve ``dvqp bench``.
+A scene's backends run one after the other in one process (so ``ratio_to_pinv`` is fair), scenes
+in parallel when ``jobs > 1`` (noisier timings). The row helpers serve ``dvqp bench``.
 """
 
 from __future__ import annotations
@@ -22,7 +21,7 @@ from dvqp.errors import DvqpError
 from dvqp.geometry import proximity
 from dvqp.kinematics import KinematicState
 from dvqp.limits import lowest_link, self_distance, start_broken_lines
-from dvqp.planning import check_run, final_errors, worst_sample_excess
+from dvqp.planning import check_run, final_errors, path_figures, worst_sample_excess
 from dvqp.resolution.registry import PINV
 from dvqp.table_text import csv_text
 from solvers.accuracy import METRICS
@@ -31,14 +30,13 @@ if TYPE_CHECKING:
     from dvqp import Scene, Trajectory
 
 FIELDS = (
-    "scene", "file", "backend", "settings", "success", "steps", "failures", "relaxed", "braking",
-    "substepped",
+    "scene", "file", "backend", "settings", "success", "steps", "failures", "slowed", "relaxed",
+    "braking", "substepped", "nominal_duration", "path_duration", "max_deviation",
     "median_step_us", "p95_step_us", "median_solver_us", "median_rest_us", "median_iterations",
     "refused_calls", "refusals", "qp_solves", "unanswered_solves", "primal_residual",
     "dual_residual", "duality_gap", "ratio_to_pinv", "max_task_error", "min_clearance", "closest",
     "min_probe_clearance", "min_tilt", "min_self_distance", "closest_pair", "min_link_height",
-    "lowest_link",
-    "max_joint_acceleration", "max_limit_excess", "worst_limit", "start_broken",
+    "lowest_link", "max_joint_acceleration", "max_limit_excess", "worst_limit", "start_broken",
     "max_joint_limit_violation", "max_velocity_limit_violation", "final_tracking_error",
     "final_joint_speed", "braking_time", "error",
 )  # fmt: skip
@@ -48,12 +46,12 @@ Row = dict[str, Any]
 
 
 def _finite(value: float) -> float | None:
-    """``value`` as a float, or None if it is NaN or infinite (JSON has no NaN)."""
+    """``value`` as a float, or None if NaN or infinite (JSON has no NaN)."""
     return v if np.isfinite(v := float(value)) else None
 
 
 def _least(values: NDArray[np.float64]) -> float | None:
-    """The smallest of ``values`` if there are any and it is finite, else None."""
+    """The smallest of ``values`` if any, and if it is finite; else None."""
     return _finite(np.min(values)) if values.size else None
 
 
@@ -63,8 +61,10 @@ def summarize(scene: Scene, traj: Trajectory, settings: str = "default") -> Row:
 
     ``success``: the run can be sent to the arm (:func:`dvqp.planning.check_run`); ``error``
     says why not. ``steps``; ``failures`` (steps not solved or that broke a limit even in
-    substeps); ``relaxed`` (the task gave way to a limit) and ``braking`` (the limits
-    conflicted and the arm slowed toward rest); ``substepped`` (steps split to keep a limit);
+    substeps); ``slowed`` (a time-scaled path's progress slowed to keep the limits; a path's
+    ``nominal_duration``, ``path_duration`` and ``max_deviation`` are those of
+    :func:`dvqp.planning.path_figures`); ``relaxed`` (the task gave way to a limit) and
+    ``braking`` (the limits conflicted: the arm slowed toward rest); ``substepped``;
     median and 95th-percentile full step time (µs), the medians of the solver call alone and
     of the rest of the step (µs) and of the solver's iterations; the backend calls refused (no
     accepted answer: the step relaxed or braked) and by kind (``refusals``); the steps' QP
@@ -96,8 +96,10 @@ def summarize(scene: Scene, traj: Trajectory, settings: str = "default") -> Row:
         "success": (why := run_error(scene, traj)) is None,
         "steps": traj.n_steps,
         "failures": int(np.sum(~ok)),
+        "slowed": int(np.sum(traj.status == "slowed")),
         "relaxed": int(np.sum(traj.status == "relaxed")),
         "braking": int(np.sum(traj.status == "braking")),
+        **path_figures(scene, traj),
         "substepped": int(np.sum(traj.substeps > 1)) if traj.substeps.size else None,
         "median_step_us": _finite(np.median(steps_us)) if traj.n_steps else None,
         "p95_step_us": _finite(np.percentile(steps_us, 95)) if traj.n_steps else None,
@@ -192,7 +194,7 @@ def _limit_figures(scene: Scene, traj: Trajectory) -> Row:
 
 
 def run_error(scene: Scene, traj: Trajectory) -> str | None:
-    """Why a planned run failed (the message of :func:`dvqp.planning.check_run`), or None."""
+    """Why a planned run failed (:func:`dvqp.planning.check_run`'s message), or None."""
     try:
         check_run(scene, traj)
     except DvqpError as exc:
@@ -203,9 +205,10 @@ def run_error(scene: Scene, traj: Trajectory) -> str | None:
 def run_scene(
     path: str, backends: Sequence[str], progress: Callable[[str], None] | None = None,
     options: dict[str, dict[str, Any]] | None = None, tier: str = "default",
+    timing: str | None = None,
 ) -> list[Row]:  # fmt: skip
     """Load a scene and run it with every backend (``options``: settings by backend, over the
-    ``tier``'s, :mod:`solvers.tiers`); the rows
+    ``tier``'s, :mod:`solvers.tiers`; ``timing``: a path scene's, :func:`dvqp.plan`); the rows
     in ``backends`` order. A run that raises a :class:`~dvqp.errors.DvqpError` gives an
     :func:`error_row`. ``progress(backend)`` is called after each run.
     """
@@ -213,7 +216,8 @@ def run_scene(
     rows = []
     for backend in backends:
         try:
-            traj = plan(scene, backend, options=given.get(backend), tier=tier)
+            traj = plan(scene, backend, options=given.get(backend), tier=tier,
+                        timing=timing if scene.path is not None else None)  # fmt: skip
             rows.append(summarize(scene, traj, tier))
         except DvqpError as exc:
             rows.append(error_row(scene, backend, exc))
@@ -246,13 +250,15 @@ def compare(
     progress: Callable[[int, int, str], None] | None = None,
     options: dict[str, dict[str, Any]] | None = None,
     tier: str = "default",
+    timing: str | None = None,
 ) -> list[Row]:
     """Run every scene with every backend; rows grouped by scene in ``paths`` order.
 
     The scene files and backend names are checked by the caller (else scene errors surface
     here; an unknown backend gives failed rows). ``jobs`` worker processes run one scene each
     (1: all in this process). ``progress(done, total, label)`` counts runs (scene × backend);
-    ``options``: backends' settings, over each scene's own, over the settings ``tier``'s.
+    ``options``: backends' settings, over each scene's own, over the settings ``tier``'s;
+    ``timing``: that of every path scene (default: each scene's own).
     """
     total, done = len(paths) * len(backends), 0
     results: dict[str, list[Row]] = {}
@@ -266,11 +272,11 @@ def compare(
     if jobs <= 1 or len(paths) <= 1:
         for path in paths:
             results[path] = run_scene(path, backends, lambda b, p=path: tick(1, f"{p} {b}"),
-                                      options, tier)  # fmt: skip
+                                      options, tier, timing)  # fmt: skip
     else:
         with ProcessPoolExecutor(max_workers=jobs, initializer=quiet_worker) as pool:
-            futures = {pool.submit(run_scene, path, list(backends), None, options, tier): path
-                       for path in paths}  # fmt: skip
+            futures = {pool.submit(run_scene, path, list(backends), None, options, tier,
+                                   timing): path for path in paths}  # fmt: skip
             for future in as_completed(futures):
                 results[futures[future]] = future.result()
                 tick(len(backends), futures[future])
@@ -290,6 +296,5 @@ def machine() -> dict[str, Any]:
 
 
 def quiet_worker() -> None:
-    """Make Ctrl-C end this worker process at once, silently (exit 130), as a forked one does
-    (``ProcessPoolExecutor(initializer=quiet_worker)`` for ``spawn`` / ``forkserver``)."""
+    """Ctrl-C ends this worker at once, silently (exit 130), as in a forked one (initializer)."""
     signal.signal(signal.SIGINT, lambda signum, frame: os._exit(130))

@@ -3,7 +3,8 @@
 :func:`plan` runs a scene's motion with a named resolver (``"pinv"``, the paper's baseline, or
 a QP backend) on the scene's step plus any tasks and limits of the caller's. In JOG mode the
 tool gets the JOG velocities; in path mode it follows the waypoints with position feedback
-``ẋ = ẋ_d + K(x_d − x)``.
+``ẋ = ẋ_d + K(x_d − x)``, on the nominal schedule or time-scaled (``timing``,
+:mod:`dvqp.motion.schedule`).
 """
 
 from __future__ import annotations
@@ -16,10 +17,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp.errors import LimitViolationError, UnreachableTargetError
+from dvqp.errors import LimitViolationError, ParameterError, UnreachableTargetError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits import Excess, Limit, start_broken_lines
 from dvqp.motion.jog import box_average, jog_commands
+from dvqp.motion.schedule import MAX_SLOWDOWN, TIMINGS, path_deviation
 from dvqp.motion.simulate import StepWatcher, dv_error, simulate
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.pinv import PseudoinverseResolver
@@ -85,6 +87,7 @@ def plan(
     options: dict[str, Any] | None = None,
     tier: str = "default",
     watch: StepWatcher | None = None,
+    timing: str | None = None,
 ) -> Trajectory:
     """Run a scene with a resolver and return its trajectory, ended at rest.
 
@@ -114,27 +117,71 @@ def plan(
         settings and the tolerance its answers are checked to (:mod:`solvers.tiers`).
     watch
         Shown every backend call of the run (:func:`dvqp.motion.simulate.simulate`).
+    timing
+        A path's timing, ``"fixed"`` or ``"scaled"`` (slow down along the path where the
+        limits bind, rather than leave it); default: the scene's (``fixed`` if it says none).
+        The tracking error is then against the path where the run had reached on it.
 
     Raises
     ------
     BackendError
         Unknown backend, or a setting it does not take.
     ParameterError
-        An unknown ``tier``.
+        An unknown ``tier`` or ``timing``, or time scaling asked of a JOG scene.
     SingularConfigurationError
         The baseline met a singular task Jacobian.
     """
     settings = backend_settings(scene, backend, options, tier)
     resolver = make_resolver(backend, scene.spec().with_extra(tasks, limits), settings)
     c = scene_commands(scene)
+    scaled = scene_timing(scene, timing) == "scaled"
     traj = simulate(
         scene.robot, scene.pipe_radius, resolver, scene.q0, c.velocity, scene.dt,
         obstacles=scene.obstacles, reference=c.reference[:-1] if c.feedback_gain > 0 else None,
         feedback_gain=c.feedback_gain, progress=progress, notice=notice, stop=stop, watch=watch,
+        time_scaling=scaled,
     )  # fmt: skip
-    held = c.reference[-1:].repeat(traj.t.shape[0] - c.reference.shape[0], axis=0)
-    error = dv_error(np.vstack([c.reference, held]), traj.tool, scene.pipe_radius)
+    if scaled:  # the reference where the run had reached on the path
+        nodes = np.arange(c.reference.shape[0])
+        u = traj.path_time / scene.dt
+        reference = np.column_stack([np.interp(u, nodes, col) for col in c.reference.T])
+    else:
+        held = c.reference[-1:].repeat(traj.t.shape[0] - c.reference.shape[0], axis=0)
+        reference = np.vstack([c.reference, held])
+    error = dv_error(reference, traj.tool, scene.pipe_radius)
     return dataclasses.replace(traj, tracking_error=error, scene_text=scene.text)
+
+
+def scene_timing(scene: Scene, timing: str | None = None) -> str:
+    """The timing a run of ``scene`` follows: ``timing``, else its path's, else ``"fixed"``.
+
+    Raises
+    ------
+    ParameterError
+        An unknown timing, or ``"scaled"`` for a JOG scene (there is no path to slow along).
+    """
+    chosen = timing or (scene.path.timing if scene.path is not None else "fixed")
+    if chosen not in TIMINGS:
+        raise ParameterError("timing", f"must be one of {', '.join(TIMINGS)}, got {chosen!r}")
+    if chosen == "scaled" and scene.path is None:
+        raise ParameterError("timing", f"{scene.source}: a JOG scene has no path to slow along")
+    return chosen
+
+
+def path_figures(scene: Scene, traj: Trajectory) -> dict[str, float | None]:
+    """A path run's ``nominal_duration`` (its schedule at full speed, s), ``path_duration``
+    (how long the run took to follow it, before the stop, s) and ``max_deviation`` (the
+    tool's largest distance from the path, m, :func:`~dvqp.motion.schedule.path_deviation`);
+    all None for a JOG scene."""
+    if scene.path is None or not traj.t.shape[0]:
+        return {"nominal_duration": None, "path_duration": None, "max_deviation": None}
+    reference = scene_commands(scene).reference
+    moving = traj.brake_start if traj.brake_start >= 0 else traj.n_steps
+    return {
+        "nominal_duration": (reference.shape[0] - 1) * scene.dt,
+        "path_duration": float(traj.t[moving]),
+        "max_deviation": float(path_deviation(reference, traj.tool).max()),
+    }
 
 
 def backend_settings(scene: Scene, backend: str, options: dict[str, Any] | None = None,
@@ -177,6 +224,9 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
             f"{where}: {count} of {traj.t.shape[0]} samples break a limit{detail}{also}",
             sample, float(traj.limit_excess[sample]),
         )  # fmt: skip
+    too_fast = _too_fast(scene, traj)
+    if too_fast is not None:
+        raise LimitViolationError(f"{where}: {too_fast[2]}", too_fast[0], too_fast[1])
     if not traj.ok:
         first = int(np.argmin(traj.success))
         count = int(np.sum(~traj.success))
@@ -185,6 +235,9 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
             f"({traj.status[first]})",
             step=first,
         )
+    unfinished = _unfinished(scene, traj)
+    if unfinished is not None:
+        raise UnreachableTargetError(f"{where}: {unfinished}", step=traj.n_steps)
     position, heading = final_errors(traj) if traj.tracking_error.shape[0] else (0.0, 0.0)
     if scene.path is not None and (position > scene.path.tolerance
                                    or heading > scene.path.heading_tolerance):  # fmt: skip
@@ -198,6 +251,36 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
     if traj.start_broken:
         worst = max(traj.start_broken, key=lambda b: b.excess.ratio).excess
         raise LimitViolationError(f"{where}: starts outside its limits: {started}", 0, worst.value)
+
+
+SPEED_TOLERANCE = 1e-6
+"""rad/s: a step's joint speed past ``qd_max`` by more than this breaks the velocity limit."""
+
+
+def _too_fast(scene: Scene, traj: Trajectory) -> tuple[int, float, str] | None:
+    """The first sample whose step breaks a joint's velocity limit, the excess (rad/s) and
+    what to say; None if every step keeps it (the baseline's steps are not held to it)."""
+    over = np.abs(traj.qdot) - scene.robot.qd_max
+    if not over.size or over.max() <= SPEED_TOLERANCE:
+        return None
+    k, joint = np.unravel_index(int(np.argmax(over)), over.shape)
+    count = int(np.sum(over.max(axis=1) > SPEED_TOLERANCE))
+    return int(k), float(over[k, joint]), (
+        f"{count} of {traj.n_steps} steps break a joint velocity limit: worst at t = "
+        f"{traj.t[k]:.3f} s, joint{joint + 1} at {abs(traj.qdot[k, joint]):.4g} rad/s "
+        f"(qd_max {scene.robot.qd_max[joint]:.4g})")  # fmt: skip
+
+
+def _unfinished(scene: Scene, traj: Trajectory) -> str | None:
+    """Why a time-scaled run did not finish its path (None: it did, or it was not one)."""
+    if scene.path is None or not traj.path_time.size:
+        return None
+    nominal = scene.dt * (scene_commands(scene).reference.shape[0] - 1)
+    if traj.path_time[-1] >= nominal - 1e-6 * scene.dt:
+        return None
+    return (f"the path was not finished: {traj.path_time[-1] / nominal:.0%} of it in "
+            f"{traj.t[-1]:.3f} s (the limits held the tool back; at most "
+            f"{MAX_SLOWDOWN:g}x the nominal {nominal:.3f} s)")  # fmt: skip
 
 
 def worst_sample_excess(

@@ -153,7 +153,8 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
                                 "solver", "us", "rest", "us", "iters", "x", "pinv", "task",
                                 "err", "clearance", "m", "closest", "self", "m",
                                 "qdd", "excess", "q",
-                                "viol", "rad", "qd", "viol", "rad/s", "relaxed", "refused",
+                                "viol", "rad", "qd", "viol", "rad/s", "slowed", "relaxed",
+                                "path", "dev", "m", "refused",
                                 "r_prim", "r_dual", "gap", "split",
                                 "fails", "end", "qd", "brake", "s"]  # fmt: skip
     assert [line.split()[:4] for line in lines[2:6]] == [

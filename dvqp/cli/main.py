@@ -35,6 +35,8 @@ from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_s
 from dvqp.cli.report import format_summary, format_table, rows_to_csv, write_text
 from dvqp.cli.solver_option import solver_options
 from dvqp.errors import DvqpError, SingularConfigurationError, one_line
+from dvqp.motion.schedule import TIMINGS
+from dvqp.planning import scene_timing
 from dvqp.resolution.registry import (
     PINV,
     check_name,
@@ -102,6 +104,7 @@ def _parser() -> argparse.ArgumentParser:
         "qd_max and qdd_max allow, at rest at both ends (needs dvqp[retime])",
     )
     p.add_argument("--rate", type=float, help="controller rate of --retime, Hz (default 500)")
+    _timing_argument(p)
     solver_option.add_argument(p)
     p.set_defaults(run=_plan)
     c = sub.add_parser("compare", help="run scenes with several backends, print one table")
@@ -113,6 +116,7 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--jobs", type=_positive_int, default=1, help="worker processes (scenes)")
     c.add_argument("--check", "--strict", dest="check", action="store_true",
                    help="exit 1 unless every QP backend's run is ok (safe to send)")  # fmt: skip
+    _timing_argument(c)
     solver_option.add_argument(c)
     c.set_defaults(run=_compare)
     plot_command.register(sub)
@@ -123,6 +127,12 @@ def _parser() -> argparse.ArgumentParser:
     b = sub.add_parser("backends", help="list the installed backends and their versions")
     b.set_defaults(run=_backends)
     return parser
+
+
+def _timing_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--timing", choices=TIMINGS, help="a path's timing: fixed (the paper's: "
+                        "the task relaxed where limits bind) or scaled (slow down along the "
+                        "path there); default: the scene's, else fixed")  # fmt: skip
 
 
 def _positive_int(text: str) -> int:
@@ -149,13 +159,14 @@ def _plan(args: argparse.Namespace) -> int:
     output = output_path(args.output, formats) if args.output is not None else None
     rate = retime_cli.checked_rate(args.retime, args.rate)  # before any work, as the backend
     check_name(args.backend)  # unknown backend: exit 2 before any work
+    scene_timing(scene, args.timing)  # nor a JOG scene asked to slow along a path
     options = solver_options(args.solver_option, [args.backend]).get(args.backend)
     check_size([scene], 1)
     try:  # a progress bar on stderr, erased when done
         with contextlib.closing(ProgressBar(sys.stderr)) as bar:
             traj = plan(scene, args.backend, progress=lambda k, n: bar.show(k, n, "steps"),
                         notice=lambda text: _notice(bar, text), options=options,
-                        tier=args.settings)  # fmt: skip
+                        tier=args.settings, timing=args.timing)  # fmt: skip
     except SingularConfigurationError as exc:
         print(f"dvqp: {one_line(scene.source)}: {args.backend}: {exc}", file=sys.stderr)
         return 1
@@ -180,7 +191,7 @@ def _compare(args: argparse.Namespace) -> int:
     plot_out = output_path(args.plot, FIGURE_FORMATS) if args.plot is not None else None
     with contextlib.closing(ProgressBar(sys.stderr)) as bar:
         rows = cmp.compare(args.scenes, backends, args.jobs, progress=bar.show, options=options,
-                           tier=args.settings)  # fmt: skip
+                           tier=args.settings, timing=args.timing)  # fmt: skip
     if args.settings != "default":
         print(f"settings: {args.settings}")
     print(format_table(rows))

@@ -31,6 +31,10 @@ class ToolPath:
         Feedback gain ``K``, 1/s.
     tolerance, heading_tolerance : float
         Largest final position error (l, z, h; m) and heading error (rad) counted as reached.
+    timing : str
+        ``"fixed"``: at ``speed`` throughout, the task relaxed where the limits bind (the
+        paper's); ``"scaled"``: a QP slows along the path there instead
+        (:mod:`dvqp.motion.schedule`).
     """
 
     waypoints: NDArray[np.float64]
@@ -38,6 +42,7 @@ class ToolPath:
     gain: float = 5.0
     tolerance: float = 0.005
     heading_tolerance: float = 0.05
+    timing: str = "fixed"
 
     @staticmethod
     def segment_lengths(nodes: NDArray[np.float64]) -> NDArray[np.float64]:

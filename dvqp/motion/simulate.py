@@ -10,6 +10,7 @@ is the compiled step (:class:`~dvqp.step.Stepper`), verified exactly
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -20,9 +21,9 @@ from numpy.typing import ArrayLike, NDArray
 from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry.obstacle import ObstacleSet
-from dvqp.kinematics.developed_view import wrap, wrap_angle
 from dvqp.kinematics.robot import Robot
 from dvqp.motion.recorder import TrajectoryRecorder
+from dvqp.motion.schedule import Schedule, dv_error
 from dvqp.motion.stop import brake, room
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.step import Resolver
@@ -35,18 +36,12 @@ COMPILE_NOTICE_SECONDS = 1.0
 """s: compiling the step for longer than this is announced through ``notice``."""
 COMPILE_NOTICE = "compiling: first run only, ~30 s"
 
+#: ``progress(k, N)``: k of the run's N nominal steps done.
+Progress = Callable[[int, int], None]
 #: ``(step, kind, problem, solution)`` of a backend call (:func:`simulate`'s ``watch``).
 StepWatcher = Callable[[int, str, Problem, Solution], None]
 
 __all__ = ["COMPILE_NOTICE", "dv_error", "simulate"]
-
-
-def dv_error(reference: Array, actual: Array, radius: float) -> Array:
-    """``x_d − x`` of DV coordinates (…, 4) with l wrapped modulo 2πR and α modulo 2π."""
-    e = np.asarray(reference, dtype=float) - np.asarray(actual, dtype=float)
-    e[..., 0] = wrap(e[..., 0], radius)
-    e[..., 3] = wrap_angle(e[..., 3])
-    return e
 
 
 @contextlib.contextmanager
@@ -99,6 +94,7 @@ def simulate(
     notice: Callable[[str], None] | None = None,
     stop: bool = True,
     watch: StepWatcher | None = None,
+    time_scaling: bool = False,
 ) -> Trajectory:
     """Run the commands from ``q0`` and return the trajectory.
 
@@ -139,6 +135,12 @@ def simulate(
         as ``watch(step, kind, problem, solution)``: ``step`` the recorded step it belongs to
         (the braking steps continue the count), the rest as a
         :data:`~dvqp.resolution.qp.Watcher` gets them.
+    time_scaling
+        Follow ``reference`` time-scaled (:mod:`dvqp.motion.schedule`): where the limits
+        bind, a QP step slows along the path (status ``"slowed"``) rather than leave it, and
+        the run takes as many steps as it needs (at most
+        :data:`~dvqp.motion.schedule.MAX_SLOWDOWN` times ``N``). The trajectory's
+        ``path_time`` holds the nominal time reached at each sample.
 
     Notes
     -----
@@ -163,23 +165,39 @@ def simulate(
             stepper.start(q_start)
     if watch is not None and stepper.solver is not None:
         stepper.solver.watchers.append(lambda kind, p, s: watch(record.steps, kind, p, s))
-    feedback = ref is not None and gain > 0.0
-    started = time.perf_counter()
-    for i in range(cmd.shape[0]):
-        xdot = cmd[i]
-        if feedback:
-            xdot = xdot + gain * dv_error(ref[i], stepper.state.tool, radius)  # type: ignore[index]
-        moved = advance(stepper, xdot, dt, verify=check, max_halvings=max_halvings, record=i + 1)
-        now = time.perf_counter()
-        record.step(i, moved, now - started)
-        started = now
-        if progress is not None:
-            progress(i + 1, cmd.shape[0])
-    steps = brake(stepper, record, cmd.shape[0], dt, verify=check,
-                  max_halvings=max_halvings) if stop else 0  # fmt: skip
+    schedule = Schedule(cmd, ref, gain, dt, radius, time_scaling)
+    n, path_time = _follow(stepper, record, schedule, check, max_halvings, progress)
+    steps = brake(stepper, record, n, dt, verify=check, max_halvings=max_halvings) if stop else 0
     solver = stepper.solver
     refused = {} if solver is None else dict(solver.refusals)
     accuracy = {} if solver is None else solver.accuracy.to_dict()
-    braked = cmd.shape[0] if stop else -1
-    return record.trajectory(dt, radius, resolver.name, cmd.shape[0] + steps, braked,
+    braked = n if stop else -1
+    traj = record.trajectory(dt, radius, resolver.name, n + steps, braked,
                              stepper.start_broken(), refused, accuracy)  # fmt: skip
+    held = np.full(steps, path_time[-1])
+    return dataclasses.replace(traj, path_time=np.concatenate([path_time, held]))
+
+
+def _follow(stepper: Stepper, record: TrajectoryRecorder, schedule: Schedule, check: bool,
+            max_halvings: int, progress: Progress | None) -> tuple[int, Array]:  # fmt: skip
+    """Run the schedule's commands; the steps taken and the nominal time (s) at each sample."""
+    u, k, dt = 0.0, 0, schedule.dt
+    reached = [0.0]
+    started = time.perf_counter()
+    while not schedule.done(u) and k < schedule.budget:
+        if k >= record.arrays["qdot"].shape[0]:  # a slowed run outgrew its room
+            record.extend(schedule.n)
+            stepper.record_into(record.arrays)
+        xdot, feedforward, span = schedule.command(u, stepper.state.tool)
+        stepper.pace(feedforward)
+        moved = advance(stepper, xdot, dt, verify=check, max_halvings=max_halvings, record=k + 1)
+        now = time.perf_counter()
+        record.step(k, moved, now - started)
+        started = now
+        u += (moved.step.rate if schedule.scaled else 1.0) * span
+        k += 1
+        reached.append(min(u, schedule.n) * dt)
+        if progress is not None:
+            progress(min(round(u), schedule.n) if schedule.scaled else k, schedule.n)
+    stepper.pace(None)
+    return k, np.asarray(reached)

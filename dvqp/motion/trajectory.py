@@ -27,7 +27,7 @@ ARRAYS = ("t", "q", "qdot", "tool", "points", "w", "min_clearance", "solve_time"
 
 DIAGNOSTICS = ("probe_clearance", "tilt", "self_distance", "limit_excess", "limits_kept",
                "substeps", "qddot", "solver_time", "link_height", "holder_height",
-               "rail")  # fmt: skip
+               "rail", "path_time")  # fmt: skip
 """Arrays added since dvqp 0.2; a file written before one was added lacks it (loaded empty)."""
 
 CONVENTIONS = {
@@ -95,12 +95,14 @@ class Trajectory:
     link_height, holder_height : ndarray, shape (N+1,) or (0,)
         The lowest height over the pipe surface (m) of the body links and the carriage link,
         and of the probe holder (last body point to the tool): each link the lowest point of
-        its real straight 3-D chord (an end's own height where that is lowest). Empty in a
-        file written before they were recorded (the reports and plots then leave them out).
+        its real straight 3-D chord (an end's own height where that is lowest); empty in a
+        file written before they were recorded.
     rail : ndarray, shape (N+1, 3) or (0, 3)
         ``[l, z, h]`` of the rail point (where the carriage rides its rail; the carriage link
         runs from it to body point 1), m, l as recorded (in ``(−πR, πR]``); empty for an arm
         without one, a console recording, or a file written before it was recorded.
+    path_time : ndarray, shape (N+1,) or (0,)
+        Nominal schedule's time reached at each sample, s (fixed timing: ``t`` until the stop).
     qddot : ndarray, shape (N, n)
         Joint acceleration at the start of each step, ``(qdot[k] − qdot[k−1]) / dt`` with the
         run starting at rest, rad/s².
@@ -112,7 +114,7 @@ class Trajectory:
     brake_start : int
         The first step of the stop that ends the run at rest (steps ``brake_start..N−1`` brake,
         with the tool held still; ``N`` if the run needed none): −1 if the run was not stopped
-        (``stop=False``, or a file written before runs were stopped).
+        (``stop=False``, or an older file).
     refusals : dict of str to int
         QP backend calls that gave no accepted answer, by kind (``"infeasible"``,
         ``"iteration limit"``, ``"inaccurate"``…, :data:`solvers.REFUSALS`); the step then
@@ -152,6 +154,7 @@ class Trajectory:
     link_height: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     holder_height: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     rail: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 3)))
+    path_time: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     start_broken: tuple[StartBroken, ...] = ()
     brake_start: int = -1
     refusals: dict[str, int] = field(default_factory=dict)
@@ -287,8 +290,7 @@ class Trajectory:
 
 
 def _counts(data: Any, name: str) -> dict[str, Any]:
-    """The JSON object ``name`` of a loaded file, values as numbers (``{}``: a file written
-    before it was recorded)."""
+    """The JSON object ``name`` of a loaded file, values as numbers (``{}``: none in it)."""
     if name not in data:
         return {}
     counts = json.loads(str(data[name]))

@@ -1,7 +1,7 @@
 """The per-step QP and its resolver: strict, else relaxed, else braking, on any backend.
 
-Decision variable ``x = Q̇`` (rad/s), or ``x = [Q̇; s]`` when the hard tasks are relaxed by a
-slack ``s`` (task units per s)::
+Decision variable ``x = Q̇`` (rad/s), ``x = [Q̇; σ]`` when a path's progress is scaled, or
+``x = [Q̇; s]`` when the hard tasks are relaxed by a slack ``s`` (task units per s)::
 
     minimise    ½ Q̇ᵀ (W + H) Q̇ + (c − g)ᵀ Q̇  (+ ½ ρ ‖s‖²)     g = λ ∂w/∂Q
     subject to  A Q̇ = b             (A Q̇ − s = b)            hard tasks (the tool's DV task)
@@ -14,7 +14,13 @@ step writes the problem's arrays in place (:class:`~dvqp.workspace.QPBuffers`); 
 gets the identical problem, set up once (``solvers.Problem.trusted`` over those arrays) and then
 only updated. When the strict problem has no accepted answer (the tasks and the limits
 conflict, or the answer does not pass the residual check), the relaxed one is solved: the step
-keeps every limit and reports its task error (``"relaxed"``). If that fails too (the limits
+keeps every limit and reports its task error (``"relaxed"``). In time-scaled path following
+(a non-zero :attr:`QPSolver.feedforward` ``v``, the nominal motion along the path) a third
+problem comes first: the task becomes ``A Q̇ = (b − v) + σ v`` with ``σ ∈ [0, 1]`` the fraction
+of the nominal progress, rewarded by ``½ ρ ‖v‖² (1 − σ)²`` (what the relaxed problem's slack
+``(1 − σ) v`` would cost): the tool slows along the path instead of leaving it
+(``"slowed"``), and is relaxed, around ``σ = 0``, only when not even stopping on the path
+holds it. If that fails too (the limits
 conflict among themselves), the step brakes: the velocity closest to rest within the joint
 bounds (``"braking"``), which the exact check of the integrated motion then accepts, splits or
 fails.
@@ -37,7 +43,8 @@ from dvqp.resolution.step import Resolver
 from dvqp.workspace import QPBuffers
 from solvers.accuracy import AccuracyTally
 
-#: A watcher of the backend calls: ``(kind, problem, solution)``, kind ``"strict"``/``"relaxed"``.
+#: A watcher of the backend calls: ``(kind, problem, solution)``, kind ``"strict"``,
+#: ``"scaled"`` or ``"relaxed"``.
 Watcher = Callable[[str, solvers.Problem, solvers.Solution], None]
 
 
@@ -89,13 +96,15 @@ class QPResolver(Resolver):
 @dataclass
 class Answer:
     """A QP solve: ``x`` (rad/s, None when even braking is impossible), the status
-    (``"optimal"``, ``"relaxed"``, ``"braking"``, or why it failed), the backend's iterations
-    and the time inside its calls (s)."""
+    (``"optimal"``, ``"slowed"``, ``"relaxed"``, ``"braking"``, or why it failed), the
+    backend's iterations, the time inside its calls (s) and ``rate``, the fraction of the
+    feed-forward's progress made (1 without time scaling)."""
 
     x: NDArray[np.float64] | None
     status: str
     iterations: int | None
     solver_time: float
+    rate: float = 1.0
 
 
 class QPSolver:
@@ -128,6 +137,13 @@ class QPSolver:
             np.concatenate([qp.ub, inf]),
         )  # fmt: skip
         self.backends = factory(), factory()
+        self.factory, self.task_weight = factory, task_weight
+        self.feedforward = np.zeros(m)
+        """The hard tasks' nominal motion this step, in their units per s, shape (m,): part
+        of ``b``; when it is not zero, a step whose strict problem has no accepted answer slows
+        along it before it relaxes (time-scaled path following). Zero: no time scaling."""
+        self.scaled: solvers.Problem | None = None
+        self._pacer: solvers.Backend | None = None
         self.refusals: Counter[str] = Counter()
         """Backend calls that gave no accepted answer, by :attr:`solvers.Solution.refusal`
         (the step then took the relaxed or braking path)."""
@@ -137,7 +153,8 @@ class QPSolver:
         (an infeasible strict problem has no optimum to be accurate about: its refusal is
         counted in :attr:`refusals`); a step with neither counts at the check's tolerance."""
         self.watchers: list[Watcher] = []
-        """Called after every backend call with ``("strict" | "relaxed", problem, solution)``;
+        """Called after every backend call with ``("strict" | "scaled" | "relaxed", problem,
+        solution)``;
         the problem's arrays are rewritten by the next step: a watcher copies what it keeps."""
 
     def solve(self, rest: bool = False) -> Answer:
@@ -154,17 +171,57 @@ class QPSolver:
         strict, relaxed = self.backends
         solution = strict.solve(self.strict)
         self._count("strict", self.strict, solution)
-        spent, status = solution.solver_time, "optimal"
+        spent, status, rate = solution.solver_time, "optimal", 1.0
+        if not solution.found and not rest and np.any(self.feedforward):
+            solution, rate = self._slow_down()
+            spent, status = spent + solution.solver_time, "slowed"
         if not solution.found:
             self._load_relaxed()
             solution = relaxed.solve(self.relaxed)
             self._count("relaxed", self.relaxed, solution)
             spent, status = spent + solution.solver_time, "relaxed"
         if solution.found and solution.x is not None:
-            return Answer(solution.x[: qp.cost.shape[0]], status, solution.iterations, spent)
+            x = solution.x[: qp.cost.shape[0]]
+            return Answer(x, status, solution.iterations, spent, rate)
         if np.any(qp.lb > qp.ub):
-            return Answer(None, f"failed: {solution.message}", solution.iterations, spent)
-        return Answer(np.clip(0.0, qp.lb, qp.ub), "braking", solution.iterations, spent)
+            return Answer(None, f"failed: {solution.message}", solution.iterations, spent, 0.0)
+        return Answer(np.clip(0.0, qp.lb, qp.ub), "braking", solution.iterations, spent, rate)
+
+    def _slow_down(self) -> tuple[solvers.Solution, float]:
+        """Solve the time-scaled problem; leave in ``b`` the task the answer meets (or, if it
+        has none, the task of stopping on the path, ``b − v``, for the relaxed problem).
+        Returns the solution and ``σ`` (0 if it has no accepted answer)."""
+        qp, v = self.qp, self.feedforward
+        n = qp.cost.shape[0]
+        if self.scaled is None:
+            self.scaled = self._scaled_problem()
+            self._pacer = self.factory()
+        p = self.scaled
+        weight = self.task_weight * float(v @ v)
+        p.P[:n, :n], p.q[:n], p.A[:, :n], p.A[:, n] = qp.P, qp.cost, qp.A, -v
+        p.P[n, n], p.q[n] = weight, -weight
+        np.subtract(qp.b, v, out=p.b)
+        p.lb[:n], p.ub[:n] = qp.lb, qp.ub
+        if p.G is not None:
+            p.G[:, :n] = qp.G
+        solution = self._pacer.solve(p)  # type: ignore[union-attr]
+        self._count("scaled", p, solution)
+        if not (solution.found and solution.x is not None):
+            qp.b[:] -= v
+            return solution, 0.0
+        rate = min(max(float(solution.x[n]), 0.0), 1.0)
+        qp.b[:] -= (1.0 - rate) * v
+        return solution, rate
+
+    def _scaled_problem(self) -> solvers.Problem:
+        """The time-scaled problem's arrays, ``x = [Q̇; σ]`` (filled by :meth:`_slow_down`)."""
+        qp = self.qp
+        n, m, p = qp.cost.shape[0], qp.b.shape[0], qp.h.shape[0]
+        G = np.zeros((p, n + 1)) if p else None
+        return solvers.Problem.trusted(
+            np.zeros((n + 1, n + 1)), np.zeros(n + 1), np.zeros((m, n + 1)), np.zeros(m), G,
+            qp.h if p else None, np.append(qp.lb, 0.0), np.append(qp.ub, 1.0),
+        )  # fmt: skip
 
     def _count(self, kind: str, problem: solvers.Problem, solution: solvers.Solution) -> None:
         """Tally one backend call (refusal, accuracy) and show it to the watchers."""
@@ -188,5 +245,6 @@ class QPSolver:
         """Forget the backends' warm starts, the refusals and accuracy counted (a run starts)."""
         self.refusals.clear()
         self.accuracy = AccuracyTally()
-        for backend in self.backends:
-            backend.reset()
+        for backend in (*self.backends, self._pacer):
+            if backend is not None:
+                backend.reset()

@@ -20,7 +20,8 @@ class Step(NamedTuple):
     success : bool
         The step satisfies every hard limit of the resolver (checked, not the solver's word).
     status : str
-        ``"optimal"``, ``"relaxed"`` (task slack used), ``"braking"``, or the failure reason.
+        ``"optimal"``, ``"slowed"`` (a path's progress slowed), ``"relaxed"`` (task slack
+        used), ``"braking"``, or the failure reason.
     task_error : float
         ``‖A·Q̇ − b‖∞`` of the hard tasks (m/s or rad/s; ``inf`` for a failed step).
     solve_time : float
@@ -30,6 +31,9 @@ class Step(NamedTuple):
     solver_time : float
         Of ``solve_time``, the time inside the QP backend's calls (data update and solve), s;
         for the baseline, its linear algebra.
+    rate : float
+        The fraction of the commanded progress along a path the step made, in [0, 1]: below 1
+        when a time-scaled step slowed (0 for a failed one); 1 without time scaling.
     """
 
     qdot: NDArray[np.float64]
@@ -39,6 +43,7 @@ class Step(NamedTuple):
     solve_time: float
     iterations: int | None = None
     solver_time: float = 0.0
+    rate: float = 1.0
 
 
 class Resolver:

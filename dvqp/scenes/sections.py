@@ -31,6 +31,7 @@ from dvqp.limits import (
 from dvqp.motion.jog import DEFAULT_RAMP, MAX_STEPS, JogSegment, jog_step_count
 from dvqp.motion.path import ToolPath
 from dvqp.motion.saddle import SaddleWeld
+from dvqp.motion.schedule import TIMINGS
 from dvqp.objective import Objective
 from dvqp.scenes.fields import Bound, Fields, join
 
@@ -53,7 +54,7 @@ TURN_RATE = Bound(-10.0, 10.0, "rad/s")
 TOLERANCE = Bound(0.0, 10.0, "m", strict=True)
 HEADING_TOLERANCE = Bound(0.0, 10.0, "rad", strict=True)
 OBJECTIVE_KEYS = ("orbital_level", "k_height", "k_obstacle", "gain")
-PATH_KEYS = ("waypoints", "speed", "gain", "tolerance", "heading_tolerance")
+PATH_KEYS = ("waypoints", "speed", "gain", "tolerance", "heading_tolerance", "timing")
 FOLLOW_KEYS = PATH_KEYS[1:]
 ONE_MOTION = "give exactly one of [[motion.jog]] segments, a [motion.path] or a [motion.saddle]"
 SADDLE_KEYS = ("branch", "offset", "arc", "heading", "h", *FOLLOW_KEYS)
@@ -167,11 +168,19 @@ def _motion(f: Fields, motion: dict[str, Any]) -> tuple[tuple[JogSegment, ...], 
     return (), ToolPath(_validate.readonly(points), speed, **given)
 
 
-def _following(f: Fields, t: dict[str, Any], prefix: str) -> tuple[float, dict[str, float]]:
-    """A path's ``speed`` (m/s) and its optional ``gain``, ``tolerance``, ``heading_tolerance``."""
+def _following(f: Fields, t: dict[str, Any], prefix: str) -> tuple[float, dict[str, Any]]:
+    """A path's ``speed`` (m/s) and its optional ``gain``, ``tolerance``, ``heading_tolerance``
+    and ``timing``."""
     speed = f.number(t, "speed", prefix, within=Bound(0.0, SPEED.high, "m/s", True))
     optional = {"gain": GAIN, "tolerance": TOLERANCE, "heading_tolerance": HEADING_TOLERANCE}
-    return speed, {k: f.number(t, k, prefix, within=b) for k, b in optional.items() if k in t}
+    given: dict[str, Any] = {k: f.number(t, k, prefix, within=b) for k, b in optional.items()
+                             if k in t}  # fmt: skip
+    if "timing" in t:
+        given["timing"] = f.string(t, "timing", prefix)
+        if given["timing"] not in TIMINGS:
+            f.fail(join(prefix, "timing"), f"must be one of {', '.join(TIMINGS)}, got "
+                   f"{given['timing']!r}")  # fmt: skip
+    return speed, given
 
 
 def _saddle(

@@ -29,6 +29,9 @@ MAX_HALVINGS = 5
 JOINT_STRIDE = 0.02
 """rad: the straight motion of a step is also checked at interior points this far apart."""
 
+STATUS_RANK = ("optimal", "slowed")
+"""A split step's status is its substeps' worst: optimal, slowed, else relaxed."""
+
 SINGULAR = Excess(math.inf, 1.0, "singular configuration", "a guarded frame on the pipe axis")
 
 
@@ -89,12 +92,12 @@ def _attempt(stepper: Stepper, q: NDArray[np.float64], command: NDArray[np.float
     if not found.success:
         stepper.observe(np.zeros_like(q), dt)
         failed = Step(np.zeros_like(q), False, found.status, math.inf, found.solve_time,
-                      found.iterations, found.solver_time)  # fmt: skip
+                      found.iterations, found.solver_time, 0.0)  # fmt: skip
         return Advance(failed, 1)
     reached = stepper.move()
     motion = stepper.motion
     step = Step(stepper.x.copy(), True, found.status, float(motion[0]), found.solve_time,
-                found.iterations, found.solver_time)  # fmt: skip
+                found.iterations, found.solver_time, found.rate)  # fmt: skip
     broken = NO_EXCESS if reached else SINGULAR
     if reached and verify and stepper.broken:
         broken = stepper.excess()
@@ -149,16 +152,18 @@ def straight_excess(stepper: Stepper, q: NDArray[np.float64], end: NDArray[np.fl
 def _failed(step: Step, broken: Excess, substeps: int, where: str = "") -> Advance:
     status = f"failed: {where}{broken.describe()} in {substeps} substeps"
     failed = Step(np.zeros_like(step.qdot), False, status, math.inf, step.solve_time,
-                  step.iterations, step.solver_time)  # fmt: skip
+                  step.iterations, step.solver_time, 0.0)  # fmt: skip
     return Advance(failed, substeps, broken)
 
 
 def _joined(q: NDArray[np.float64], end: NDArray[np.float64], first: Advance, second: Advance,
             dt: float) -> Advance:  # fmt: skip
     a, b = first.step, second.step
-    status = "optimal" if a.status == b.status == "optimal" else "relaxed"
+    both = {a.status, b.status}
+    status = "relaxed" if both - set(STATUS_RANK) else max(both, key=STATUS_RANK.index)
     counted = a.iterations is not None and b.iterations is not None
     iterations = a.iterations + b.iterations if counted else None  # type: ignore[operator]
     step = Step((end - q) / dt, True, status, max(a.task_error, b.task_error),
-                a.solve_time + b.solve_time, iterations, a.solver_time + b.solver_time)  # fmt: skip
+                a.solve_time + b.solve_time, iterations, a.solver_time + b.solver_time,
+                0.5 * (a.rate + b.rate))  # fmt: skip
     return Advance(step, first.substeps + second.substeps)

@@ -38,14 +38,16 @@ Array = NDArray[np.float64]
 
 class Resolution(NamedTuple):
     """How a step's joint velocity (:attr:`Stepper.x`) was found: ``success``, ``status``
-    (``"optimal"``, ``"relaxed"``, ``"braking"`` or why it failed), the backend's
-    ``iterations``, the time inside its calls and of the whole resolution (s)."""
+    (``"optimal"``, ``"slowed"``, ``"relaxed"``, ``"braking"`` or why it failed), the
+    backend's ``iterations``, the time inside its calls and of the whole resolution (s), and
+    the fraction of the nominal progress made (:meth:`Stepper.pace`; 1 without it)."""
 
     success: bool
     status: str
     iterations: int | None
     solver_time: float
     solve_time: float
+    rate: float = 1.0
 
 
 class Stepper(Verification):
@@ -188,7 +190,21 @@ class Stepper(Verification):
         if answer.x is not None:
             self.x[:] = answer.x
         return Resolution(answer.x is not None, answer.status, answer.iterations,
-                          answer.solver_time, time.perf_counter() - started)  # fmt: skip
+                          answer.solver_time, time.perf_counter() - started,
+                          answer.rate)  # fmt: skip
+
+    def pace(self, feedforward: Array | None) -> None:
+        """Let the next steps slow along ``feedforward``, the tool's nominal DV velocity in
+        the command (m/s, rad/s; shape (4,)), before they relax the task (time-scaled path
+        following, :attr:`~dvqp.resolution.qp.QPSolver.feedforward`); None: no time scaling.
+        The baseline has no such choice: its steps always make the whole progress."""
+        if self.solver is None:
+            return
+        v = self.solver.feedforward
+        v[:] = 0.0
+        if feedforward is not None:
+            for start in self.layout.measures.tool_rows:
+                v[start : start + 4] = feedforward
 
     def prepare(self, command: Array, dt: float) -> int:
         """Write the problem of a step from the loaded state for ``command`` (4,) over ``dt``
