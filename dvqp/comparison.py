@@ -21,8 +21,9 @@ from dvqp.errors import DvqpError
 from dvqp.geometry import proximity
 from dvqp.kinematics import KinematicState
 from dvqp.limits import lowest_link, self_distance, start_broken_lines
-from dvqp.planning import check_run, final_errors, path_figures, worst_sample_excess
+from dvqp.planning import check_run, path_figures
 from dvqp.resolution.registry import PINV
+from dvqp.sample_checks import final_errors, worst_sample_excess
 from dvqp.table_text import csv_text
 from solvers.accuracy import METRICS
 
@@ -31,12 +32,12 @@ if TYPE_CHECKING:
 
 FIELDS = (
     "scene", "file", "backend", "settings", "success", "steps", "failures", "slowed", "relaxed",
-    "braking", "substepped", "nominal_duration", "path_duration", "max_deviation",
-    "median_step_us", "p95_step_us", "median_solver_us", "median_rest_us", "median_iterations",
-    "refused_calls", "refusals", "qp_solves", "unanswered_solves", "primal_residual",
-    "dual_residual", "duality_gap", "ratio_to_pinv", "max_task_error", "min_clearance", "closest",
-    "min_probe_clearance", "min_tilt", "min_self_distance", "closest_pair", "min_link_height",
-    "lowest_link", "max_joint_acceleration", "max_limit_excess", "worst_limit", "start_broken",
+    "braking", "substepped", "nominal_duration", "path_duration", "max_deviation", "median_step_us",
+    "p95_step_us", "median_solver_us", "median_rest_us", "median_iterations", "refused_calls",
+    "refusals", "qp_solves", "unanswered_solves", "primal_residual", "dual_residual", "duality_gap",
+    "ratio_to_pinv", "max_task_error", "min_clearance", "closest", "min_probe_clearance",
+    "min_tilt", "min_self_distance", "closest_pair", "min_link_height", "lowest_link",
+    "max_joint_acceleration", "max_limit_excess", "worst_limit", "start_broken",
     "max_joint_limit_violation", "max_velocity_limit_violation", "final_tracking_error",
     "final_joint_speed", "braking_time", "error",
 )  # fmt: skip
@@ -81,10 +82,9 @@ def summarize(scene: Scene, traj: Trajectory, settings: str = "default") -> Row:
     ``worst_limit``), also of a limit the start broke, which ``start_broken`` names (a line
     per limit of :func:`dvqp.limits.start_broken_lines`, ``"; "``-joined; None if none); the
     largest joint-limit violation (rad) of ``q`` and velocity-limit violation (rad/s) of
-    ``Q̇``; the final tracking error (m) against the commanded motion; ``final_joint_speed``,
-    the largest ``|Q̇|`` of the last step that succeeded (rad/s; 0: the run ended at rest), and
-    ``braking_time``, how long the stop at the end took (s; None: not stopped); ``final_tool``
-    ``[l, z, h, α]``. Undefined figures are None.
+    ``Q̇``; the final tracking error (m); ``final_joint_speed``, the largest ``|Q̇|`` of the
+    last step that succeeded (rad/s; 0: at rest), ``braking_time`` (s; None: not stopped) and
+    ``final_tool`` ``[l, z, h, α]``. Undefined figures are None.
     """
     ok = traj.success
     steps_us = traj.step_time * 1e6
@@ -228,8 +228,8 @@ def run_scene(
 
 
 def error_row(scene: Scene, backend: str, exc: Exception, extra: Sequence[str] = ()) -> Row:
-    """The row of a run that raised: ``success`` False, ``error`` the message of ``exc``, every
-    other figure (keys :data:`FIELDS`, then ``extra``, then ``final_tool``) None."""
+    """A run that raised: ``error`` says why, every other figure (:data:`FIELDS`, ``extra``,
+    ``final_tool``) None and ``success`` False."""
     row: Row = dict.fromkeys((*FIELDS, *extra, "final_tool"))
     row.update(scene=scene.name, file=scene.source, backend=backend, success=False, error=str(exc))
     return row
@@ -291,8 +291,8 @@ def rows_to_csv(rows: Sequence[Row], fields: Sequence[str] = FIELDS) -> str:
 def machine() -> dict[str, Any]:
     """Platform, processor, CPU count and Python version of this machine."""
     processor = platform.processor() or platform.machine()
-    return {"platform": platform.platform(), "processor": processor,
-            "cpu_count": os.cpu_count(), "python": platform.python_version()}  # fmt: skip
+    return {"platform": platform.platform(), "processor": processor, "cpu_count": os.cpu_count(),
+            "python": platform.python_version()}  # fmt: skip
 
 
 def quiet_worker() -> None:

@@ -19,15 +19,14 @@ from numpy.typing import NDArray
 
 from dvqp.errors import LimitViolationError, ParameterError, UnreachableTargetError
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits import Excess, Limit, start_broken_lines
+from dvqp.limits import Limit, start_broken_lines
 from dvqp.motion.jog import box_average, jog_commands
 from dvqp.motion.schedule import MAX_SLOWDOWN, TIMINGS, path_deviation
 from dvqp.motion.simulate import StepWatcher, dv_error, simulate
 from dvqp.motion.trajectory import Trajectory
-from dvqp.resolution.pinv import PseudoinverseResolver
 from dvqp.resolution.registry import make_resolver, tier_options
+from dvqp.sample_checks import final_errors, worst_sample_excess
 from dvqp.scenes.scene import Scene
-from dvqp.step import Stepper
 from dvqp.tasks import Task
 
 
@@ -281,28 +280,3 @@ def _unfinished(scene: Scene, traj: Trajectory) -> str | None:
     return (f"the path was not finished: {traj.path_time[-1] / nominal:.0%} of it in "
             f"{traj.t[-1]:.3f} s (the limits held the tool back; at most "
             f"{MAX_SLOWDOWN:g}x the nominal {nominal:.3f} s)")  # fmt: skip
-
-
-def worst_sample_excess(
-    scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()
-) -> tuple[int, Excess] | None:
-    """The sample whose limit excess is worst relative to its tolerance, and that excess; None
-    if no sample exceeds a limit (or the file, from before 0.2, records no excess)."""
-    candidates = np.flatnonzero(traj.limit_excess > 0.0)
-    if candidates.shape[0] == 0:
-        return None
-    spec = scene.spec().with_extra(limits=limits)
-    stepper = Stepper(scene.robot, scene.pipe_radius, PseudoinverseResolver(spec), traj.q[0],
-                      scene.dt)  # fmt: skip
-    stepper.start(traj.q[0])
-    found = []
-    for k in candidates[np.argsort(traj.limit_excess[candidates])[-20:]]:
-        if stepper.load(traj.q[k]):
-            found.append((int(k), stepper.excess()))
-    return max(found, key=lambda item: item[1].ratio) if found else None
-
-
-def final_errors(traj: Trajectory) -> tuple[float, float]:
-    """Final tracking error: largest of |l|, |z|, |h| (m) and |α| (rad)."""
-    last = traj.tracking_error[-1]
-    return float(np.max(np.abs(last[:3]))), float(abs(last[3]))

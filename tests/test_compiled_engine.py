@@ -21,7 +21,7 @@ from dvqp import Bounds, Limit, ObjectiveTerm, QPResolver, Stepper, Term
 from dvqp.geometry.real_links import PRECISION
 from dvqp.motion.simulate import dv_error
 from dvqp.objective import OrbitalLevel
-from dvqp.planning import scene_commands
+from dvqp.planning import scene_commands, scene_timing
 from dvqp.resolution.pinv import PseudoinverseResolver
 from tests import safety
 from tests.oracle_resolution import (
@@ -39,7 +39,10 @@ from tests.runs import BUNDLED, run, scene
 
 def commands(s: dvqp.Scene, traj: dvqp.Trajectory) -> np.ndarray:
     """The tool command of every step, with the position feedback of a path, (N, 4): the
-    braking steps at the end (from ``traj.brake_start``) hold the tool still (0)."""
+    braking steps at the end (from ``traj.brake_start``) hold the tool still (0). A
+    time-scaled run's (:func:`scaled_commands`) as its steps wrote them."""
+    if scene_timing(s) == "scaled":
+        return scaled_commands(s, traj)[0]
     c = scene_commands(s)
     given = c.velocity.shape[0]
     assert traj.brake_start == given
@@ -48,6 +51,36 @@ def commands(s: dvqp.Scene, traj: dvqp.Trajectory) -> np.ndarray:
         return np.vstack([c.velocity, still])
     error = dv_error(c.reference[:-1], traj.tool[:given], s.pipe_radius)
     return np.vstack([c.velocity + c.feedback_gain * error, still])
+
+
+def scaled_commands(s: dvqp.Scene, traj: dvqp.Trajectory) -> tuple[np.ndarray, ...]:
+    """A time-scaled run's steps from its recorded progress alone, each (N, 4) but ``σ`` (N,):
+    the command each step wrote (nominal motion ``v`` from ``x_d(u)`` to ``x_d(u + 1)``, the
+    path interpolated between its samples, plus the feedback), ``v``, and the rate ``σ`` the
+    step made of it (the braking steps: 0, 0, 1)."""
+    c = scene_commands(s)
+    n, k = c.velocity.shape[0], traj.brake_start
+    u = traj.path_time / s.dt
+    span = np.minimum(1.0, n - u[:k])
+    at = lambda v: np.column_stack([np.interp(v, np.arange(n + 1), col)  # noqa: E731
+                                    for col in c.reference.T])  # fmt: skip
+    v = (at(u[:k] + span) - at(u[:k])) / s.dt
+    xdot = v + c.feedback_gain * dv_error(at(u[:k]), traj.tool[:k], s.pipe_radius)
+    rate = (u[1 : k + 1] - u[:k]) / span
+    still = np.zeros((traj.n_steps - k, 4))
+    return (np.vstack([xdot, still]), np.vstack([v, still]),
+            np.concatenate([rate, np.ones(traj.n_steps - k)]))  # fmt: skip
+
+
+def slowed_residual(p: object, x: np.ndarray, v: np.ndarray, rate: float, rho: float) -> float:
+    """The KKT residual of ``[x; σ]`` for the slowed step's own problem: the strict one ``p``
+    with ``A Q̇ − σ v = b − v``, ``0 ≤ σ ≤ 1`` and ``½ ρ‖v‖²(1 − σ)²`` in the cost."""
+    n, w = x.shape[0], rho * float(v @ v)
+    P = np.zeros((n + 1, n + 1))
+    P[:n, :n], P[n, n] = p.P, w  # type: ignore[attr-defined]
+    G = None if p.G is None else np.column_stack([p.G, np.zeros(p.G.shape[0])])  # type: ignore[attr-defined]
+    return kkt_residual(P, np.append(p.q, -w), np.column_stack([p.A, -v]), p.b - v, G, p.h,  # type: ignore[attr-defined]
+                        np.append(p.lb, 0.0), np.append(p.ub, 1.0), np.append(x, rate))  # type: ignore[attr-defined]  # fmt: skip
 
 
 def checked_samples(traj: dvqp.Trajectory) -> list[int]:
@@ -105,6 +138,9 @@ def test_the_task_error_of_every_step_is_measured_on_the_motion(name: str, backe
     """``‖J̄ Q̇ − ẋ‖∞`` with ``J̄ Q̇`` the derivative of Pinocchio's tool along ``Q̇``."""
     s, traj = scene(name), run(name, backend)
     xdot, eps = commands(s, traj), 1e-6
+    if scene_timing(s) == "scaled":  # a slowed step meets its task at the rate it made
+        full, v, rate = scaled_commands(s, traj)
+        xdot = full - (1.0 - rate)[:, None] * v
     taken = np.flatnonzero(traj.success & (traj.substeps == 1))
     assert taken.size > 0.9 * traj.n_steps
     for k in taken:
@@ -126,14 +162,17 @@ def test_every_answer_of_the_qp_is_optimal_for_the_problem_of_its_step(name: str
     step = Stepper(s.robot, s.pipe_radius, QPResolver(spec, "daqp"), s.q0, s.dt)
     step.start(s.q0)
     xdot, weights = commands(s, traj), spec.diagonal(s.robot.n)
-    free = 0
+    free = slowed = 0
+    scaled = scene_timing(s) == "scaled"
+    if scaled:
+        _, speeds, rates = scaled_commands(s, traj)
     for k in np.flatnonzero(traj.success & (traj.substeps == 1)):
         step.observe(traj.qdot[k - 1] if k else np.zeros(s.robot.n), s.dt)  # the velocity so far
         step.stopping = k >= traj.brake_start
         assert step.load(traj.q[k]) and step.prepare(xdot[k], s.dt) == -1
         p, x, status = step.problem(), traj.qdot[k], traj.status[k]
         g = (0.0 if step.stopping else spec.objective.gain) * step.objective.gradient
-        np.testing.assert_array_equal(p.b, xdot[k])
+        np.testing.assert_allclose(p.b, xdot[k], rtol=0, atol=1e-12)
         np.testing.assert_array_equal(p.q, -g)
         np.testing.assert_array_equal(p.P, np.diag(weights))
         assert np.all(p.lb - 1e-9 <= x) and np.all(x <= p.ub + 1e-9), k
@@ -141,6 +180,11 @@ def test_every_answer_of_the_qp_is_optimal_for_the_problem_of_its_step(name: str
             np.testing.assert_array_equal(x, np.clip(0.0, p.lb, p.ub))
             continue
         assert p.G is None or np.all(p.G @ x <= p.h + 1e-9), k
+        if status == "slowed":  # optimal for its own problem, the strict one had no answer
+            slowed += 1
+            assert 0.0 <= rates[k] < 1.0
+            assert slowed_residual(p, x, speeds[k], rates[k], spec.task_weight) < 1e-9, k
+            continue
         relaxed = spec.task_weight if status == "relaxed" else None
         if relaxed is None:
             np.testing.assert_allclose(p.A @ x, p.b, rtol=0, atol=1e-9)
@@ -152,6 +196,7 @@ def test_every_answer_of_the_qp_is_optimal_for_the_problem_of_its_step(name: str
             expected = eq18(p.A, p.b, g, weights)
             np.testing.assert_allclose(x, expected, rtol=0, atol=1e-9 * max(1.0, np.abs(x).max()))
     assert free > 0  # eq. 18 was met as well as the active rows
+    assert (slowed > 0) == scaled  # the time-scaled scene slows somewhere
     assert not traj.qdot[-1].any() and traj.status[-1] == "optimal"  # at rest, exactly
 
 

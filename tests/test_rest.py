@@ -23,7 +23,7 @@ from dvqp.comparison import summarize
 from dvqp.errors import UnreachableTargetError
 from dvqp.limits import AccelerationLimit, JointVelocityLimit
 from dvqp.motion.stop import MARGIN, braking_steps, room
-from dvqp.planning import check_run, scene_commands
+from dvqp.planning import check_run, scene_commands, scene_timing
 from dvqp.scenes.scene import loads
 from tests.runs import BUNDLED, QP, run, scene
 
@@ -42,6 +42,9 @@ def assert_ends_at_rest(s: Scene, traj: Trajectory, tol: float = 1e-6) -> None:
     """At rest exactly, every acceleration within the limit, the stop as long as it must be
     (each step changes a joint's velocity by at most ``q̈_max dt``) and within its bound."""
     commanded = scene_commands(s).velocity.shape[0]
+    if scene_timing(s) == "scaled":  # as many steps as following the path took
+        assert traj.path_time[traj.brake_start] == pytest.approx(commanded * s.dt, abs=1e-12)
+        commanded = traj.brake_start
     assert traj.brake_start == commanded and traj.n_steps > commanded
     assert not traj.qdot[-1].any() and traj.status[-1] == "optimal"
     a, dt = qdd_max(s), s.dt

@@ -63,7 +63,8 @@ def test_a_retimed_bundled_scene_keeps_qd_max_and_qdd_max_at_every_sample_rest_t
     # the planned path, not another: the spline through its samples strays from the straight
     # steps between them by a fraction of dt² qdd_max
     assert polyline_distance(r.q, planned.q).max() < 0.25 * s.dt**2 * qdd_max(s).max()
-    assert r.duration <= planned.t[-1]  # every bundled run is paced by its commands
+    if not np.any(planned.status == "slowed"):  # a run paced by its commands, not its limits
+        assert r.duration <= planned.t[-1]
 
 
 @pytest.mark.parametrize("name", ["paper-two-inlets", "joint-limit", "probe-into-clamp"])

@@ -144,7 +144,9 @@ def test_the_baseline_breaking_a_joint_velocity_limit_is_not_safe_to_send(rush: 
         check_run(rush, traj)
 
 
-def test_path_time_is_saved_and_loaded(rush_runs: dict[str, dvqp.Trajectory], tmp_path: Path) -> None:
+def test_path_time_is_saved_and_loaded(
+    rush_runs: dict[str, dvqp.Trajectory], tmp_path: Path
+) -> None:
     traj = rush_runs["scaled"]
     again = dvqp.Trajectory.load(traj.save(tmp_path / "run.npz"))
     np.testing.assert_array_equal(again.path_time, traj.path_time)

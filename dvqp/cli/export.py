@@ -46,7 +46,9 @@ def run(args: argparse.Namespace) -> int:
         )  # fmt: skip
     index = exported.index
     kinds = Counter(entry["kind"] for entry in index["problems"])
-    counted = ", ".join(f"{kinds[kind]} {kind}" for kind in ("strict", "relaxed") if kinds[kind])
+    counted = ", ".join(
+        f"{kinds[kind]} {kind}" for kind in ("strict", "scaled", "relaxed") if kinds[kind]
+    )
     print(f"wrote {len(index['problems'])} QPs ({counted or 'none'}) of {index['steps']} steps "
           f"to {args.output} ({INDEX}, answers/)")  # fmt: skip
     if index["error"]:

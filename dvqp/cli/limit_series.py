@@ -37,7 +37,7 @@ BOUND_TOLERANCE = 1e-6
 """rad/s: how far past a QP bound (joint speed) an accepted answer may be: the solution
 check's primal tolerance. A joint acceleration's is this over ``dt``."""
 
-MARKS = ("relaxed", "braking", "split", "failed")
+MARKS = ("slowed", "relaxed", "braking", "split", "failed")
 """The kinds of step a limits page marks (:attr:`LimitPage.marks`)."""
 
 
@@ -191,8 +191,9 @@ def _rates(traj: Trajectory, stepper: Stepper, dt: float) -> list[Curve]:
 
 
 def _marks(traj: Trajectory) -> dict[str, Array]:
-    """The start times (s) of the relaxed, braking, split and failed steps."""
+    """The start times (s) of the slowed, relaxed, braking, split and failed steps."""
     t, status = traj.t[:-1], traj.status.astype(str)
     split = traj.substeps > 1 if traj.substeps.shape == t.shape else np.zeros(t.shape, bool)
-    return {"relaxed": t[status == "relaxed"], "braking": t[status == "braking"],
+    return {"slowed": t[status == "slowed"], "relaxed": t[status == "relaxed"],
+            "braking": t[status == "braking"],
             "split": t[split], "failed": t[~traj.success]}  # fmt: skip

@@ -3,7 +3,7 @@
 One panel per kind of limit (:func:`dvqp.cli.limit_series.limit_series`): clearance per
 obstacle, self distance, heights, tilt, then joint positions, speeds and accelerations as
 fractions of their limits. The bound is a dashed red line with the forbidden side shaded; the
-run's relaxed, braking, split and failed steps are shaded bands on every panel.
+run's slowed, relaxed, braking, split and failed steps are shaded bands on every panel.
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ from dvqp.cli.limit_series import MARKS, Curve, LimitPage
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-MARK_COLOURS = {"relaxed": "tab:orange", "braking": "tab:blue", "split": "tab:purple",
-                "failed": "tab:red"}  # fmt: skip
+MARK_COLOURS = {"slowed": "tab:olive", "relaxed": "tab:orange", "braking": "tab:blue",
+                "split": "tab:purple", "failed": "tab:red"}  # fmt: skip
 """The band colour of each kind of marked step."""
 
 NAMED = 8
