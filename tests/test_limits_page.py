@@ -164,3 +164,17 @@ def test_plot_limits_cli_writes_the_page_from_the_stored_scene(
     assert err.startswith(f"dvqp: {wrong}: not a run of {wrong} (stored scene): ")
     assert "pipe radius is 0.3 m, the scene's 0.254 m" in err and err.count("\n") == 1
     assert sorted(os.listdir(tmp_path)) == ["limits.png", "run.npz", "wrong.npz"]
+
+
+def test_plot_limits_against_another_scene_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    npz, png = tmp_path / "run.npz", tmp_path / "limits.png"
+    run("paper-two-inlets", "daqp").save(npz)
+    same = ["plot", str(npz), "-o", str(png), "--limits", "--scene"]
+    assert main([*same, "scenes/paper-two-inlets.toml"]) == 0
+    assert "note" not in capsys.readouterr().err  # the scene it was planned from
+    assert main([*same, "scenes/paper-inlets.toml"]) == 0  # the same arm: allowed, but said
+    err = capsys.readouterr().err
+    assert err == (f"dvqp: note: {npz} was planned from another scene text than "
+                   "scenes/paper-inlets.toml: drawn against the latter's limits\n")  # fmt: skip

@@ -7,6 +7,7 @@ The trajectory file is checked enough to be drawn before anything is drawn; the 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -14,7 +15,7 @@ import numpy as np
 
 from dvqp._files import output_path
 from dvqp.cli.figures import FIGURE_FORMATS
-from dvqp.errors import DvqpError
+from dvqp.errors import DvqpError, one_line
 from dvqp.motion.trajectory import Trajectory
 from dvqp.scenes import environment, load_scene, loads
 
@@ -60,6 +61,10 @@ def _plot_limits(args: argparse.Namespace, traj: Trajectory) -> int:
     target = output_path(args.output, FIGURE_FORMATS)
     if args.scene is not None:
         scene = load_scene(args.scene)
+        if traj.scene_text and traj.scene_text != scene.text:  # allowed: other limits, say
+            print(f"dvqp: note: {one_line(args.trajectory)} was planned from another scene text "
+                  f"than {one_line(args.scene)}: drawn against the latter's limits",
+                  file=sys.stderr)  # fmt: skip
     elif traj.scene_text:
         folder = Path(args.trajectory).parent  # a relative URDF: beside the trajectory
         scene = loads(traj.scene_text, f"{args.trajectory} (stored scene)", base_dir=folder)
