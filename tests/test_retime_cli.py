@@ -45,6 +45,19 @@ def test_plan_retime_writes_csv_and_npz_by_suffix(tmp_path: Path) -> None:
         assert np.array_equal(data["t"], table[:, 0]) and data["qddot"].shape == (len(table), 13)
 
 
+def test_plot_of_a_retimed_file_says_what_it_is_and_what_to_plot(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene, npz = write_scene(tmp_path), tmp_path / "r.npz"
+    assert main(["plan", scene, "--retime", "-o", str(npz)]) == 0
+    capsys.readouterr()
+    assert main(["plot", str(npz), "-o", str(tmp_path / "r.png")]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"dvqp: {npz}: a retimed motion (dvqp plan --retime): dvqp plot draws planned "
+                   "runs; save the run itself (dvqp plan SCENE -o RUN.npz) and plot that\n")  # fmt: skip
+    assert not (tmp_path / "r.png").exists()
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [

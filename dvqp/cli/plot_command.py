@@ -95,10 +95,23 @@ def _load_trajectory(path: str) -> Trajectory:
     try:
         traj = Trajectory.load(path)
     except DvqpError as exc:  # dvqp reads arrays only, never pickled objects
+        if _retimed(path):
+            raise DvqpError(f"{path}: a retimed motion (dvqp plan --retime): dvqp plot draws "
+                            "planned runs; save the run itself (dvqp plan SCENE -o RUN.npz) "
+                            "and plot that") from exc  # fmt: skip
         raise DvqpError(f"{path}: not a dvqp trajectory (not written by 'dvqp plan')") from exc
     if not _drawable(traj):
         raise DvqpError(f"{path}: not a dvqp trajectory (arrays of unexpected shapes)")
     return traj
+
+
+def _retimed(path: str) -> bool:
+    """The file is a retimed motion's (:meth:`dvqp.retime.Retimed.save`)."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            return {"rate", "planned_duration", "qddot"} <= set(data.files)
+    except (OSError, ValueError, EOFError):
+        return False
 
 
 def _drawable(traj: Trajectory) -> bool:
