@@ -53,8 +53,9 @@ def test_plot_of_a_retimed_file_says_what_it_is_and_what_to_plot(
     capsys.readouterr()
     assert main(["plot", str(npz), "-o", str(tmp_path / "r.png")]) == 2
     err = capsys.readouterr().err
-    assert err == (f"dvqp: {npz}: a retimed motion (dvqp plan --retime): dvqp plot draws planned "
-                   "runs; save the run itself (dvqp plan SCENE -o RUN.npz) and plot that\n")  # fmt: skip
+    assert err == (f"dvqp: {npz}: a retimed motion (dvqp plan --retime): dvqp plot draws "
+                   "planned runs; save the run itself (dvqp plan SCENE -o RUN.npz) and plot "
+                   "that\n")  # fmt: skip
     assert not (tmp_path / "r.png").exists()
 
 
