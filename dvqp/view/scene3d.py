@@ -26,10 +26,10 @@ Color = tuple[int, int, int]
 
 COLORS: dict[str, Color] = {
     "pipe": (70, 120, 200), "obstacle": (40, 160, 70), "arm": (245, 140, 20),
-    "margin": (215, 25, 25), "rail": (80, 80, 80), "weld": (240, 200, 0), "path": (160, 40, 200),
+    "margin": (215, 25, 25), "rail": (80, 80, 80), "weld": (255, 255, 255), "path": (160, 40, 200),
 }  # fmt: skip
 """The view's colours (r, g, b): the pipe blue, the obstacles green, the arm orange and a link
-at its margin red, the rail grey, the weld yellow, the probe's path purple."""
+at its margin red, the rail grey, the weld white, the probe's path purple."""
 PATCH_HEIGHT = 0.01
 """m: how far a raised patch (a circle or a polygon pad) stands over the surface."""
 RING_HEIGHT = 0.03
