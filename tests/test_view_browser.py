@@ -2,7 +2,7 @@
 ``chromium``, WebGL on SwiftShader) driven by Playwright: the screenshot shows the pipe and
 the arm (counted by pixels of their colours), with the baseline's links at the lower inlet's
 margin in red at the last sample; typing sample 0 into the slider's box puts the arm at its
-start pose, where no link is at its margin.
+start pose, where no link is at its margin. The page asks nothing of any other server.
 
 Skipped only where no Chromium is installed. On CI (``CI=true``) a missing Playwright or
 viser is an error, not a skip. The screenshots are kept in the test's tmp folder.
@@ -90,6 +90,8 @@ def test_view_in_chromium_shows_the_pipe_and_the_arm(served: str, tmp_path: Path
         )  # fmt: skip
         page = browser.new_page()
         page.on("pageerror", lambda exc: errors.append(str(exc)))
+        asked: list[str] = []
+        page.on("request", lambda request: asked.append(request.url))
         page.goto(served)
         last = shot(page, tmp_path / "view-last.png", {"pipe": 50_000, "arm": 2_000,
                                                        "margin": 300})  # fmt: skip
@@ -107,3 +109,5 @@ def test_view_in_chromium_shows_the_pipe_and_the_arm(served: str, tmp_path: Path
         assert start["margin"] < 10 and start["arm"] > 2_000 and start["pipe"] > 50_000, start
         browser.close()
     assert not errors
+    away = [u for u in asked if not u.startswith((served, "data:", "blob:"))]
+    assert not away  # viser's client is served whole by the view: no network needed

@@ -67,3 +67,16 @@ def test_plot_3d_of_a_run_without_its_scene_asks_for_it(saved: Path, capsys) -> 
     scene = str(runs.SCENES / "paper-two-inlets.toml")
     assert main(["plot", str(bare), "-o", str(png), "--3d", "--scene", scene]) == 0
     assert colour_counts(png)["arm"] > 1_000
+
+
+def test_plot_3d_refuses_a_scene_the_run_is_not_of(saved: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    text = (runs.SCENES / "paper-two-inlets.toml").read_text()
+    wider = saved / "wider.toml"
+    wider.write_text(text.replace("radius = 0.254", "radius = 0.3", 1))
+    png = saved / "wider.png"
+    assert (
+        main(["plot", str(saved / "pinv.npz"), "-o", str(png), "--3d", "--scene", str(wider)]) == 2
+    )
+    assert capsys.readouterr().err == (f"dvqp: {saved / 'pinv.npz'}: not a run of {wider}: its "
+                                       "pipe radius is 0.254 m, the scene's 0.3 m\n")  # fmt: skip
+    assert not png.exists()

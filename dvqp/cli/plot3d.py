@@ -39,7 +39,9 @@ def plot_3d(view: Scene3D, target: Path, dpi: int = 130) -> Path:
     _arm(ax, view, len(view.t) - 1, alpha=1.0)
     _frame(ax, view, azim)
     ax.set_title(view.title, fontsize=10)
-    ax.legend(loc="upper left", fontsize=8)
+    ax.plot([], [], color=_rgb(COLORS["arm"]), lw=5.0, label="arm (first sample faint)")
+    ax.plot([], [], color=_rgb(COLORS["margin"]), lw=5.0, label="link at its margin")
+    ax.legend(loc="upper left", fontsize=8, facecolor="0.82")
     return save_figure(fig, target, dpi)
 
 

@@ -106,6 +106,9 @@ def trajectory_3d(path: str, traj: Trajectory, scene: Scene, samples: int = 2000
     if traj.q.shape[1] != scene.robot.n:
         raise DvqpError(f"{path}: not a run of {scene.source}: {traj.q.shape[1]} joints, "
                         f"the scene's arm has {scene.robot.n}")  # fmt: skip
+    if traj.pipe_radius and abs(traj.pipe_radius - scene.pipe_radius) > 1e-12:
+        raise DvqpError(f"{path}: not a run of {scene.source}: its pipe radius is "
+                        f"{traj.pipe_radius:g} m, the scene's {scene.pipe_radius:g} m")  # fmt: skip
     pick = np.unique(np.linspace(0, len(traj.t) - 1, min(samples, len(traj.t))).round())
     pick = pick.astype(np.int64)
     title = f"{scene.name} / {traj.backend or 'unknown resolver'}"

@@ -70,6 +70,15 @@ class View:
             raise DvqpError(f"cannot listen on {host}:{port}: the port is in use")
         self.url, self.view = url(host, port), view
         self._stop = threading.Event()
+        try:
+            self._start()
+        except BaseException:
+            self.close()
+            raise
+
+    def _start(self) -> None:
+        """The scene, the controls and the player."""
+        view = self.view
         self._draw_scene()
         n = len(view.t) - 1
         gui = self.server.gui
@@ -138,7 +147,7 @@ class View:
 
     def close(self) -> None:
         """Stop the player and the server."""
-        if hasattr(self, "_stop"):
+        if hasattr(self, "_player"):
             self._stop.set()
             self._player.join(timeout=2.0)
         with _quiet():
