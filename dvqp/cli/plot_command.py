@@ -63,7 +63,8 @@ def run(args: argparse.Namespace) -> int:
 def _plot_limits(args: argparse.Namespace, traj: Trajectory) -> int:
     """The limits page of a trajectory, from its stored scene (or ``--scene``)."""
     if not args.limits or args.gif or args.full:
-        raise DvqpError("--scene goes with --limits, which takes neither --gif nor --full")
+        raise DvqpError("--scene goes with --limits or --3d; --limits takes neither --gif nor "
+                        "--full")  # fmt: skip
     target = output_path(args.output, FIGURE_FORMATS)
     scene = scene_of(args.trajectory, traj, args.scene)
     from dvqp.cli.limit_series import limit_series
