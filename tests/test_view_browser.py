@@ -2,7 +2,8 @@
 ``chromium``, WebGL on SwiftShader) driven by Playwright: the screenshot shows the pipe and
 the arm (counted by pixels of their colours), with the baseline's links at the lower inlet's
 margin in red at the last sample; typing sample 0 into the slider's box puts the arm at its
-start pose, where no link is at its margin. The page asks nothing of any other server.
+start pose, where no link is at its margin; ticking play runs the time on. The page asks
+nothing of any other server.
 
 Skipped only where no Chromium is installed. On CI (``CI=true``) a missing Playwright or
 viser is an error, not a skip. The screenshots are kept in the test's tmp folder.
@@ -107,6 +108,8 @@ def test_view_in_chromium_shows_the_pipe_and_the_arm(served: str, tmp_path: Path
         page.wait_for_timeout(1000)  # the arm's new pose, drawn
         start = shot(page, tmp_path / "view-start.png", {"pipe": 50_000, "arm": 2_000})
         assert start["margin"] < 10 and start["arm"] > 2_000 and start["pipe"] > 50_000, start
+        page.locator("input.mantine-Checkbox-input").last.check()  # play
+        page.wait_for_function("(e) => parseFloat(e.value) > 0.2", arg=shown_t.element_handle())
         browser.close()
     assert not errors
     away = [u for u in asked if not u.startswith((served, "data:", "blob:"))]

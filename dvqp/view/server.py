@@ -3,8 +3,8 @@
 viser serves its own built three.js client (no network needed) and the scene over a
 websocket. :class:`View` shows a :class:`~dvqp.view.scene3d.Scene3D`: the pipe and the
 obstacles, the rail, the weld and the probe's path as lines, the arm (links at their margin
-red) at the sample the time slider picks, and a ``play`` box that runs the samples at their
-own times. It listens on the address it is given (the command line's default: loopback only).
+red) at the sample the time slider picks, and a ``play`` box that runs the samples in real
+time. It listens on the address it is given (the command line's default: loopback only).
 """
 
 from __future__ import annotations
@@ -34,6 +34,8 @@ LINK_THICKNESS = 0.02
 """m: the arm's links are drawn this thick."""
 LINE_THICKNESS = 0.004
 """m: the rail, the weld and the path are drawn this thick."""
+FRAME = 1.0 / 30.0
+"""s: the least time between two poses while playing."""
 
 
 @contextlib.contextmanager
@@ -133,17 +135,21 @@ class View:
         self.time.value = f"{view.t[n]:.3f}"
 
     def _run_player(self) -> None:
-        """While ``play`` is ticked, step the slider through the samples at their own pace
-        (from the start again after the last)."""
+        """While ``play`` is ticked, move the slider on in real time, :data:`FRAME` apart (or
+        to the next sample, if further), and after a pause at the last from the start again."""
         t, last = self.view.t, len(self.view.t) - 1
         while not self._stop.is_set():
             if not self.play.value or last == 0:
                 self._stop.wait(0.05)
                 continue
             n = int(self.sample.value)
-            nxt = 0 if n >= last else n + 1
-            self._stop.wait(0.02 if nxt == 0 else max(float(t[nxt] - t[n]), 0.005))
-            self.sample.value = nxt
+            if n >= last:
+                nxt, wait = 0, 0.5
+            else:
+                nxt = min(max(int(np.searchsorted(t, t[n] + FRAME)), n + 1), last)
+                wait = max(float(t[nxt] - t[n]), 0.005)
+            if not self._stop.wait(wait) and self.play.value:
+                self.sample.value = nxt
 
     def close(self) -> None:
         """Stop the player and the server."""
