@@ -177,4 +177,5 @@ def test_plot_limits_against_another_scene_says_so(
     assert main([*same, "scenes/paper-inlets.toml"]) == 0  # the same arm: allowed, but said
     err = capsys.readouterr().err
     assert err == (f"dvqp: note: {npz} was planned from another scene text than "
-                   "scenes/paper-inlets.toml: drawn against the latter's limits\n")  # fmt: skip
+                   "scenes/paper-inlets.toml: drawn with the latter's arm, obstacles and "
+                   "limits\n")  # fmt: skip

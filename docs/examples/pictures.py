@@ -6,7 +6,9 @@ into ``docs/img/``: each run's figure (``paper-two-inlets.png``, ``paper-two-inl
 what ``dvqp plot`` draws) and the baseline's limits page (``paper-two-inlets-limits.png``,
 what ``dvqp plot --limits`` draws), where its clearance to the lower inlet and its joint
 accelerations cross their bounds. It also plans ``scenes/reconfiguration.toml`` (the paper's
-Figs. 8 -> 9) with both and writes ``reconfiguration.png`` and ``reconfiguration-pinv.png``.
+Figs. 8 -> 9) with both and writes ``reconfiguration.png`` and ``reconfiguration-pinv.png``,
+and the still of the 3-D view of the baseline's run of the paper's scene
+(``paper-two-inlets-3d.png``, what ``dvqp plot --3d`` draws).
 """
 
 from __future__ import annotations
@@ -16,8 +18,10 @@ from pathlib import Path
 import dvqp
 from dvqp.cli.limit_series import limit_series
 from dvqp.cli.plot import plot_trajectory
+from dvqp.cli.plot3d import plot_3d
 from dvqp.cli.plot_limits import plot_limits
 from dvqp.scenes import environment
+from dvqp.view.scene3d import scene_3d
 
 IMG = Path("docs/img")
 
@@ -39,6 +43,8 @@ def main() -> None:
     traj = draw_runs(scene)
     title = f"{scene.name} / pinv (the paper's baseline): limits over time"
     print(plot_limits(limit_series(scene, traj), IMG / "paper-two-inlets-limits.png", title))
+    view = scene_3d(scene, traj.q, traj.t, f"{scene.name} / pinv (the paper's baseline)")
+    print(plot_3d(view, IMG / "paper-two-inlets-3d.png"))
 
 
 if __name__ == "__main__":

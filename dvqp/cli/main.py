@@ -1,5 +1,5 @@
 """The ``dvqp`` command line: ``plan``, ``compare``, ``plot``, ``backends``, ``bench``,
-``console``, ``cache`` and ``export-qps``.
+``console``, ``view``, ``cache`` and ``export-qps``.
 
 Exit codes: 0 success (``compare`` and ``bench``: the comparison ran, whatever its runs'
 verdicts; ``--check``: and every QP backend's run is ``ok``, the baseline's known limit
@@ -30,6 +30,7 @@ from dvqp.cli import console as console_cli
 from dvqp.cli import export as export_cmd
 from dvqp.cli import plot_command, solver_option
 from dvqp.cli import retime as retime_cli
+from dvqp.cli import view as view_cli
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
 from dvqp.cli.report import format_summary, format_table, rows_to_csv, write_text
@@ -121,6 +122,7 @@ def _parser() -> argparse.ArgumentParser:
     c.set_defaults(run=_compare)
     plot_command.register(sub)
     console_cli.register(sub)
+    view_cli.register(sub)
     bench_cmd.register(sub)
     cache_cmd.register(sub)
     export_cmd.register(sub)

@@ -1,4 +1,5 @@
-"""``dvqp plot TRAJ.npz -o FIG [--gif] [--full] [--limits [--scene SCENE]]``: draw a saved run.
+"""``dvqp plot TRAJ.npz -o FIG [--gif] [--full] [--limits | --3d [--scene SCENE]]``: draw a
+saved run.
 
 The trajectory file is checked enough to be drawn before anything is drawn; the figure modules
 (matplotlib) are imported only here, when a figure is asked for.
@@ -17,7 +18,8 @@ from dvqp._files import output_path
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.errors import DvqpError, one_line
 from dvqp.motion.trajectory import Trajectory
-from dvqp.scenes import environment, load_scene, loads
+from dvqp.scenes import Scene, environment, load_scene, loads
+from dvqp.view.scene3d import Scene3D, scene_3d
 
 
 def register(subparsers: Any) -> None:
@@ -32,14 +34,19 @@ def register(subparsers: Any) -> None:
     g.add_argument("--limits", action="store_true",
                    help="write the limits page: each limit's quantity over time against its "
                         "bound")  # fmt: skip
-    g.add_argument("--scene", help="with --limits: the scene file to read the arm and limits "
-                                   "from (default: the one stored in the trajectory)")  # fmt: skip
+    g.add_argument("--3d", dest="three_d", action="store_true",
+                   help="write a still of the 3-D view: the pipe, its obstacles as the objects "
+                        "they stand for, the arm at the first and last sample")  # fmt: skip
+    g.add_argument("--scene", help="with --limits or --3d: the scene file to read the arm "
+                   "and limits from (default: the one stored in the trajectory)")  # fmt: skip
     g.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Draw a saved trajectory (or its limits page); 0 once written."""
-    traj = _load_trajectory(args.trajectory)
+    traj = load_trajectory(args.trajectory)
+    if args.three_d:
+        return _plot_3d(args, traj)
     if args.limits or args.scene is not None:
         return _plot_limits(args, traj)
     drawn_with: dict[str, Any] = {"full": args.full}
@@ -57,19 +64,10 @@ def run(args: argparse.Namespace) -> int:
 def _plot_limits(args: argparse.Namespace, traj: Trajectory) -> int:
     """The limits page of a trajectory, from its stored scene (or ``--scene``)."""
     if not args.limits or args.gif or args.full:
-        raise DvqpError("--scene goes with --limits, which takes neither --gif nor --full")
+        raise DvqpError("--scene goes with --limits or --3d; --limits takes neither --gif nor "
+                        "--full")  # fmt: skip
     target = output_path(args.output, FIGURE_FORMATS)
-    if args.scene is not None:
-        scene = load_scene(args.scene)
-        if traj.scene_text and traj.scene_text != scene.text:  # allowed: other limits, say
-            print(f"dvqp: note: {one_line(args.trajectory)} was planned from another scene text "
-                  f"than {one_line(args.scene)}: drawn against the latter's limits",
-                  file=sys.stderr)  # fmt: skip
-    elif traj.scene_text:
-        folder = Path(args.trajectory).parent  # a relative URDF: beside the trajectory
-        scene = loads(traj.scene_text, f"{args.trajectory} (stored scene)", base_dir=folder)
-    else:
-        raise DvqpError(f"{args.trajectory}: no stored scene: give the run's --scene")
+    scene = scene_of(args.trajectory, traj, args.scene)
     from dvqp.cli.limit_series import limit_series
     from dvqp.cli.plot_limits import plot_limits
 
@@ -82,7 +80,49 @@ def _plot_limits(args: argparse.Namespace, traj: Trajectory) -> int:
     return 0
 
 
-def _load_trajectory(path: str) -> Trajectory:
+def _plot_3d(args: argparse.Namespace, traj: Trajectory) -> int:
+    """The still of the 3-D view of a trajectory, with its stored scene (or ``--scene``)."""
+    if args.limits or args.gif or args.full:
+        raise DvqpError("--3d takes neither --limits, --gif nor --full")
+    target = output_path(args.output, FIGURE_FORMATS)
+    view = trajectory_3d(args.trajectory, traj, scene_of(args.trajectory, traj, args.scene))
+    from dvqp.cli.plot3d import plot_3d
+
+    print(f"wrote {plot_3d(view, target)}")
+    return 0
+
+
+def scene_of(path: str, traj: Trajectory, scene_file: str | None) -> Scene:
+    """The scene of the trajectory read from ``path``: ``scene_file`` if given, else the one
+    stored in it (a relative URDF read beside the trajectory); a DvqpError without either."""
+    if scene_file is not None:
+        scene = load_scene(scene_file)
+        if traj.scene_text and traj.scene_text != scene.text:  # allowed: other limits, say
+            print(f"dvqp: note: {one_line(path)} was planned from another scene text than "
+                  f"{one_line(scene_file)}: drawn with the latter's arm, obstacles and limits",
+                  file=sys.stderr)  # fmt: skip
+        return scene
+    if not traj.scene_text:
+        raise DvqpError(f"{path}: no stored scene: give the run's --scene")
+    return loads(traj.scene_text, f"{path} (stored scene)", base_dir=Path(path).parent)
+
+
+def trajectory_3d(path: str, traj: Trajectory, scene: Scene, samples: int = 2000) -> Scene3D:
+    """The 3-D view of a run of ``scene`` (read from ``path``) at no more than ``samples``
+    evenly spaced samples, the last one included; a DvqpError if it is not a run of it."""
+    if traj.q.shape[1] != scene.robot.n:
+        raise DvqpError(f"{path}: not a run of {scene.source}: {traj.q.shape[1]} joints, "
+                        f"the scene's arm has {scene.robot.n}")  # fmt: skip
+    if traj.pipe_radius and abs(traj.pipe_radius - scene.pipe_radius) > 1e-12:
+        raise DvqpError(f"{path}: not a run of {scene.source}: its pipe radius is "
+                        f"{traj.pipe_radius:g} m, the scene's {scene.pipe_radius:g} m")  # fmt: skip
+    pick = np.unique(np.linspace(0, len(traj.t) - 1, min(samples, len(traj.t))).round())
+    pick = pick.astype(np.int64)
+    title = f"{scene.name} / {traj.backend or 'unknown resolver'}"
+    return scene_3d(scene, traj.q[pick], traj.t[pick], title)
+
+
+def load_trajectory(path: str) -> Trajectory:
     """A trajectory file, checked enough to be drawn; else a DvqpError
     ``<path>: cannot read: <reason>`` or ``<path>: not a dvqp trajectory (<reason>)``."""
     try:
