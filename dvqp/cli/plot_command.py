@@ -77,6 +77,7 @@ def _plot_limits(args: argparse.Namespace, traj: Trajectory) -> int:
         raise DvqpError(f"{args.trajectory}: not a run of {scene.source}: {exc}") from exc
     title = f"{scene.name} / {traj.backend or 'unknown resolver'}: limits over time"
     print(f"wrote {plot_limits(page, target, title)}")
+    _note_other_scene(args, traj, scene)
     return 0
 
 
@@ -85,23 +86,29 @@ def _plot_3d(args: argparse.Namespace, traj: Trajectory) -> int:
     if args.limits or args.gif or args.full:
         raise DvqpError("--3d takes neither --limits, --gif nor --full")
     target = output_path(args.output, FIGURE_FORMATS)
-    view = trajectory_3d(args.trajectory, traj, scene_of(args.trajectory, traj, args.scene))
+    scene = scene_of(args.trajectory, traj, args.scene)
+    view = trajectory_3d(args.trajectory, traj, scene)
     from dvqp.cli.plot3d import plot_3d
 
     print(f"wrote {plot_3d(view, target)}")
+    _note_other_scene(args, traj, scene)
     return 0
+
+
+def _note_other_scene(args: argparse.Namespace, traj: Trajectory, scene: Scene) -> None:
+    """Say on stderr that ``--scene`` is not the scene text stored in the trajectory (allowed:
+    to see a run against other limits, say)."""
+    if args.scene is not None and traj.scene_text and traj.scene_text != scene.text:
+        print(f"dvqp: note: {one_line(args.trajectory)} was planned from another scene text "
+              f"than {one_line(args.scene)}: drawn with the latter's arm, obstacles and limits",
+              file=sys.stderr)  # fmt: skip
 
 
 def scene_of(path: str, traj: Trajectory, scene_file: str | None) -> Scene:
     """The scene of the trajectory read from ``path``: ``scene_file`` if given, else the one
     stored in it (a relative URDF read beside the trajectory); a DvqpError without either."""
     if scene_file is not None:
-        scene = load_scene(scene_file)
-        if traj.scene_text and traj.scene_text != scene.text:  # allowed: other limits, say
-            print(f"dvqp: note: {one_line(path)} was planned from another scene text than "
-                  f"{one_line(scene_file)}: drawn with the latter's arm, obstacles and limits",
-                  file=sys.stderr)  # fmt: skip
-        return scene
+        return load_scene(scene_file)
     if not traj.scene_text:
         raise DvqpError(f"{path}: no stored scene: give the run's --scene")
     return loads(traj.scene_text, f"{path} (stored scene)", base_dir=Path(path).parent)
