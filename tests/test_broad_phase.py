@@ -112,3 +112,18 @@ def test_fifty_obstacles_report_the_true_clearance() -> None:
         state = KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius)
         near = dvqp.geometry.proximity(state, scene.obstacles)  # every row exact
         assert abs(traj.min_clearance[k] - near.min_clearance()) <= 1e-5
+
+
+def test_far_obstacles_rows_never_reach_the_solver() -> None:
+    scene = dvqp.load_scene("benchmarks/scenes/fifty-obstacles.toml")
+    resolver = dvqp.QPResolver(scene.spec(), "daqp")
+    stepper = dvqp.Stepper(scene.robot, scene.pipe_radius, resolver, scene.q0, scene.dt)
+    stepper.start(scene.q0)
+    found = stepper.resolve(np.array([0.0, 0.01, 0.0, 0.0]), scene.dt)
+    assert found.success
+    applies = int(np.isfinite(stepper.arrays.qp.h).sum())
+    strict = stepper.solver.backends[0]  # type: ignore[union-attr]
+    seen = strict._copy.problem.h  # type: ignore[attr-defined]
+    assert stepper.arrays.near.skipped.sum() > 30  # most obstacles are far from the arm
+    assert applies <= seen.shape[0] <= max(8, 2 * applies) < stepper.arrays.qp.h.shape[0] // 4
+    assert np.isfinite(seen).sum() == applies

@@ -178,9 +178,13 @@ def _broad(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-de
     matter: a point whose bound is below the arm's (probe's) closest part, a link whose bound
     less its bend is below that, below ``far`` or may need refining (:func:`real_links`)."""
     ends, bends, points, links = near.ends, near.bends, near.point_distance, near.link_distance
+    most = bends.max() if bends.shape[0] else 0.0
     for j in range(points.shape[0]):
         far = shapes.far[j]
-        if far == math.inf:
+        if far == math.inf or (
+            near.skipped[j]  # one bound in every row: none may matter
+            and points[j, 0] - 3.0 * most > max(far, shapes.refine[j], arm, probe)
+        ):
             continue
         for p in range(points.shape[1]):
             if far < points[j, p] < (probe if p == tool else arm):

@@ -91,6 +91,11 @@ def obstacle_distances(near, jacobians, origins, frame_jacobians, radius, reach,
     ``reach`` (m, per row), where the row applies (a point row's too)."""
     r, points, n, ends = start, near.point_distance.shape[1], gradient.shape[1], near.ends
     for j in members:
+        if near.skipped[j]:  # far from the whole arm: its bound, no row applies
+            for i in range(points):
+                distance[r + i], usable[r + i] = near.point_distance[j, i], False
+            r += points
+            continue
         for i in range(points):
             nl, nz = near.point_normal[j, i, 0], near.point_normal[j, i, 1]
             distance[r], usable[r] = near.point_distance[j, i], nl != 0.0 or nz != 0.0
