@@ -94,7 +94,8 @@ class ProximityBuffers:
         How far each link's real DV image strays from its straight DV segment, m.
     skipped : (J,) bool
         The broad phase left obstacle j out: its point and link rows all hold one lower bound
-        of their clearance, its other rows are not written (``dvqp.geometry.measure``).
+        of their clearance (no normal), its real rows that less the bend, its penalty rows are
+        not written (``dvqp.geometry.measure``).
     """
 
     ends: NDArray[np.int64]
