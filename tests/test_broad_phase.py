@@ -1,5 +1,6 @@
-"""The broad phase: a part far from a polygon's or an inlet's box gets the box's distance (a
-lower bound), and every row that may matter (below the far distance, the damper's refining,
+"""The broad phase: an obstacle far from the chain's box is skipped (its rows hold that
+distance, a lower bound), a part far from a polygon's or an inlet's box gets the box's distance
+(a lower bound), and every row that may matter (below the far distance, the damper's refining,
 the arm's or the probe's closest part) is exactly what it is without it."""
 
 from __future__ import annotations
@@ -10,7 +11,14 @@ import numpy as np
 import pytest
 
 import dvqp
-from dvqp.geometry.measure import ShapeArrays, box_bound, measure_chain, penalties
+from dvqp.geometry.measure import (
+    ShapeArrays,
+    box_bound,
+    chain_box,
+    measure_chain,
+    obstacle_bound,
+    penalties,
+)
 from dvqp.geometry.real_links import real_links
 from dvqp.kinematics.state import KinematicState
 from dvqp.workspace import ProximityBuffers, as_struct, link_ends
@@ -28,22 +36,23 @@ def measured(case: Case, state: KinematicState, far: float) -> ProximityBuffers:
     shapes = list(case.obstacles)
     packed = ShapeArrays.of(shapes, 2 * math.pi * case.radius)
     packed.refine[:] = 0.01
-    boxed = np.array([type(s).__name__ in ("Polygon", "Inlet") for s in shapes])
-    packed.far[boxed] = far
+    packed.far[:] = far
     ends = link_ends(state.k, state.rail)
     near = ProximityBuffers.sized(len(shapes), state.guarded.shape[0], ends)
     chain = np.ascontiguousarray(state.guarded)
     measure_chain(as_struct(packed), chain, as_struct(near))
-    penalties(packed.size, as_struct(near))
     real_links(as_struct(packed), chain, np.array(state.origins), case.radius, state.k,
                as_struct(near))  # fmt: skip
+    penalties(packed.size, as_struct(near))
     return near
 
 
-@pytest.mark.parametrize("spread", [0.05, 0.4])
-def test_rows_that_may_matter_are_exact_and_the_others_below_the_truth(spread: float) -> None:
-    case = mixed_case(paper_robot())
-    proxies = 0
+@pytest.mark.parametrize(("spread", "seam"), [(0.05, False), (0.4, False), (0.4, True)])
+def test_rows_that_may_matter_are_exact_and_the_others_below_the_truth(
+    spread: float, seam: bool
+) -> None:
+    case = mixed_case(paper_robot(), seam)
+    proxies = skipped = 0
     for state in states(case, 12, spread):
         exact, broad = measured(case, state, math.inf), measured(case, state, FAR)
         for side in ("point_distance", "real_distance"):
@@ -53,11 +62,30 @@ def test_rows_that_may_matter_are_exact_and_the_others_below_the_truth(spread: f
             assert (b <= e + 1e-15).all() and (b[~same] >= FAR - 1e-15).all()
             assert e.min() == b.min()  # the arm's closest part, exact
             proxies += int((b != e).sum())
+        skipped += int(broad.skipped.sum())
+        assert not broad.point_penalty[broad.skipped].any()  # no repulsion computed
         k = state.k  # the probe and its holder
         assert min(exact.point_distance[:, k].min(), exact.real_distance[:, k - 1].min()) == min(
             broad.point_distance[:, k].min(), broad.real_distance[:, k - 1].min())  # fmt: skip
     if spread > 0.1:
-        assert proxies > 0  # the broad phase did skip rows
+        assert proxies > 0 and skipped > 0  # the broad phase did skip rows and obstacles
+
+
+@pytest.mark.parametrize("seam", [False, True])
+def test_the_chain_box_bound_is_below_every_row_of_the_obstacle(seam: bool) -> None:
+    case = mixed_case(paper_robot(), seam)
+    packed = ShapeArrays.of(list(case.obstacles), 2 * math.pi * case.radius)
+    shapes, far = as_struct(packed), 0
+    for state in states(case, 30, 0.6):
+        exact = measured(case, state, math.inf)
+        chain = np.ascontiguousarray(state.guarded)
+        box = chain_box(chain, exact.ends, packed.period)
+        for j in range(len(case.obstacles)):
+            bound = obstacle_bound(shapes, j, *box)
+            rows = np.concatenate([exact.point_distance[j], exact.link_distance[j]])
+            assert bound <= max(rows.min(), 0.0) + 1e-15
+            far += bound > FAR
+    assert far > 0  # some obstacles were far from the whole chain
 
 
 def test_the_box_bound_is_below_the_exact_distance_outside() -> None:
@@ -84,3 +112,18 @@ def test_fifty_obstacles_report_the_true_clearance() -> None:
         state = KinematicState.compute(scene.robot, traj.q[k], scene.pipe_radius)
         near = dvqp.geometry.proximity(state, scene.obstacles)  # every row exact
         assert abs(traj.min_clearance[k] - near.min_clearance()) <= 1e-5
+
+
+def test_far_obstacles_rows_never_reach_the_solver() -> None:
+    scene = dvqp.load_scene("benchmarks/scenes/fifty-obstacles.toml")
+    resolver = dvqp.QPResolver(scene.spec(), "daqp")
+    stepper = dvqp.Stepper(scene.robot, scene.pipe_radius, resolver, scene.q0, scene.dt)
+    stepper.start(scene.q0)
+    found = stepper.resolve(np.array([0.0, 0.01, 0.0, 0.0]), scene.dt)
+    assert found.success
+    applies = int(np.isfinite(stepper.arrays.qp.h).sum())
+    strict = stepper.solver.backends[0]  # type: ignore[union-attr]
+    seen = strict._copy.problem.h  # type: ignore[attr-defined]
+    assert stepper.arrays.near.skipped.sum() > 30  # most obstacles are far from the arm
+    assert applies <= seen.shape[0] <= max(8, 2 * applies) < stepper.arrays.qp.h.shape[0] // 4
+    assert np.isfinite(seen).sum() == applies

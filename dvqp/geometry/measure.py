@@ -56,11 +56,13 @@ class ShapeArrays:
         the last :data:`~dvqp.geometry.real_links.PRECISION` (its obstacle damper's margin,
         0 if none: ``inf`` until set; see :func:`~dvqp.geometry.real_links.real_links`).
     box : (J, 4)
-        ``[l_lo, l_hi, z_lo, z_hi]`` (m) of each polygon and inlet, l from ``data[0]`` (a
-        circle's or a band's distance costs less than a box's: they have none).
+        ``[l_lo, l_hi, z_lo, z_hi]`` (m) of each obstacle, l from ``data[0]`` (a band's
+        ``l`` unbounded).
     far : (J,)
-        The broad phase (m): a part farther than this from a polygon's or an inlet's box gets
-        the box's distance and direction (a lower bound) instead of the exact row, unless
+        The broad phase (m): an obstacle whose box is farther than this from the box of the
+        whole chain gets that distance (a lower bound, no direction) in every row; else a part
+        farther than this from a polygon's or an inlet's box gets the box's distance and
+        direction (a circle's or a band's exact distance costs less than a box's), unless
         :func:`~dvqp.geometry.real_links.real_links` finds that the row may matter (``inf``,
         the default: every row exact).
     """
@@ -89,8 +91,10 @@ class ShapeArrays:
             kind = type(shape)
             if kind is Circle:
                 code[j], data[j] = CIRCLE, (*shape.center, shape.radius, 0.0)  # type: ignore[attr-defined]
+                box[j] = (-data[j, 2], data[j, 2], data[j, 1] - data[j, 2], data[j, 1] + data[j, 2])
             elif kind is Band:
                 code[j], data[j] = BAND, (shape.z_min, shape.z_max, 0.0, 0.0)  # type: ignore[attr-defined]
+                box[j] = (-math.inf, math.inf, data[j, 0], data[j, 1])
             elif kind is Inlet:
                 code[j], data[j] = INLET, (*shape.center, shape.radius, shape.pipe_radius)  # type: ignore[attr-defined]
                 local = shape.samples  # type: ignore[attr-defined]
@@ -198,15 +202,51 @@ def link_row(shapes, j, chain, i, near, exact) -> None:  # type: ignore[no-untyp
 
 
 @njit
+def chain_box(chain, ends, period):  # type: ignore[no-untyped-def]
+    """``(l0, l_lo, l_hi, z_lo, z_hi)``: a box (m) holding the points ``chain`` and the DV
+    segments ``ends`` between them, l from the first point's ``l0`` (unwrapped from it)."""
+    l0, lo, hi, zlo, zhi = chain[0, 0], 0.0, 0.0, chain[0, 1], chain[0, 1]
+    for i in range(chain.shape[0]):
+        u = wrap_period(chain[i, 0] - l0, period)
+        lo, hi, zlo, zhi = min(lo, u), max(hi, u), min(zlo, chain[i, 1]), max(zhi, chain[i, 1])
+    for i in range(ends.shape[0]):
+        a, b = chain[ends[i, 0], 0], chain[ends[i, 1], 0]
+        u = wrap_period(a - l0, period) + wrap_period(b - a, period)
+        lo, hi = min(lo, u), max(hi, u)
+    return l0, lo, hi, zlo, zhi
+
+
+@njit
+def obstacle_bound(shapes, j, l0, lo, hi, zlo, zhi):  # type: ignore[no-untyped-def]
+    """The distance (m) from the chain's box (:func:`chain_box`) to obstacle j's box: a lower
+    bound of every row's clearance to it (the obstacle taken at its nearest period)."""
+    own, period = shapes.box[j], shapes.period
+    gz = abs(_gap(own[2], own[3], zlo, zhi))
+    if own[0] == -math.inf:
+        return gz
+    c = wrap_period(shapes.data[j, 0] - l0, period)
+    gl = math.inf
+    for k in range(-1, 2):
+        gl = min(gl, abs(_gap(c + own[0], c + own[1], lo + k * period, hi + k * period)))
+    return math.hypot(gl, gz)
+
+
+@njit
 def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
     """Distances and normals of the points ``chain`` (m; columns l, z, ...) and of the links
     ``near.ends`` between them to every compiled obstacle, into ``near`` (a packed
     :class:`~dvqp.workspace.ProximityBuffers`); rows of :data:`OTHER` shapes are left alone.
-    A row farther than ``shapes.far`` from a polygon's or an inlet's box holds the box's
-    distance (the broad phase; :func:`~dvqp.geometry.real_links.real_links` measures those
-    that may matter)."""
+    The broad phase: an obstacle whose box is farther than ``shapes.far`` from the chain's is
+    skipped (:func:`obstacle_bound`); a row farther than it from a polygon's or an inlet's box
+    holds the box's distance (:func:`~.real_links.real_links` measures those that matter)."""
+    l0, lo, hi, zlo, zhi = chain_box(chain, near.ends, shapes.period)
     for j in range(shapes.code.shape[0]):
+        near.skipped[j] = False
         if shapes.code[j] == OTHER:
+            continue
+        bound = obstacle_bound(shapes, j, l0, lo, hi, zlo, zhi) if shapes.far[j] < math.inf else 0.0
+        if bound > shapes.far[j]:
+            _fill(near, j, bound)
             continue
         for i in range(chain.shape[0]):
             point_row(shapes, j, chain, i, near, False)
@@ -214,10 +254,25 @@ def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
             link_row(shapes, j, chain, i, near, False)
 
 
+@njit(inline="always")
+def _fill(near, j, bound) -> None:  # type: ignore[no-untyped-def]
+    """Obstacle j skipped: its point and link rows at ``bound`` (m), no direction, ``t = 0``."""
+    near.skipped[j] = True
+    for i in range(near.point_distance.shape[1]):
+        near.point_distance[j, i] = bound
+        near.point_normal[j, i, 0], near.point_normal[j, i, 1] = 0.0, 0.0
+    for i in range(near.link_distance.shape[1]):
+        near.link_distance[j, i], near.link_t[j, i] = bound, 0.0
+        near.link_normal[j, i, 0], near.link_normal[j, i, 1] = 0.0, 0.0
+
+
 @njit
 def penalties(size, near) -> None:  # type: ignore[no-untyped-def]
-    """Every row's penalty ``e = d (d + 2ρ)`` (m²) and ``∇e = 2 (d + ρ) ∇d`` (m)."""
+    """Every row's penalty ``e = d (d + 2ρ)`` (m²) and ``∇e = 2 (d + ρ) ∇d`` (m), but those of
+    an obstacle the broad phase skipped (its repulsion, acting only inside, is 0)."""
     for j in range(size.shape[0]):
+        if near.skipped[j]:
+            continue
         rho = size[j]
         for i in range(near.point_distance.shape[1]):
             d = near.point_distance[j, i]

@@ -156,9 +156,9 @@ def measure(shapes: Sequence[Shape], chain: Array, period: float, ends: NDArray[
     points = np.ascontiguousarray(chain, dtype=np.float64)
     measure_chain(as_struct(packed), points, as_struct(near))
     user_rows(shapes, packed.code, points, period, near)
-    penalties(packed.size, as_struct(near))
     if real is not None:
         real_links(as_struct(packed), points, *real, as_struct(near))
+    penalties(packed.size, as_struct(near))
     return near
 
 

@@ -102,7 +102,7 @@ def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ign
         arm, probe = _seed(shapes, chain, near, tool, arm, probe)
         arm, probe = _broad(shapes, chain, near, tool, arm, probe)
     for j in range(near.real_distance.shape[0]):
-        if shapes.code[j] == OTHER:
+        if shapes.code[j] == OTHER or near.skipped[j]:
             continue
         for i in range(ends.shape[0]):
             d, reported = near.real_distance[j, i], probe if ends[i, 1] == tool else arm
@@ -144,6 +144,12 @@ def _one_piece(near, j, i) -> None:  # type: ignore[no-untyped-def]
     near.real_at[j, i], near.real_t0[j, i], near.real_t1[j, i] = near.link_t[j, i], 0.0, 1.0
 
 
+@njit(inline="always")
+def _unskip(near, j) -> None:  # type: ignore[no-untyped-def]
+    """Obstacle j, if the broad phase skipped it, is measured: its bounds become rows."""
+    near.skipped[j] = False
+
+
 @njit
 def _seed(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-def]
     """Where no exact row bounds the arm (or the probe): the point row of least box bound
@@ -159,6 +165,7 @@ def _seed(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-def
                 if points[j, p] > shapes.far[j] and points[j, p] < best:
                     best, bj, bp = points[j, p], j, p
         if bj >= 0:
+            _unskip(near, bj)
             point_row(shapes, bj, chain, bp, near, True)
             arm = min(arm, points[bj, bp])
             probe = min(probe, points[bj, bp]) if bp == tool else probe
@@ -171,12 +178,17 @@ def _broad(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-de
     matter: a point whose bound is below the arm's (probe's) closest part, a link whose bound
     less its bend is below that, below ``far`` or may need refining (:func:`real_links`)."""
     ends, bends, points, links = near.ends, near.bends, near.point_distance, near.link_distance
+    most = bends.max() if bends.shape[0] else 0.0
     for j in range(points.shape[0]):
         far = shapes.far[j]
-        if far == math.inf:
+        if far == math.inf or (
+            near.skipped[j]  # one bound in every row: none may matter
+            and points[j, 0] - 3.0 * most > max(far, shapes.refine[j], arm, probe)
+        ):
             continue
         for p in range(points.shape[1]):
             if far < points[j, p] < (probe if p == tool else arm):
+                _unskip(near, j)
                 point_row(shapes, j, chain, p, near, True)
                 arm = min(arm, points[j, p])
                 probe = min(probe, points[j, p]) if p == tool else probe
@@ -185,6 +197,7 @@ def _broad(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-de
             reported = probe if ends[i, 1] == tool else arm
             if links[j, i] > far and (d <= far or d < shapes.refine[j] + 2.0 * bends[i]
                                       or d < reported):  # fmt: skip
+                _unskip(near, j)
                 link_row(shapes, j, chain, i, near, True)
                 _one_piece(near, j, i)
                 arm = min(arm, links[j, i] + bends[i])

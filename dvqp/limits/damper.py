@@ -165,7 +165,7 @@ def damper_rows(params, dampers, dt: float, G: Array, h: Array) -> None:  # type
                 G[r, c] = -dampers.gradient[r, c]
             h[r] = damper_value(d, params.safe[r], params.gain[r], dt, params.depth[r],
                                 params.deceleration[r])  # fmt: skip
-        else:
+        elif h[r] != np.inf:  # (a row at +inf is a zero row already)
             for c in range(G.shape[1]):
                 G[r, c] = 0.0
             h[r] = np.inf
@@ -175,6 +175,7 @@ def damper_rows(params, dampers, dt: float, G: Array, h: Array) -> None:  # type
 def damper_values(angle, distance: Array, values: Array, start: int) -> None:  # type: ignore[no-untyped-def]
     """The verified values of the damper rows at ``values[start:]``: the distances, or the
     angle ``asin(min(d, 1))`` of an ``angle`` row."""
+    values[start : start + distance.shape[0]] = distance
     for r in range(distance.shape[0]):
-        d = distance[r]
-        values[start + r] = math.asin(min(d, 1.0)) if angle[r] else d
+        if angle[r]:
+            values[start + r] = math.asin(min(distance[r], 1.0))

@@ -88,14 +88,20 @@ def obstacle_distances(near, jacobians, origins, frame_jacobians, radius, reach,
     envelope), defined where its closest point is inside it. ``jacobians`` (m, 3, n) are the
     guarded points' DV Jacobians, ``origins`` (m, 3) and ``frame_jacobians`` (m, 6, n) their
     3-D ones, ``radius`` the pipe's (m); a link row's gradient is written only below its
-    ``reach`` (m, per row), where the row applies."""
+    ``reach`` (m, per row), where the row applies (a point row's too)."""
     r, points, n, ends = start, near.point_distance.shape[1], gradient.shape[1], near.ends
     for j in members:
+        if near.skipped[j]:  # far from the whole arm: its bound, no row applies
+            for i in range(points):
+                distance[r + i], usable[r + i] = near.point_distance[j, i], False
+            r += points
+            continue
         for i in range(points):
             nl, nz = near.point_normal[j, i, 0], near.point_normal[j, i, 1]
             distance[r], usable[r] = near.point_distance[j, i], nl != 0.0 or nz != 0.0
-            for c in range(n):
-                gradient[r, c] = nl * jacobians[i, 0, c] + nz * jacobians[i, 1, c]
+            if usable[r] and distance[r] < reach[r]:
+                for c in range(n):
+                    gradient[r, c] = nl * jacobians[i, 0, c] + nz * jacobians[i, 1, c]
             r += 1
     for j in members:
         for i in range(ends.shape[0]):

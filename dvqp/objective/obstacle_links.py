@@ -36,6 +36,7 @@ class ObstacleLinks(ObjectiveTerm):
 def obstacle_links(
     penalty: Array,
     penalty_gradient: Array,
+    skipped: Array,
     link_t: Array,
     coef: Array,
     jacobians: Array,
@@ -47,10 +48,13 @@ def obstacle_links(
     (``0 < t < 1``) and inside obstacle j to ``value``, the gradient shared by the link's ends
     as ``(1 − t, t)`` (the ∂t term vanishes). ``penalty``, ``link_t`` (J, k) and
     ``penalty_gradient`` (J, k, 2) are the guarded links'; ``coef`` (J, k − 1) is
-    ``w_j k¹_i``; ``at_points`` (k, 2) is scratch."""
+    ``w_j k¹_i``; an obstacle ``skipped`` (J,) by the broad phase is outside; ``at_points``
+    (k, 2) is scratch."""
     at_points[:, :] = 0.0
     total = 0.0
     for j in range(coef.shape[0]):
+        if skipped[j]:
+            continue
         for i in range(coef.shape[1]):
             e, t, c = penalty[j, i], link_t[j, i], coef[j, i]
             if e < 0.0 and t > 0.0 and t < 1.0 and c != 0.0:

@@ -32,16 +32,20 @@ class ObstaclePoints(ObjectiveTerm):
 
 
 @njit
-def obstacle_points(penalty: Array, penalty_gradient: Array, coef: Array, jacobians: Array,
-                    at_points: Array, value: Array, gradient: Array) -> None:  # fmt: skip
+def obstacle_points(penalty: Array, penalty_gradient: Array, skipped: Array, coef: Array,
+                    jacobians: Array, at_points: Array, value: Array,
+                    gradient: Array) -> None:  # fmt: skip
     """Add ``Σ_j Σ_i ½ c_ji e_ji`` over the body points inside obstacle j (``e < 0``) to
     ``value`` and ``Σ ½ c ∇eᵀ ∂p/∂Q`` to ``gradient``. ``penalty`` (J, k+1) and
     ``penalty_gradient`` (J, k+1, 2) are the guarded points'; ``coef`` (J, k) is
-    ``w_j k¹_i`` (0 for an obstacle the term does not see); ``at_points`` (k, 2) is scratch."""
+    ``w_j k¹_i`` (0 for an obstacle the term does not see); an obstacle ``skipped`` (J,) by
+    the broad phase is outside; ``at_points`` (k, 2) is scratch."""
     k = coef.shape[1]
     at_points[:, :] = 0.0
     total = 0.0
     for j in range(coef.shape[0]):
+        if skipped[j]:
+            continue
         for i in range(k):
             e, c = penalty[j, i], coef[j, i]
             if e < 0.0 and c != 0.0:

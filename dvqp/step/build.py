@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from dvqp.errors import ParameterError
-from dvqp.geometry.measure import INLET, POLYGON, ShapeArrays
+from dvqp.geometry.measure import OTHER, ShapeArrays
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.shapes import Shape
 from dvqp.kinematics.robot import Robot
@@ -260,7 +260,7 @@ def lay_out(robot: Robot, radius: float, resolver: Resolver, q0: ArrayLike, dt: 
         shapes.refine[rows] = np.maximum(shapes.refine[rows], damper.safe)
         far[rows] = np.maximum(far[rows], damper.reach)
     if not layout.hooks.active:  # parts of your own may read any row: every row exact
-        boxed = (shapes.code == POLYGON) | (shapes.code == INLET)
+        boxed = shapes.code != OTHER
         shapes.far[boxed] = far[boxed]
     layout.hooks.finalize(layout.shapes, shapes.code, layout.params, layout.damper_values)
     fields = [f for f in RecordArrays.__dataclass_fields__ if f != "index"]

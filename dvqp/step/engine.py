@@ -11,7 +11,7 @@ the common step, split substeps and interior points of a large step
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import replace
 from typing import NamedTuple
 
@@ -32,8 +32,15 @@ from dvqp.step.arrays import RecordArrays
 from dvqp.step.build import lay_out
 from dvqp.step.verification import Verification
 from dvqp.workspace import as_struct
+from solvers.rows import RowDropping
 
 Array = NDArray[np.float64]
+
+
+def dropping(factory: Callable[[], solvers.Backend]) -> Callable[[], solvers.Backend]:
+    """``factory``'s backends, each handed only the rows of the QP that apply this step
+    (:class:`solvers.rows.RowDropping`): a far obstacle's damper rows cost the solver nothing."""
+    return lambda: RowDropping(factory())
 
 
 class Resolution(NamedTuple):
@@ -86,7 +93,7 @@ class Stepper(Verification):
         plan = self.layout.plan
         self.struct = as_struct(self.arrays)
         assert plan.qp is not None and plan.checks is not None
-        self.solver = (QPSolver(resolver.factory, plan.qp, spec.task_weight)
+        self.solver = (QPSolver(dropping(resolver.factory), plan.qp, spec.task_weight)
                        if isinstance(resolver, QPResolver) else None)  # fmt: skip
         self.hooks = self.layout.hooks
         self._prepare = stages.prepare_baseline if self.arrays.pinv.baseline else stages.prepare

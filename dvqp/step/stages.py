@@ -53,8 +53,8 @@ def evaluate(s, integrate, first, last) -> int:  # type: ignore[no-untyped-def]
         measure_chain(s.shapes, s.state.guarded, s.near)
         pair_distances(s.state.origins, s.pairs)
     if first <= ASSESS <= last:
-        penalties(s.shapes.size, s.near)  # the paper's w: of the straight DV links
         real_links(s.shapes, s.state.guarded, s.state.origins, s.radius, s.model.tool, s.near)
+        penalties(s.shapes.size, s.near)  # the paper's w: of the straight DV links
         _objective(s)
         _distances(s)
     if first <= CONCLUDE <= last:
@@ -90,10 +90,10 @@ def _objective(s) -> None:  # type: ignore[no-untyped-def]
     for t in range(o.levels.shape[0]):
         orbital_level(st.guarded, st.guarded_jacobians, o.levels[t], o.k_height[t], o.value,
                       o.gradient)  # fmt: skip
-    obstacle_points(near.point_penalty, near.point_penalty_gradient, o.point_coef,
+    obstacle_points(near.point_penalty, near.point_penalty_gradient, near.skipped, o.point_coef,
                     st.guarded_jacobians, o.scratch, o.value, o.gradient)  # fmt: skip
-    obstacle_links(near.link_penalty, near.link_penalty_gradient, near.link_t, o.link_coef,
-                   st.guarded_jacobians, o.scratch, o.value, o.gradient)  # fmt: skip
+    obstacle_links(near.link_penalty, near.link_penalty_gradient, near.skipped, near.link_t,
+                   o.link_coef, st.guarded_jacobians, o.scratch, o.value, o.gradient)  # fmt: skip
 
 
 @njit(inline="always")
@@ -145,6 +145,8 @@ def _diagnostics(s) -> None:  # type: ignore[no-untyped-def]
     out[2], out[3], out[4] = math.inf, math.inf, -1.0
     for r in range(s.recorded.shape[0]):
         j = s.recorded[r]
+        if near.skipped[j]:  # its rows are above the closest part's (real_links)
+            continue
         for i in range(parts):
             d = near.point_distance[j, i] if i < m else near.real_distance[j, i - m]
             if d < out[2]:

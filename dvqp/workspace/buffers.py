@@ -92,6 +92,10 @@ class ProximityBuffers:
         The piece ``[t0, t1]`` of the link that has it.
     bends : (L,)
         How far each link's real DV image strays from its straight DV segment, m.
+    skipped : (J,) bool
+        The broad phase left obstacle j out: its point and link rows all hold one lower bound
+        of their clearance (no normal), its real rows that less the bend, its penalty rows are
+        not written (``dvqp.geometry.measure``).
     """
 
     ends: NDArray[np.int64]
@@ -110,6 +114,7 @@ class ProximityBuffers:
     real_t0: Array
     real_t1: Array
     bends: Array
+    skipped: NDArray[np.bool_]
 
     @classmethod
     def allocate(cls, count: int, k: int, rail: bool = False) -> ProximityBuffers:
@@ -123,7 +128,8 @@ class ProximityBuffers:
         return cls(np.ascontiguousarray(ends, dtype=np.int64), np.zeros(p), np.zeros((*p, 2)),
                    np.zeros(p), np.zeros((*p, 2)), np.zeros(s), np.zeros((*s, 2)), np.zeros(s),
                    np.zeros((*s, 2)), np.zeros(s), np.zeros(s), np.zeros((*s, 2)), np.zeros(s),
-                   np.zeros(s), np.ones(s), np.zeros(ends.shape[0]))  # fmt: skip
+                   np.zeros(s), np.ones(s), np.zeros(ends.shape[0]),
+                   np.zeros(count, np.bool_))  # fmt: skip
 
 
 @dataclass(frozen=True)
