@@ -21,11 +21,11 @@ DENSE = 200_000
 
 
 class Dense:
-    """The outline as a closed polyline of 200 000 points (its chords within 0.1 µm of the
-    curve) with a k-d tree of them."""
+    """The outline as a closed polyline of ``count`` points (200 000: its chords within 0.1 µm
+    of the curve) with a k-d tree of them."""
 
-    def __init__(self, inlet: Inlet) -> None:
-        self.ring = inlet.curve(DENSE)
+    def __init__(self, inlet: Inlet, count: int = DENSE) -> None:
+        self.ring, self.count = inlet.curve(count), count
         self.tree = cKDTree(self.ring)
 
     def query(self, p: np.ndarray) -> tuple[np.ndarray]:
@@ -33,7 +33,7 @@ class Dense:
         nearest point."""
         k = self.tree.query(p)[1]
         best = np.full(p.shape[0], np.inf)
-        for other in (k - 1, (k + 1) % DENSE):
+        for other in (k - 1, (k + 1) % self.count):
             a, b = self.ring[k], self.ring[other]
             t = np.clip(((p - a) * (b - a)).sum(1) / ((b - a) ** 2).sum(1), 0.0, 1.0)
             best = np.minimum(best, np.linalg.norm(p - a - t[:, None] * (b - a), axis=1))
@@ -41,6 +41,9 @@ class Dense:
 
 
 TREES = [Dense(s) for s in INLETS]
+COARSE = [Dense(s, DENSE // 50) for s in INLETS]
+"""The outlines at 4 000 points: a k-d tree's query from deep inside a ring visits most of
+it (4 ms for the dense one), so the dense one is asked only of the points that may be nearest."""
 
 
 def signed(inlet: Inlet, tree: Dense, p: np.ndarray) -> np.ndarray:
@@ -51,6 +54,16 @@ def signed(inlet: Inlet, tree: Dense, p: np.ndarray) -> np.ndarray:
     inside = ((R * np.sin(off[:, 0] / R)) ** 2 + off[:, 1] ** 2 < inlet.radius**2) & (
         np.abs(off[:, 0]) < 0.5 * math.pi * R)  # fmt: skip
     return np.where(inside, -d, d)
+
+
+def least(k: int, p: np.ndarray) -> float:
+    """The least signed distance (m) of points (k, 2) to inlet ``k``'s dense outline: found
+    among the points within 0.1 mm of the least on the coarse one, whose chords stray from
+    the curve by far less (κ c²/8 with chords c of 0.4 mm: 20 µm at a 1 mm radius of
+    curvature; 0.44 µm measured against the dense one)."""
+    p = np.unique(p, axis=0)  # a segment of length 0 is one point
+    rough = signed(INLETS[k], COARSE[k], p)
+    return float(signed(INLETS[k], TREES[k], p[rough <= rough.min() + 1e-4]).min())
 
 
 def place(inlet: Inlet, u: float, v: float, tip: bool) -> np.ndarray:
@@ -95,9 +108,9 @@ def test_the_segment_distance_is_the_least_along_the_segment_to_a_micrometre(
         start = place(inlet, u, v, tip)
         end = start + length * np.array([du, dv])
         d, t, n = (x[0, 0] for x in segment_distances([inlet], start[None], end[None], PERIOD))
-        sampled = signed(inlet, tree, start + ts * (end - start))
+        sampled = least(k, start + ts * (end - start))
         step = length * math.hypot(du, dv) / 2000  # how far the best sample may be from it
-        assert sampled.min() - step - 1e-6 <= d <= sampled.min() + 1e-6
+        assert sampled - step - 1e-6 <= d <= sampled + 1e-6
         at = start + t * (end - start)
         assert abs(signed(inlet, tree, at[None])[0] - d) <= 1e-6  # t is where it is
         d_at, n_at = distances([inlet], at[None], PERIOD)
