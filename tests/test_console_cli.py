@@ -5,9 +5,6 @@ from __future__ import annotations
 
 import argparse
 import re
-import signal
-import socket
-import subprocess
 import sys
 import urllib.error
 import urllib.request
@@ -18,6 +15,7 @@ import pytest
 from dvqp.cli import console as console_cli
 from dvqp.cli.main import _parser, _run
 from dvqp.console import server
+from tests.servers import assert_a_taken_port_is_refused, interrupted, serving
 
 ROOT = Path(__file__).resolve().parent.parent
 PAPER = ROOT / "scenes" / "paper-two-inlets.toml"
@@ -98,13 +96,8 @@ def test_bad_input_is_one_line_and_exit_2(argv: list[str], message: str, capsys)
 
 def test_a_port_in_use_is_one_line_and_exit_2(capsys) -> None:  # type: ignore[no-untyped-def]
     pytest.importorskip("aiohttp", reason="the console extra is not installed")
-    with socket.socket() as taken:
-        taken.bind(("127.0.0.1", 0))
-        taken.listen()
-        port = taken.getsockname()[1]
-        assert _run(parse(str(PAPER), "--port", str(port))) == 2
-    err = capsys.readouterr().err
-    assert err.startswith(f"dvqp: cannot listen on 127.0.0.1:{port}: ") and err.count("\n") == 1
+    assert_a_taken_port_is_refused(lambda port: _run(parse(str(PAPER), "--port", str(port))),
+                                   capsys)  # fmt: skip
 
 
 def get(url: str) -> int:
@@ -117,9 +110,7 @@ def get(url: str) -> int:
 
 def test_the_command_prints_one_url_line_serves_it_and_ends_on_ctrl_c() -> None:
     pytest.importorskip("aiohttp", reason="the console extra is not installed")
-    proc = subprocess.Popen(command(str(PAPER), "--port", "0"), stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, cwd=ROOT)  # fmt: skip
-    try:
+    with serving(command(str(PAPER), "--port", "0"), ROOT) as proc:
         line = proc.stdout.readline().rstrip("\n")  # type: ignore[union-attr]
         found = URL.match(line)
         assert found, line
@@ -127,10 +118,5 @@ def test_the_command_prints_one_url_line_serves_it_and_ends_on_ctrl_c() -> None:
         assert get(f"http://127.0.0.1:{port}/?token={token}") == 200
         assert get(f"http://127.0.0.1:{port}/") == 401
         assert get(f"http://127.0.0.1:{port}/?token={token[:-1]}") == 401
-        proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=15)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+        out, err = interrupted(proc)
     assert proc.returncode == 130 and out == "" and err == "dvqp: interrupted\n"

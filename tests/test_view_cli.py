@@ -6,9 +6,6 @@ from __future__ import annotations
 
 import argparse
 import re
-import signal
-import socket
-import subprocess
 import sys
 import urllib.request
 from pathlib import Path
@@ -20,6 +17,7 @@ from dvqp.cli import view as view_cli
 from dvqp.cli.main import _run, main
 from dvqp.view import server
 from tests import runs
+from tests.servers import assert_a_taken_port_is_refused, interrupted, serving
 
 ROOT = Path(__file__).resolve().parent.parent
 PAPER = ROOT / "scenes" / "paper-two-inlets.toml"
@@ -70,13 +68,8 @@ def test_without_viser_it_says_how_to_install_it(monkeypatch, capsys) -> None:  
 
 def test_a_port_in_use_is_refused(capsys) -> None:  # type: ignore[no-untyped-def]
     pytest.importorskip("viser", reason="the view extra is not installed")
-    with socket.socket() as taken:
-        taken.bind(("127.0.0.1", 0))
-        taken.listen()
-        port = taken.getsockname()[1]
-        assert _run(parse(str(PAPER), "--port", str(port))) == 2
-    err = capsys.readouterr().err
-    assert err.startswith(f"dvqp: cannot listen on 127.0.0.1:{port}: ") and err.count("\n") == 1
+    assert_a_taken_port_is_refused(lambda port: _run(parse(str(PAPER), "--port", str(port))),
+                                   capsys)  # fmt: skip
 
 
 def test_the_view_serves_its_page_and_puts_the_arm_at_the_sliders_sample(saved: Path) -> None:
@@ -104,18 +97,10 @@ def test_the_view_serves_its_page_and_puts_the_arm_at_the_sliders_sample(saved: 
 
 def test_the_command_prints_one_url_line_serves_it_and_ends_on_ctrl_c(saved: Path) -> None:
     pytest.importorskip("viser", reason="the view extra is not installed")
-    proc = subprocess.Popen([sys.executable, "-m", "dvqp", "view", str(PAPER), "--port", "0"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            cwd=ROOT)  # fmt: skip
-    try:
+    with serving([sys.executable, "-m", "dvqp", "view", str(PAPER), "--port", "0"], ROOT) as proc:
         line = proc.stdout.readline().rstrip("\n")  # type: ignore[union-attr]
         assert URL.match(line), line
         with urllib.request.urlopen(line, timeout=5) as page:
             assert page.status == 200
-        proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=15)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+        out, err = interrupted(proc)
     assert proc.returncode == 130 and out == "" and err == "dvqp: interrupted\n"
