@@ -189,7 +189,8 @@ def _follow(stepper: Stepper, record: TrajectoryRecorder, schedule: Schedule, ch
             record.extend(schedule.n)
             stepper.record_into(record.arrays)
         xdot, feedforward, span = schedule.command(u, stepper.state.tool)
-        stepper.pace(feedforward)
+        if schedule.scaled:  # fixed timing: the feed-forward stays 0, nothing to write
+            stepper.pace(feedforward)
         moved = advance(stepper, xdot, dt, verify=check, max_halvings=max_halvings, record=k + 1)
         now = time.perf_counter()
         record.step(k, moved, now - started)
@@ -199,5 +200,6 @@ def _follow(stepper: Stepper, record: TrajectoryRecorder, schedule: Schedule, ch
         reached.append(min(u, schedule.n) * dt)
         if progress is not None:
             progress(min(round(u), schedule.n) if schedule.scaled else k, schedule.n)
-    stepper.pace(None)
+    if schedule.scaled:
+        stepper.pace(None)  # the stop, and whatever runs next, at fixed timing
     return k, np.asarray(reached)
