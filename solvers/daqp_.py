@@ -83,6 +83,7 @@ class DaqpBackend(StatefulBackend):
     name: str = "daqp"
     default_tolerance: ClassVar[float] = 1e-6
     default_settings: ClassVar[dict[str, Any]] = {"primal_tol": 1e-8}
+    restarts: ClassVar[bool] = True
 
     def __init__(self, *, tolerance: float | None = None, **settings: Any) -> None:
         super().__init__(tolerance=tolerance, **settings)
@@ -95,6 +96,7 @@ class DaqpBackend(StatefulBackend):
         self._cuts: tuple[slice | None, ...] = ()  # y, z, z_box in DAQP's lam
         self._bound: Problem | None = None  # the problem whose arguments of stack are kept
         self._stack: tuple[Any, ...] | None = None  # None: copy _bound with NumPy
+        self._sense = np.zeros(0, dtype=np.intc)  # the set-up's sense: equality rows flagged
 
     @classmethod
     def known_settings(cls) -> set[str]:
@@ -156,7 +158,7 @@ class DaqpBackend(StatefulBackend):
         self._upper[:], self._lower[:] = np.inf, -np.inf
         self._bound = None
         self._load(problem)  # H: DAQP's, and the reference that tells P changed
-        sense = np.zeros(rows, dtype=np.intc)
+        sense = self._sense = np.zeros(rows, dtype=np.intc)
         sense[rows - m :] = _SENSE_EQUALITY
         model = daqp.Model()
         model.settings = dict(self.settings)
@@ -201,6 +203,22 @@ class DaqpBackend(StatefulBackend):
             flag = self._model.update(H=self._H, f=self._f, A=self._M)
         else:
             flag = self._model.update(f=self._f, A=self._M)
+        if flag < 0:
+            return RawResult(None, f"update failed: {EXIT_FLAGS.get(flag, flag)}")
+        return self._run(problem, start)
+
+    def _restart(self, problem: Problem, guess: np.ndarray | None) -> RawResult | Solution:
+        """A cold solve in the kept model: every datum passed again with the set-up's
+        ``sense``, which makes DAQP re-form its whole LDP and start its working set afresh
+        from the equality rows alone, as its set-up does (without the set-up's allocations:
+        ~5 µs instead of ~20 µs). A primal guess needs a set-up (``primal_start``)."""
+        if self._model is None or guess is not None:
+            self._release()
+            return self._setup(problem, guess)
+        self._bound = None  # bound afresh: the compiled copy is tried again
+        self._load(problem)
+        start = perf_counter()
+        flag = self._model.update(H=self._H, f=self._f, A=self._M, sense=self._sense)
         if flag < 0:
             return RawResult(None, f"update failed: {EXIT_FLAGS.get(flag, flag)}")
         return self._run(problem, start)

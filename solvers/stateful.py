@@ -143,6 +143,9 @@ class StatefulBackend:
     name: str
     default_tolerance: ClassVar[float]
     default_settings: ClassVar[dict[str, Any]]
+    restarts: ClassVar[bool] = False
+    """True if :meth:`_restart` solves cold within the set-up (no new set-up): then a cold
+    retry, and the solve after a failed one, restart there instead of setting up again."""
 
     def __init__(self, *, tolerance: float | None = None, **settings: Any) -> None:
         unknown = sorted(set(settings) - self.known_settings())
@@ -153,6 +156,7 @@ class StatefulBackend:
         self.tolerance = self.default_tolerance if tolerance is None else float(tolerance)
         self.settings: dict[str, Any] = {**self.default_settings, **settings}
         self._structure: Hashable | None = None
+        self._warm = False  # the last solve was accepted: the next may start from its state
 
     @classmethod
     def known_settings(cls) -> set[str]:
@@ -165,6 +169,7 @@ class StatefulBackend:
     def reset(self) -> None:
         """Forget the solver state; the next solve sets up from scratch."""
         self._structure = None
+        self._warm = False
         self._release()
 
     def solve(self, problem: Problem, initvals: np.ndarray | None = None) -> Solution:
@@ -186,7 +191,7 @@ class StatefulBackend:
         start = perf_counter()
         guess = None if initvals is None else check_initvals(problem, initvals)
         structure = self._structure_of(problem)
-        if structure == self._structure:
+        if structure == self._structure and self._warm:
             solution = solve_guarded(self, problem, self._update, problem, guess)
             if not solution.found:
                 warm_time = solution.solver_time
@@ -195,13 +200,17 @@ class StatefulBackend:
                 solution.solver_time += warm_time
         else:
             solution = self._cold(problem, guess, structure)
-        if not solution.found:
+        self._warm = solution.found
+        if not solution.found and not self.restarts:
             self.reset()
         solution.solve_time = perf_counter() - start
         return solution
 
     def _cold(self, problem: Problem, guess: np.ndarray | None, structure: Hashable) -> Solution:
-        """Drop the solver, set it up for ``problem`` and solve."""
+        """Solve ``problem`` from a cold start: restarted within the kept set-up
+        (:attr:`restarts`), or with the solver dropped and set up anew."""
+        if self.restarts and structure == self._structure:
+            return solve_guarded(self, problem, self._restart, problem, guess)
         self._structure = None
         self._release()
         solution = solve_guarded(self, problem, self._setup, problem, guess)
@@ -229,6 +238,11 @@ class StatefulBackend:
 
     def _update(self, problem: Problem, guess: np.ndarray | None) -> RawResult | Solution:
         """Push ``problem``'s data into the existing solver and solve (warm start)."""
+        raise NotImplementedError
+
+    def _restart(self, problem: Problem, guess: np.ndarray | None) -> RawResult | Solution:
+        """Push ``problem``'s data into the existing solver and solve from a cold start (no
+        state of earlier solves kept); only called when :attr:`restarts` is True."""
         raise NotImplementedError
 
     def _release(self) -> None:

@@ -11,14 +11,8 @@ import numpy as np
 import pytest
 
 import dvqp
-from dvqp.geometry.measure import (
-    ShapeArrays,
-    box_bound,
-    chain_box,
-    measure_chain,
-    obstacle_bound,
-    penalties,
-)
+from dvqp.geometry.broad_phase import box_bound, chain_box, obstacle_bound
+from dvqp.geometry.measure import ShapeArrays, measure_chain, penalties
 from dvqp.geometry.real_links import real_links
 from dvqp.kinematics.state import KinematicState
 from dvqp.workspace import ProximityBuffers, as_struct, link_ends

@@ -131,10 +131,12 @@ def test_plan_of_an_unreachable_path_exits_1_with_one_line(
     captured = capsys.readouterr()
     lines = captured.err.splitlines()
     assert len(lines) == 1 and no_traceback(captured.err)
-    # the path ends at 0.215 s, at 1.5 rad/s: the stop takes 42 steps, the tool held first
-    # (43 when the solver saw the rows that do not apply too: its answers then differ by
-    # ~3e-14 rad/s, and Q̇ = 0 becomes feasible, at the edge, one step later)
-    assert lines[0].startswith(f"dvqp: {scene}: daqp: target not reached at t = 0.425 s: ")
+    # the path ends at 0.215 s, at 1.5 rad/s: the stop takes 42 or 43 steps, the tool held
+    # first: Q̇ = 0 becomes feasible at the edge, where answers ~3e-14 rad/s apart (rows that
+    # do not apply shown to the solver or not; clearances within their 10 µm) fall either side
+    head = f"dvqp: {scene}: daqp: target not reached at t = "
+    assert lines[0].startswith(head)
+    assert lines[0][len(head) :].startswith(("0.425 s: ", "0.430 s: "))
     assert out.exists()  # the failed run is kept, to look at
     assert "final deviation" in captured.out
 

@@ -18,7 +18,7 @@ import pytest
 
 import dvqp
 from dvqp import Bounds, Limit, ObjectiveTerm, QPResolver, Stepper, Term
-from dvqp.geometry.real_links import PRECISION
+from dvqp.geometry.bend import PRECISION
 from dvqp.motion.simulate import dv_error
 from dvqp.objective import OrbitalLevel
 from dvqp.planning import scene_commands, scene_timing

@@ -14,7 +14,7 @@ import pytest
 
 from dvqp import KinematicState, Robot
 from dvqp.geometry import link_bends, proximity
-from dvqp.geometry.real_links import link_bend
+from dvqp.geometry.bend import link_bend
 from dvqp.workspace import link_ends
 from tests.common import PIPE_RADIUS, random_configurations
 from tests.oracle_limits import bend

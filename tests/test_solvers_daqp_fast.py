@@ -273,3 +273,26 @@ def test_daqp_survives_a_trusted_array_reshaped_in_place_or_misfit() -> None:
 def test_stacked_refuses_a_misfit_with_nan_values() -> None:
     values = stacked(np.zeros(3), np.zeros(1), np.zeros(1), 1, 0, 0, 0, 0)
     assert values[0] == -1 and all(math.isnan(v) for v in values[1:])
+
+
+def test_daqp_restarts_cold_in_its_model_after_a_refused_answer() -> None:
+    """An infeasible verdict reached warm is confirmed by a cold restart, and the solve after
+    a refusal starts cold too, both in the kept model (no new set-up): the very iterations and
+    answer of a fresh set-up."""
+    pytest.importorskip("daqp")
+    ws = Drift(seed=8)
+    backend = make_backend("daqp")
+    backend.solve(ws.problem).require()
+    model = backend._model
+    ws.G[0] = 0.0
+    ws.G[0, 0], ws.h[0] = 1.0, ws.lb[0] - 0.5  # x0 below its own bound
+    refused = backend.solve(ws.problem)
+    assert not refused.found and refused.retried and backend._model is model
+    fresh = make_backend("daqp").solve(ws.fresh())
+    assert not fresh.found and refused.iterations == fresh.iterations
+    ws.move(0.01)
+    after = backend.solve(ws.problem)
+    cold = make_backend("daqp").solve(ws.fresh())
+    assert after.found and not after.retried and backend._model is model
+    assert after.iterations == cold.iterations
+    np.testing.assert_array_equal(after.require(), cold.require())

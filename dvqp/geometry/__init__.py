@@ -1,5 +1,6 @@
 """Obstacles in the developed view and the body's proximity to them."""
 
+from dvqp.geometry.bend import link_bends
 from dvqp.geometry.obstacle import Obstacle, ObstacleSet
 from dvqp.geometry.proximity import (
     Proximity,
@@ -8,7 +9,6 @@ from dvqp.geometry.proximity import (
     proximity,
     segment_distances,
 )
-from dvqp.geometry.real_links import link_bends
 
 __all__ = [
     "Obstacle", "ObstacleSet", "Proximity", "distances", "link_bends", "min_clearance",

@@ -16,10 +16,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from dvqp.geometry.broad_phase import box_bound, chain_box, obstacle_bound
 from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon, Shape
 from dvqp.geometry.shapes.band import band_point, band_segment
 from dvqp.geometry.shapes.circle import circle_point, circle_segment
-from dvqp.geometry.shapes.inlet import inlet_point, inlet_segment
+from dvqp.geometry.shapes.inlet import UNKNOWN, inlet_point, inlet_segment
 from dvqp.geometry.shapes.polygon import polygon_point, polygon_segment
 from dvqp.kinematics.developed_view import wrap_period
 from dvqp.workspace import ProximityBuffers
@@ -53,7 +54,7 @@ class ShapeArrays:
         ``ρ`` of each obstacle's penalty, m.
     refine : (J,)
         Below what clearance (m) a link's to each obstacle is measured on its real DV image to
-        the last :data:`~dvqp.geometry.real_links.PRECISION` (its obstacle damper's margin,
+        the last :data:`~dvqp.geometry.bend.PRECISION` (its obstacle damper's margin,
         0 if none: ``inf`` until set; see :func:`~dvqp.geometry.real_links.real_links`).
     box : (J, 4)
         ``[l_lo, l_hi, z_lo, z_hi]`` (m) of each obstacle, l from ``data[0]`` (a band's
@@ -117,7 +118,7 @@ class ShapeArrays:
 
 
 @njit
-def _point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
+def shape_point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
     """``(d, ∂d/∂l, ∂d/∂z)`` of a point to obstacle j."""
     code, data, period = shapes.code[j], shapes.data[j], shapes.period
     if code == CIRCLE:
@@ -133,8 +134,10 @@ def _point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
 
 
 @njit
-def shape_segment(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
-    """``(d, t, ∂d/∂l, ∂d/∂z)`` of a segment to obstacle j."""
+def shape_segment(shapes, j, al, az, bl, bz, a_end, b_end):  # type: ignore[no-untyped-def]
+    """``(d, t, ∂d/∂l, ∂d/∂z)`` of a segment to obstacle j; ``a_end``, ``b_end`` the ends'
+    :func:`_point` where known (else :data:`~.shapes.inlet.UNKNOWN`; an inlet's segment
+    then needs no second measurement of them)."""
     code, data, period = shapes.code[j], shapes.data[j], shapes.period
     if code == CIRCLE:
         return circle_segment(data[0], data[1], data[2], al, az, bl, bz, period)
@@ -145,90 +148,52 @@ def shape_segment(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
     la = wrap_period(al - data[0], period)
     lb = la + wrap_period(bl - al, period)
     if code == INLET:
+        if lb != wrap_period(bl - data[0], period):  # b measured at another period's copy
+            b_end = UNKNOWN
         return inlet_segment(la, az - data[1], lb, bz - data[1], data[2], data[3],
-                             shapes.vl[a:b], shapes.vz[a:b])  # fmt: skip
+                             shapes.vl[a:b], shapes.vz[a:b], a_end, b_end)  # fmt: skip
     return polygon_segment(la, az, lb, bz, shapes.vl[a:b], shapes.vz[a:b])
 
 
-@njit(inline="always")
-def _gap(lo, hi, a, b):  # type: ignore[no-untyped-def]
-    """How far the interval ``[min(a, b), max(a, b)]`` is from ``[lo, hi]`` (m), signed by
-    its side (0: they overlap)."""
-    if min(a, b) > hi:
-        return min(a, b) - hi
-    if max(a, b) < lo:
-        return max(a, b) - lo
-    return 0.0
-
-
 @njit
-def box_bound(shapes, j, al, az, bl, bz):  # type: ignore[no-untyped-def]
-    """``(b, n_l, n_z)``: the distance (m) from the box of the segment ``a → b`` (a point if
-    ``a = b``) to obstacle j's box, a lower bound of its clearance, and its direction."""
-    box = shapes.box[j]
-    la = wrap_period(al - shapes.data[j, 0], shapes.period)
-    gl = _gap(box[0], box[1], la, la + wrap_period(bl - al, shapes.period))
-    gz = _gap(box[2], box[3], az, bz)
-    b = math.hypot(gl, gz)
-    return (b, gl / b, gz / b) if b > 0.0 else (0.0, 0.0, 0.0)
-
-
-@njit
-def point_row(shapes, j, chain, i, near, exact) -> None:  # type: ignore[no-untyped-def]
+def point_row(shapes, j, chain, i, near, exact):  # type: ignore[no-untyped-def]
     """Point i's row to obstacle j: exact, or (unless ``exact``) its box bound if that is
-    beyond ``shapes.far[j]``."""
+    beyond ``shapes.far[j]``. Returns whether it is exact."""
     pl, pz = chain[i, 0], chain[i, 1]
     d, nl, nz = -1.0, 0.0, 0.0
     if not exact and (shapes.code[j] == POLYGON or shapes.code[j] == INLET):
         d, nl, nz = box_bound(shapes, j, pl, pz, pl, pz)
-    if d <= shapes.far[j]:
-        d, nl, nz = _point(shapes, j, pl, pz)
+    measured = d <= shapes.far[j]
+    if measured:
+        d, nl, nz = shape_point(shapes, j, pl, pz)
     near.point_distance[j, i] = d
     near.point_normal[j, i, 0], near.point_normal[j, i, 1] = nl, nz
+    return measured
+
+
+@njit(inline="always")
+def _end(near, j, i, known):  # type: ignore[no-untyped-def]
+    """Point i's row to obstacle j as a segment's end: ``(d, n_l, n_z)`` if ``known`` (exact),
+    else unknown."""
+    if not known:
+        return UNKNOWN
+    return near.point_distance[j, i], near.point_normal[j, i, 0], near.point_normal[j, i, 1]
 
 
 @njit
-def link_row(shapes, j, chain, i, near, exact) -> None:  # type: ignore[no-untyped-def]
-    """Link i's row to obstacle j, as :func:`point_row` (a box bound has ``t = 0``)."""
+def link_row(shapes, j, chain, i, near, exact, a_known, b_known) -> None:  # type: ignore[no-untyped-def]
+    """Link i's row to obstacle j, as :func:`point_row` (a box bound has ``t = 0``);
+    ``a_known``, ``b_known``: its ends' point rows are exact (then not measured again)."""
     a, b = near.ends[i, 0], near.ends[i, 1]
     al, az, bl, bz = chain[a, 0], chain[a, 1], chain[b, 0], chain[b, 1]
     d, t, nl, nz = -1.0, 0.0, 0.0, 0.0
     if not exact and (shapes.code[j] == POLYGON or shapes.code[j] == INLET):
         d, nl, nz = box_bound(shapes, j, al, az, bl, bz)
     if d <= shapes.far[j]:
-        d, t, nl, nz = shape_segment(shapes, j, al, az, bl, bz)
+        d, t, nl, nz = shape_segment(shapes, j, al, az, bl, bz, _end(near, j, a, a_known),
+                                     _end(near, j, b, b_known))  # fmt: skip
     near.link_distance[j, i], near.link_t[j, i] = d, t
     near.link_normal[j, i, 0], near.link_normal[j, i, 1] = nl, nz
-
-
-@njit
-def chain_box(chain, ends, period):  # type: ignore[no-untyped-def]
-    """``(l0, l_lo, l_hi, z_lo, z_hi)``: a box (m) holding the points ``chain`` and the DV
-    segments ``ends`` between them, l from the first point's ``l0`` (unwrapped from it)."""
-    l0, lo, hi, zlo, zhi = chain[0, 0], 0.0, 0.0, chain[0, 1], chain[0, 1]
-    for i in range(chain.shape[0]):
-        u = wrap_period(chain[i, 0] - l0, period)
-        lo, hi, zlo, zhi = min(lo, u), max(hi, u), min(zlo, chain[i, 1]), max(zhi, chain[i, 1])
-    for i in range(ends.shape[0]):
-        a, b = chain[ends[i, 0], 0], chain[ends[i, 1], 0]
-        u = wrap_period(a - l0, period) + wrap_period(b - a, period)
-        lo, hi = min(lo, u), max(hi, u)
-    return l0, lo, hi, zlo, zhi
-
-
-@njit
-def obstacle_bound(shapes, j, l0, lo, hi, zlo, zhi):  # type: ignore[no-untyped-def]
-    """The distance (m) from the chain's box (:func:`chain_box`) to obstacle j's box: a lower
-    bound of every row's clearance to it (the obstacle taken at its nearest period)."""
-    own, period = shapes.box[j], shapes.period
-    gz = abs(_gap(own[2], own[3], zlo, zhi))
-    if own[0] == -math.inf:
-        return gz
-    c = wrap_period(shapes.data[j, 0] - l0, period)
-    gl = math.inf
-    for k in range(-1, 2):
-        gl = min(gl, abs(_gap(c + own[0], c + own[1], lo + k * period, hi + k * period)))
-    return math.hypot(gl, gz)
 
 
 @njit
@@ -240,6 +205,7 @@ def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
     skipped (:func:`obstacle_bound`); a row farther than it from a polygon's or an inlet's box
     holds the box's distance (:func:`~.real_links.real_links` measures those that matter)."""
     l0, lo, hi, zlo, zhi = chain_box(chain, near.ends, shapes.period)
+    exact = np.empty(chain.shape[0], np.bool_)  # each point's row of this obstacle is exact
     for j in range(shapes.code.shape[0]):
         near.skipped[j] = False
         if shapes.code[j] == OTHER:
@@ -249,9 +215,10 @@ def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
             _fill(near, j, bound)
             continue
         for i in range(chain.shape[0]):
-            point_row(shapes, j, chain, i, near, False)
+            exact[i] = point_row(shapes, j, chain, i, near, False)
         for i in range(near.ends.shape[0]):
-            link_row(shapes, j, chain, i, near, False)
+            link_row(shapes, j, chain, i, near, False, exact[near.ends[i, 0]],
+                     exact[near.ends[i, 1]])  # fmt: skip
 
 
 @njit(inline="always")

@@ -26,9 +26,13 @@ SAMPLES = 32
 """Outline points, at ``φ = 2πk/SAMPLES``, that bracket the nearest point's parameter."""
 NEWTON_STEPS = 40
 GOLDEN_STEPS = 60
+BRACKET_STEPS = 120
+"""Most false-position steps of the deepest point of a segment that enters."""
 INV_PHI = (math.sqrt(5.0) - 1.0) / 2.0
 _ON = 1e-14
 """m: a point this close to the outline is on it (its normal: the outline's)."""
+UNKNOWN = (math.nan, 0.0, 0.0)
+"""An end of a segment whose distance the caller does not have."""
 _POINT2 = 1e-18
 """m²: a shorter segment is a point (its nearer end)."""
 
@@ -167,7 +171,9 @@ def inlet_point(pl, pz, r, big, sl, sz):  # type: ignore[no-untyped-def]
         j = k + 1 if k + 1 < n else 0
         after = (sl[j] - pl) ** 2 + (sz[j] - pz) ** 2
         if here <= before and here <= after:
-            x = _nearest(pl, pz, r, big, k * h, (k - 1) * h, (k + 1) * h)
+            curve = before - 2.0 * here + after  # Newton from the samples' parabola's vertex
+            guess = k * h + (0.5 * h * (before - after) / curve if curve > 0.0 else 0.0)
+            x = _nearest(pl, pz, r, big, guess, (k - 1) * h, (k + 1) * h)
             if x != x:  # nan: no clean Newton's step
                 x = _golden(pl, pz, r, big, (k - 1) * h, (k + 1) * h)
             dl, dz = _curve(x, r, big)[:2]
@@ -199,26 +205,52 @@ def _support(nl, nz, r, big):  # type: ignore[no-untyped-def]
 
 
 @njit
-def _deepest(al, az, el, ez, r, big, sl, sz):  # type: ignore[no-untyped-def]
-    """A segment that enters: the least signed distance along it (convex, the region being
-    convex: golden section), ``(d, t, ∂d/∂l, ∂d/∂z)``."""
+def _deepest(al, az, el, ez, r, big, sl, sz, a_end, b_end):  # type: ignore[no-untyped-def]
+    """A segment that enters: the least signed distance along it, ``(d, t, ∂d/∂l, ∂d/∂z)``;
+    ``a_end``, ``b_end`` its ends' :func:`inlet_point`. The signed distance of a convex region
+    is convex, so its slope along the segment, ``g(t) = ∇d · e``, does not decrease: the least
+    is at an end whose slope points inside, else where ``g`` changes sign, bracketed by false
+    position (Illinois; a step that does not halve the bracket is followed by a halving) to
+    ``1e-14`` of the length. The point returned is the last one, where the bracket closed:
+    it moves with the data as smoothly as the root does."""
     lo, hi = 0.0, 1.0
-    for _ in range(GOLDEN_STEPS):
-        x1, x2 = hi - INV_PHI * (hi - lo), lo + INV_PHI * (hi - lo)
-        f1 = inlet_point(al + x1 * el, az + x1 * ez, r, big, sl, sz)[0]
-        f2 = inlet_point(al + x2 * el, az + x2 * ez, r, big, sl, sz)[0]
-        if f1 < f2:
-            hi = x2
+    glo = a_end[1] * el + a_end[2] * ez
+    ghi = b_end[1] * el + b_end[2] * ez
+    if glo >= 0.0 or ghi <= 0.0:
+        return (a_end[0], 0.0, a_end[1], a_end[2]) if glo >= 0.0 else (
+            b_end[0], 1.0, b_end[1], b_end[2])  # fmt: skip
+    last, side, halve = (math.nan, 0.0, 0.0, 0.0), 0, False
+    for _ in range(BRACKET_STEPS):
+        width = hi - lo
+        t = 0.5 * (lo + hi) if halve else lo + width * glo / (glo - ghi)
+        if not lo < t < hi:
+            t = 0.5 * (lo + hi)
+            if not lo < t < hi:  # the bracket is two neighbouring numbers
+                break
+        d, nl, nz = inlet_point(al + t * el, az + t * ez, r, big, sl, sz)
+        last = (d, t, nl, nz)
+        g = nl * el + nz * ez
+        if g > 0.0:
+            hi, ghi = t, g
+            glo = 0.5 * glo if side == 1 else glo  # Illinois: the stale end's slope halved
+            side = 1
+        elif g < 0.0:
+            lo, glo = t, g
+            ghi = 0.5 * ghi if side == -1 else ghi
+            side = -1
         else:
-            lo = x1
-    t = 0.5 * (lo + hi)
-    d, nl, nz = inlet_point(al + t * el, az + t * ez, r, big, sl, sz)
-    return d, t, nl, nz
+            break
+        if hi - lo < 1e-14:
+            break
+        halve = hi - lo > 0.5 * width  # a slow step: the next one halves the bracket
+    return last
 
 
 @njit
-def inlet_segment(al, az, bl, bz, r, big, sl, sz):  # type: ignore[no-untyped-def]
-    """``(d, t, ∂d/∂l, ∂d/∂z)`` of the segment ``a → b`` (local, as :func:`inlet_point`).
+def inlet_segment(al, az, bl, bz, r, big, sl, sz, a_end=UNKNOWN, b_end=UNKNOWN):  # type: ignore[no-untyped-def]
+    """``(d, t, ∂d/∂l, ∂d/∂z)`` of the segment ``a → b`` (local, as :func:`inlet_point`);
+    ``a_end``, ``b_end`` its ends' :func:`inlet_point` where the caller has them (else
+    :data:`UNKNOWN`: they are measured).
 
     The tangent is parallel to ``e = b − a`` where ``cos² φ = X`` solves
     ``k² n_z² X² − X + n_l² = 0`` (``n ⊥ e`` a unit vector, ``k = r/R``): one root in
@@ -226,22 +258,23 @@ def inlet_segment(al, az, bl, bz, r, big, sl, sz):  # type: ignore[no-untyped-de
     at an end or, at an interior point, to one of those two points. It enters the region if an
     end is inside, or if its line passes between the two points while ``a``'s normal faces
     along ``e`` and ``b``'s against it (the region then lies on the line between them); then
-    the deepest point is found by golden section (to 1e-12 of the length)."""
-    da, nal, naz = inlet_point(al, az, r, big, sl, sz)
-    db, nbl, nbz = inlet_point(bl, bz, r, big, sl, sz)
+    the deepest point is found where the distance's slope along it changes sign (to 1e-14 of
+    the length)."""
+    da, nal, naz = a_end if a_end[0] == a_end[0] else inlet_point(al, az, r, big, sl, sz)
+    db, nbl, nbz = b_end if b_end[0] == b_end[0] else inlet_point(bl, bz, r, big, sl, sz)
     el, ez = bl - al, bz - az
     res = (da, 0.0, nal, naz) if da <= db else (db, 1.0, nbl, nbz)
     if el * el + ez * ez < _POINT2:
         return res
     length = math.hypot(el, ez)
     if da <= 0.0 or db <= 0.0:
-        return _deepest(al, az, el, ez, r, big, sl, sz)
+        return _deepest(al, az, el, ez, r, big, sl, sz, (da, nal, naz), (db, nbl, nbz))
     nl, nz = -ez / length, el / length
     cl, cz = _support(nl, nz, r, big)
     ga = el * (cz - az) - ez * (cl - al)  # sides of the line of the two support points
     gb = el * (-cz - az) - ez * (-cl - al)
     if ga * gb < 0.0 and nal * el + naz * ez < 0.0 and nbl * el + nbz * ez > 0.0:
-        return _deepest(al, az, el, ez, r, big, sl, sz)
+        return _deepest(al, az, el, ez, r, big, sl, sz, (da, nal, naz), (db, nbl, nbz))
     for side in (1.0, -1.0):
         ql, qz = side * cl, side * cz
         t = ((ql - al) * el + (qz - az) * ez) / (length * length)
