@@ -2,14 +2,20 @@
 
 Usage::
 
-    python benchmarks/scene_benchmark.py [SCENE ...] [--backends pinv,daqp] [--repeat 3]
+    python benchmarks/scene_benchmark.py [SCENE ...] [--backends pinv,daqp] [--repeat 5]
 
 Without scene files it runs every ``scenes/*.toml`` and ``benchmarks/scenes/*.toml``. Each run
-is a whole ``dvqp.plan`` of one scene with one backend in a fresh process (compiled code loaded
-from the cache, outside the timed steps); the first step, which pays set-ups, is left out. The
-repeats go round every scene and backend in turn, so that drift of the machine's speed falls on
-all alike. The ratio is to ``paper-two-inlets`` (the paper's scene: two circles) with the same
-backend, measured in the same run: compare ratios, not absolute numbers across runs.
+is a whole ``dvqp.plan`` of one scene with one backend; the first step, which pays set-ups, is
+left out. The ratio is to ``paper-two-inlets`` (the paper's scene: two circles) with the same
+backend, and it is taken in pairs: every run of a scene is bracketed by runs of the paper scene
+just before and after it, and its ratio is to their mean. This machine's speed drifts by up to
+half within seconds (the same code, the same process: paper-two-inlets' DAQP step at 29 µs,
+then 42 µs a run later), so a ratio of medians taken minutes apart is noise; a bracketed
+ratio sees the machine at the speed of its own neighbours. Each repeat runs every scene, in an
+order rotated from the last one's, in one fresh process per backend (compiled code loaded from
+the cache before the first timed run; a backend's side effects on a process reach no other
+backend's). Printed per scene and backend: the median step (µs) over every run, and the median
+over the repeats of the bracketed ratio, with its spread (least–largest) over the repeats.
 """
 
 from __future__ import annotations
@@ -25,42 +31,64 @@ ROOT = Path(__file__).resolve().parent.parent
 PAPER = "paper-two-inlets"
 
 
-def step_times(scene_file: str, backend: str) -> np.ndarray:
-    """Wall time (s) of every step but the first of one run of ``scene_file`` with ``backend``."""
+def median_step(scene: object, backend: str) -> float:
+    """The median wall time (s) of every step but the first of one run of ``scene``."""
     import dvqp
 
-    traj = dvqp.plan(dvqp.load_scene(scene_file), backend)
-    return np.asarray(traj.step_time[1:])
+    traj = dvqp.plan(scene, backend)  # type: ignore[arg-type]
+    return float(np.median(traj.step_time[1:]))
+
+
+def bracketed(files: list[str], paper: str, backend: str) -> list[tuple[float, float]]:
+    """Per scene file, ``(median step (s), its ratio to the mean of the paper scene's runs just
+    before and after it)``, all in this process."""
+    import dvqp
+
+    scenes = [dvqp.load_scene(f) for f in files]
+    reference = dvqp.load_scene(paper)
+    median_step(reference, backend)  # loads the compiled code
+    before, out = median_step(reference, backend), []
+    for scene in scenes:
+        step = median_step(scene, backend)
+        after = median_step(reference, backend)
+        out.append((step, step / (0.5 * (before + after))))
+        before = after
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("scenes", nargs="*")
     parser.add_argument("--backends", default="pinv,daqp")
-    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args(argv)
-    files = args.scenes or sorted(
+    files = args.scenes or [str(f) for f in sorted(
         [*(ROOT / "scenes").glob("*.toml"), *(ROOT / "benchmarks" / "scenes").glob("*.toml")]
-    )
+    )]  # fmt: skip
     names = [Path(f).stem for f in files]
+    paper = str(ROOT / "scenes" / f"{PAPER}.toml")
     backends = args.backends.split(",")
-    got: dict[tuple[str, str], list[np.ndarray]] = {}
+    steps: dict[tuple[str, str], list[float]] = {}
+    ratios: dict[tuple[str, str], list[float]] = {}
     for r in range(args.repeat):
-        for f, name in zip(files, names, strict=True):
-            for b in backends:
-                got.setdefault((name, b), []).append(isolated(step_times, str(f), b))
+        shift = r % len(files)
+        order = files[shift:] + files[:shift]
+        for b in backends:
+            for f, (step, ratio) in zip(order, isolated(bracketed, order, paper, b), strict=True):
+                steps.setdefault((Path(f).stem, b), []).append(step)
+                ratios.setdefault((Path(f).stem, b), []).append(ratio)
         print(f"repeat {r + 1}/{args.repeat} done", file=sys.stderr)
-    med = {key: float(np.median(np.concatenate(v))) * 1e6 for key, v in got.items()}
-    header = f"{'scene':<22}" + "".join(f" {b + ' us':>10} {'/paper':>7}" for b in backends)
+    header = f"{'scene':<20}" + "".join(f" {b + ' us':>9} {'/paper':>6} {'spread':>11}"
+                                         for b in backends)  # fmt: skip
     print(header)
     print("-" * len(header))
     for name in names:
         cells = ""
         for b in backends:
-            paper = med.get((PAPER, b))
-            ratio = f"{med[name, b] / paper:7.2f}" if paper else "      -"
-            cells += f" {med[name, b]:10.1f} {ratio}"
-        print(f"{name:<22}{cells}")
+            ratio = ratios[name, b]
+            cells += (f" {np.median(steps[name, b]) * 1e6:9.1f} {np.median(ratio):6.2f} "
+                      f"{min(ratio):5.2f}-{max(ratio):<5.2f}")  # fmt: skip
+        print(f"{name:<20}{cells}")
     return 0
 
 

@@ -209,20 +209,26 @@ def _deepest(al, az, el, ez, r, big, sl, sz, a_end, b_end):  # type: ignore[no-u
     """A segment that enters: the least signed distance along it, ``(d, t, ∂d/∂l, ∂d/∂z)``;
     ``a_end``, ``b_end`` its ends' :func:`inlet_point`. The signed distance of a convex region
     is convex, so its slope along the segment, ``g(t) = ∇d · e``, does not decrease: the least
-    is at an end whose slope points inside, else where ``g`` changes sign, bracketed by false
-    position (Illinois; a step that does not halve the bracket is followed by a halving) to
-    ``1e-14`` of the length. The point returned is the last one, where the bracket closed:
-    it moves with the data as smoothly as the root does."""
+    is at an end whose slope points inside, else where ``g`` changes sign: by false position
+    on ``g`` (Illinois) where it is smooth, and where it jumps (the deepest point on the
+    region's medial axis, two sides equally near: ``g`` keeps its value on approach), where the tangents
+    of ``d`` at both ends of the bracket meet (they close on the kink quadratically), to
+    ``1e-14`` of the length. The point returned is the last one: it moves with the data as
+    smoothly as the root does."""
     lo, hi = 0.0, 1.0
     glo = a_end[1] * el + a_end[2] * ez
     ghi = b_end[1] * el + b_end[2] * ez
     if glo >= 0.0 or ghi <= 0.0:
         return (a_end[0], 0.0, a_end[1], a_end[2]) if glo >= 0.0 else (
             b_end[0], 1.0, b_end[1], b_end[2])  # fmt: skip
-    last, side, halve = (math.nan, 0.0, 0.0, 0.0), 0, False
+    dlo, dhi, wlo, whi = a_end[0], b_end[0], glo, ghi  # w: the slopes Illinois weighs
+    flat = 1e-14 * math.hypot(el, ez)  # a slope this small is the root (to ~1e-14 of it)
+    last, side, kink, before = (math.nan, 0.0, 0.0, 0.0), 0, False, -1.0
     for _ in range(BRACKET_STEPS):
-        width = hi - lo
-        t = 0.5 * (lo + hi) if halve else lo + width * glo / (glo - ghi)
+        if kink:  # where the tangents at both ends meet
+            t = (dhi - dlo + glo * lo - ghi * hi) / (glo - ghi)
+        else:  # where the slope, weighed, is 0 (false position)
+            t = lo + (hi - lo) * wlo / (wlo - whi)
         if not lo < t < hi:
             t = 0.5 * (lo + hi)
             if not lo < t < hi:  # the bracket is two neighbouring numbers
@@ -230,19 +236,21 @@ def _deepest(al, az, el, ez, r, big, sl, sz, a_end, b_end):  # type: ignore[no-u
         d, nl, nz = inlet_point(al + t * el, az + t * ez, r, big, sl, sz)
         last = (d, t, nl, nz)
         g = nl * el + nz * ez
+        same = ghi if g > 0.0 else glo  # the slope at the bracket's end on this side
+        kink = abs(g - same) < 0.2 * abs(same)  # it did not change coming closer: a jump
         if g > 0.0:
-            hi, ghi = t, g
-            glo = 0.5 * glo if side == 1 else glo  # Illinois: the stale end's slope halved
+            hi, dhi, ghi, whi = t, d, g, g
+            wlo = 0.5 * wlo if side == 1 else glo  # Illinois: the stale end's slope halved
             side = 1
         elif g < 0.0:
-            lo, glo = t, g
-            ghi = 0.5 * ghi if side == -1 else ghi
+            lo, dlo, glo, wlo = t, d, g, g
+            whi = 0.5 * whi if side == -1 else ghi
             side = -1
         else:
             break
-        if hi - lo < 1e-14:
+        if hi - lo < 1e-14 or abs(t - before) < 1e-15 or abs(g) < flat:
             break
-        halve = hi - lo > 0.5 * width  # a slow step: the next one halves the bracket
+        before = t
     return last
 
 
