@@ -211,10 +211,10 @@ def _deepest(al, az, el, ez, r, big, sl, sz, a_end, b_end):  # type: ignore[no-u
     is convex, so its slope along the segment, ``g(t) = ∇d · e``, does not decrease: the least
     is at an end whose slope points inside, else where ``g`` changes sign: by false position
     on ``g`` (Illinois) where it is smooth, and where it jumps (the deepest point on the
-    region's medial axis, two sides equally near: ``g`` keeps its value on approach), where the tangents
-    of ``d`` at both ends of the bracket meet (they close on the kink quadratically), to
-    ``1e-14`` of the length. The point returned is the last one: it moves with the data as
-    smoothly as the root does."""
+    region's medial axis, two sides equally near: ``g`` keeps its value on approach) where
+    the tangents of ``d`` at both ends of the bracket meet (they close on the kink
+    quadratically); to ``1e-14`` of the length, or a slope that small. The point returned is
+    the last one: it moves with the data as smoothly as the root does."""
     lo, hi = 0.0, 1.0
     glo = a_end[1] * el + a_end[2] * ez
     ghi = b_end[1] * el + b_end[2] * ez
