@@ -11,6 +11,7 @@ import pytest
 
 from dvqp.bench import Job, execution, generate_scenes, outcome_differences, run_suite
 from dvqp.bench.execution import generate_local
+from dvqp.bench.suite import longest_first
 
 BACKENDS = ("pinv", "daqp")
 
@@ -57,7 +58,8 @@ def test_a_pool_runs_the_first_scene_here_then_every_other_once_in_workers_forke
         for line in (tmp_path / "runs.txt").read_text().split("\n")
         if line
     ]
-    assert runs[0] == (os.getpid(), 0)
+    shortest = min(scenes, key=lambda s: (s.steps, s.index)).index
+    assert runs[0] == (os.getpid(), shortest)  # the shortest scene warms this process up
     assert sorted(index for _, index in runs) == list(range(7))  # once each: no warm-up run
     workers = {pid for pid, _ in runs[1:]}
     assert os.getpid() not in workers and 1 <= len(workers) <= 2
@@ -78,3 +80,13 @@ def test_workers_that_cannot_fork_warm_themselves_up_and_give_the_same_outcomes(
     assert [r["index"] for r in pooled.rows] == [0, 1, 2, 3]
     # a spawned worker imports dvqp and runs the first scene before its first task
     assert 1 <= len(pooled.where.startup) <= 2 and min(pooled.where.startup) > 0.1
+
+
+def test_the_shortest_scene_goes_first_then_the_longest_first() -> None:
+    scenes = generate_scenes(11, 12)
+    order = longest_first(scenes)
+    assert sorted(s.index for s in order) == list(range(12))
+    assert order[0].steps == min(s.steps for s in scenes)
+    rest = [s.steps for s in order[1:]]
+    assert rest == sorted(rest, reverse=True) and len(set(s.steps for s in scenes)) > 2
+    assert longest_first(scenes[:1]) == scenes[:1] and longest_first([]) == []

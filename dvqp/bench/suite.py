@@ -62,7 +62,7 @@ def run_suite(
         Dask is missing, or the scheduler cannot be reached.
     """
     jobs = [Job(s.index, s.name, s.text, tuple(backends), dict(options or {}), tier)
-            for s in scenes]  # fmt: skip
+            for s in longest_first(scenes)]  # fmt: skip
     rows: list[Row] = []
 
     def finished(scene_rows: list[Row]) -> None:
@@ -97,6 +97,18 @@ def run_suite(
         exc.suite = make_suite(rows, backends, seed, len(scenes), where, shift, interrupted=True)
         raise
     return make_suite(rows, backends, seed, len(scenes), where, shift)
+
+
+def longest_first(scenes: Sequence[BenchScene]) -> list[BenchScene]:
+    """The order the scenes are handed out in: the shortest first (run alone, here, when the
+    workers are forked warm from this process: the least time with one process busy), then
+    the longest first (the last to finish are short: the workers end together). The suite's
+    rows are sorted by scene index whatever the order."""
+    if len(scenes) < 2:
+        return list(scenes)
+    shortest = min(scenes, key=lambda s: (s.steps, s.index))
+    rest = sorted((s for s in scenes if s is not shortest), key=lambda s: (-s.steps, s.index))
+    return [shortest, *rest]
 
 
 def _shifted(progress: Progress | None, before: int, jobs: Sequence[Job]) -> Progress | None:
