@@ -145,15 +145,19 @@ def _warmed(job: Job, asked: float) -> float:
 
 
 def _quiet_logs(stack: contextlib.ExitStack) -> None:
-    """Distributed's loggers (each has its own level) to CRITICAL and asyncio's off for the
-    stack's life: no info lines on the cluster's start and stop, no warning when a result must
-    be recomputed, no "Task exception was never retrieved" for a fetch given up; what matters
+    """Distributed's loggers (each has its own level) to CRITICAL and asyncio's and tornado's
+    off for the stack's life: no info lines on the cluster's start and stop, no warning when a
+    result must be recomputed, no "Task exception was never retrieved" for a fetch given up, no
+    traceback of distributed's own ``sync`` when a Ctrl-C lands before its future exists
+    (tornado logs that callback's NameError, distributed 2026.8); what matters
     reaches the user as dvqp's own lines. Dead tasks are collected before the levels return
     (a nanny's start cut short by Ctrl-C leaves a failed task, reported when collected); after
     an exception they stay raised (the cut-short start goes on logging in its threads)."""
-    names = [n for n in logging.root.manager.loggerDict if n.split(".")[0] == "distributed"]
+    known = logging.root.manager.loggerDict
+    names = [n for n in known if n.split(".")[0] == "distributed"]
+    off = ["asyncio", "tornado", *(n for n in known if n.startswith("tornado."))]
     for name, level in [*((n, logging.CRITICAL) for n in ["distributed", *names]),
-                        ("asyncio", logging.CRITICAL + 1)]:  # fmt: skip
+                        *((n, logging.CRITICAL + 1) for n in off)]:  # fmt: skip
         logger = logging.getLogger(name)
         stack.push(_restorer(logger, logger.level))
         logger.setLevel(level)
