@@ -201,8 +201,8 @@ class StatefulBackend:
         else:
             solution = self._cold(problem, guess, structure)
         self._warm = solution.found
-        if not solution.found and not self.restarts:
-            self.reset()
+        if not solution.found and (not self.restarts or solution.status == "exception"):
+            self.reset()  # a solver that raised may be left in any state: set up anew
         solution.solve_time = perf_counter() - start
         return solution
 

@@ -296,3 +296,16 @@ def test_daqp_restarts_cold_in_its_model_after_a_refused_answer() -> None:
     assert after.found and not after.retried and backend._model is model
     assert after.iterations == cold.iterations
     np.testing.assert_array_equal(after.require(), cold.require())
+
+
+def test_daqp_sets_up_a_new_model_after_a_solve_that_raised() -> None:
+    pytest.importorskip("daqp")
+    ws = Drift(seed=9)
+    backend = make_backend("daqp")
+    backend.solve(ws.problem).require()
+    model = backend._model
+    ws.q.shape = (ws.q.size, 1)  # the copy raises: a failure of status "exception"
+    raised = backend.solve(ws.problem)
+    assert not raised.found and raised.status == "exception"
+    ws.q.shape = (ws.q.size,)
+    assert backend.solve(ws.problem).found and backend._model is not model
