@@ -358,11 +358,11 @@ def first_pieces(t: float, bend: float) -> Array:
     """The pieces dvqp's halving starts from (``dvqp.geometry.link_pieces``): the halving's
     piece (at ``k / 2ⁿ``) that holds ``t``, the straight link's closest point, short enough for
     its bend (about the link's ``bend`` (m) times the square of its length) to be within
-    5 µm with 30 % to spare, and the rest of the link either side of it."""
+    5 µm with 30 % to spare, a piece as short either side, and the rest of the link."""
     width = 0.7 * math.sqrt(0.5e-5 / bend)
     cuts = 2.0 ** max(math.ceil(-math.log2(width)), 0) if width < 1.0 else 1.0
     at = min(math.floor(t * cuts), cuts - 1.0)
-    cut = [0.0, at / cuts, (at + 1.0) / cuts, 1.0]
+    cut = [0.0, *(min(max((at + k) / cuts, 0.0), 1.0) for k in (-1, 0, 1, 2)), 1.0]
     return np.array([[a, b] for a, b in itertools.pairwise(cut) if b > a])
 
 

@@ -108,16 +108,18 @@ def _halve(shapes, j, a, b, la, radius, piece, first, second) -> None:  # type: 
 def _first_pieces(shapes, j, a, b, la, radius, t, bend, live):  # type: ignore[no-untyped-def]
     """The pieces the halving starts from, into ``live``; returns their count. A piece's bend
     shrinks about as the square of its length: the piece holding ``t`` (where the straight link
-    is closest) is cut short enough to be final at once, the rest of the link is two pieces
-    that the halving drops, or cuts where they may hold the minimum. Every cut is a halving's
-    (at ``k / 2ⁿ``): the pieces do not move with the link, so the clearance measured on one
-    has the gradient :func:`~dvqp.geometry.real_links.real_link_gradient` gives it."""
+    is closest) is cut short enough to be final at once, with a piece as short either side of
+    it (the minimum may lie just across a cut, and a long piece next to it could not be
+    dropped); the rest of the link is two pieces that the halving drops, or cuts where they
+    may hold the minimum. Every cut is a halving's (at ``k / 2ⁿ``): the pieces do not move
+    with the link, so the clearance measured on one has the gradient
+    :func:`~dvqp.geometry.real_links.real_link_gradient` gives it."""
     width = SEED_SHORTER * math.sqrt(0.5 * PRECISION / bend)
     cuts = 2.0 ** max(math.ceil(-math.log2(width)), 0) if width < 1.0 else 1.0
     at = min(math.floor(t * cuts), cuts - 1.0)
-    lo, hi = at / cuts, (at + 1.0) / cuts
-    count = 0
-    for t0, t1 in ((0.0, lo), (lo, hi), (hi, 1.0)):
+    count, t0 = 0, 0.0
+    for k in range(5):  # the cuts (at − 1, at, at + 1, at + 2) / cuts, then 1
+        t1 = min(max((at - 1.0 + k) / cuts, 0.0), 1.0) if k < 4 else 1.0
         if t1 > t0:
             piece = live[count]
             piece[T0], piece[T1] = t0, t1
@@ -127,6 +129,7 @@ def _first_pieces(shapes, j, a, b, la, radius, t, bend, live):  # type: ignore[n
                 _copy_end(live[count - 1], END1, piece, END0)
             _end(shapes, j, a, b, la, radius, t1, piece, END1)
             count += 1
+            t0 = t1
     return count
 
 

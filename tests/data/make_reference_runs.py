@@ -26,12 +26,12 @@ point enters the inlet and the discontinuous repulsion (``∇e = 2ρ n`` at the 
 from the exact curve's normal instead of a polygon vertex's (6e-4 rad apart): from there its
 joints moved by up to 0.036 rad and its clearance by up to 3.7 mm (lowest −3.7 mm before,
 −0.9 mm now).
-Rewritten when the halving of a link into pieces began at the piece (of the same halving's
+Rewritten when the halving of a link into pieces began at the pieces (of the same halving's
 grid) round the straight link's closest point instead of at the whole link: another set of
 pieces, to the same 10 µm. The baselines' joint paths are bit for bit the same, their
 recorded clearances moved by up to 5.7 µm (weld-circumference); the QP runs that hold a link
-at its margin moved by up to 1.7e-4 rad (narrow-passage; many-obstacles 1.6e-4, paper-two-inlets
-6.4e-5) and their clearances by up to 8.8 µm; every status is the same.
+at its margin moved by up to 1.7e-4 rad (narrow-passage; many-obstacles 1.7e-4; paper-two-inlets
+not at all) and their clearances by up to 7.7 µm; every status is the same.
 ``tests/test_reference_runs.py`` checks that today's code reproduces it within 1e-9. Run
 ``python tests/data/make_reference_runs.py`` only when a change of results is intended, and say
 why in the commit.
