@@ -136,7 +136,7 @@ def shape_point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
 @njit
 def shape_segment(shapes, j, al, az, bl, bz, a_end, b_end):  # type: ignore[no-untyped-def]
     """``(d, t, ∂d/∂l, ∂d/∂z)`` of a segment to obstacle j; ``a_end``, ``b_end`` the ends'
-    :func:`_point` where known (else :data:`~.shapes.inlet.UNKNOWN`; an inlet's segment
+    :func:`shape_point` where known (else :data:`~.shapes.inlet.UNKNOWN`; an inlet's segment
     then needs no second measurement of them)."""
     code, data, period = shapes.code[j], shapes.data[j], shapes.period
     if code == CIRCLE:
@@ -156,42 +156,40 @@ def shape_segment(shapes, j, al, az, bl, bz, a_end, b_end):  # type: ignore[no-u
 
 
 @njit
-def point_row(shapes, j, chain, i, near, exact):  # type: ignore[no-untyped-def]
+def point_row(shapes, j, chain, i, near, exact) -> None:  # type: ignore[no-untyped-def]
     """Point i's row to obstacle j: exact, or (unless ``exact``) its box bound if that is
-    beyond ``shapes.far[j]``. Returns whether it is exact."""
+    beyond ``shapes.far[j]`` (so a row not beyond it is exact)."""
     pl, pz = chain[i, 0], chain[i, 1]
     d, nl, nz = -1.0, 0.0, 0.0
     if not exact and (shapes.code[j] == POLYGON or shapes.code[j] == INLET):
         d, nl, nz = box_bound(shapes, j, pl, pz, pl, pz)
-    measured = d <= shapes.far[j]
-    if measured:
+    if d <= shapes.far[j]:
         d, nl, nz = shape_point(shapes, j, pl, pz)
     near.point_distance[j, i] = d
     near.point_normal[j, i, 0], near.point_normal[j, i, 1] = nl, nz
-    return measured
 
 
 @njit(inline="always")
-def _end(near, j, i, known):  # type: ignore[no-untyped-def]
-    """Point i's row to obstacle j as a segment's end: ``(d, n_l, n_z)`` if ``known`` (exact),
-    else unknown."""
-    if not known:
+def _end(shapes, near, j, i):  # type: ignore[no-untyped-def]
+    """Point i's row to obstacle j as a segment's end: ``(d, n_l, n_z)`` where it is exact
+    (not beyond ``shapes.far[j]``: :func:`point_row`), else unknown."""
+    if not near.point_distance[j, i] <= shapes.far[j]:
         return UNKNOWN
     return near.point_distance[j, i], near.point_normal[j, i, 0], near.point_normal[j, i, 1]
 
 
 @njit
-def link_row(shapes, j, chain, i, near, exact, a_known, b_known) -> None:  # type: ignore[no-untyped-def]
-    """Link i's row to obstacle j, as :func:`point_row` (a box bound has ``t = 0``);
-    ``a_known``, ``b_known``: its ends' point rows are exact (then not measured again)."""
+def link_row(shapes, j, chain, i, near, exact) -> None:  # type: ignore[no-untyped-def]
+    """Link i's row to obstacle j, as :func:`point_row` (a box bound has ``t = 0``); its ends'
+    point rows, written before it, are not measured again where they are exact."""
     a, b = near.ends[i, 0], near.ends[i, 1]
     al, az, bl, bz = chain[a, 0], chain[a, 1], chain[b, 0], chain[b, 1]
     d, t, nl, nz = -1.0, 0.0, 0.0, 0.0
     if not exact and (shapes.code[j] == POLYGON or shapes.code[j] == INLET):
         d, nl, nz = box_bound(shapes, j, al, az, bl, bz)
     if d <= shapes.far[j]:
-        d, t, nl, nz = shape_segment(shapes, j, al, az, bl, bz, _end(near, j, a, a_known),
-                                     _end(near, j, b, b_known))  # fmt: skip
+        d, t, nl, nz = shape_segment(shapes, j, al, az, bl, bz, _end(shapes, near, j, a),
+                                     _end(shapes, near, j, b))  # fmt: skip
     near.link_distance[j, i], near.link_t[j, i] = d, t
     near.link_normal[j, i, 0], near.link_normal[j, i, 1] = nl, nz
 
@@ -205,7 +203,6 @@ def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
     skipped (:func:`obstacle_bound`); a row farther than it from a polygon's or an inlet's box
     holds the box's distance (:func:`~.real_links.real_links` measures those that matter)."""
     l0, lo, hi, zlo, zhi = chain_box(chain, near.ends, shapes.period)
-    exact = np.empty(chain.shape[0], np.bool_)  # each point's row of this obstacle is exact
     for j in range(shapes.code.shape[0]):
         near.skipped[j] = False
         if shapes.code[j] == OTHER:
@@ -215,10 +212,9 @@ def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
             _fill(near, j, bound)
             continue
         for i in range(chain.shape[0]):
-            exact[i] = point_row(shapes, j, chain, i, near, False)
+            point_row(shapes, j, chain, i, near, False)
         for i in range(near.ends.shape[0]):
-            link_row(shapes, j, chain, i, near, False, exact[near.ends[i, 0]],
-                     exact[near.ends[i, 1]])  # fmt: skip
+            link_row(shapes, j, chain, i, near, False)
 
 
 @njit(inline="always")

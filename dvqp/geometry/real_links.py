@@ -135,7 +135,7 @@ def _broad(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-de
             if links[j, i] > far and (d <= far or d < shapes.refine[j] + 2.0 * bends[i]
                                       or d < reported):  # fmt: skip
                 _unskip(near, j)
-                link_row(shapes, j, chain, i, near, True, False, False)
+                link_row(shapes, j, chain, i, near, True)
                 _one_piece(near, j, i)
                 arm = min(arm, links[j, i] + bends[i])
                 if ends[i, 1] == tool:

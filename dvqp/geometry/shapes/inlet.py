@@ -255,7 +255,7 @@ def _deepest(al, az, el, ez, r, big, sl, sz, a_end, b_end):  # type: ignore[no-u
 
 
 @njit
-def inlet_segment(al, az, bl, bz, r, big, sl, sz, a_end=UNKNOWN, b_end=UNKNOWN):  # type: ignore[no-untyped-def]
+def inlet_segment(al, az, bl, bz, r, big, sl, sz, a_end, b_end):  # type: ignore[no-untyped-def]
     """``(d, t, ∂d/∂l, ∂d/∂z)`` of the segment ``a → b`` (local, as :func:`inlet_point`);
     ``a_end``, ``b_end`` its ends' :func:`inlet_point` where the caller has them (else
     :data:`UNKNOWN`: they are measured).
