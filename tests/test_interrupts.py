@@ -49,6 +49,37 @@ def test_a_call_into_compiled_code_runs_no_python_code_where_an_interrupt_is_cle
     assert called == ["first"]  # the dispatcher's typing of the struct ran no Python function
 
 
+class _InterruptedLookup(dict):  # type: ignore[type-arg]
+    """numba's unpickling memo, raising KeyboardInterrupt at its ``at``-th lookup (as a
+    Ctrl-C handled inside ``numba_unpickle`` does)."""
+
+    def __init__(self, memo: dict, at: int) -> None:  # type: ignore[type-arg]
+        super().__init__(memo)
+        self.left = at
+
+    def __getitem__(self, key):  # type: ignore[no-untyped-def]
+        self.left -= 1
+        if self.left == 0:
+            raise KeyboardInterrupt
+        return super().__getitem__(key)
+
+
+@pytest.mark.parametrize("at", [1, 2])
+def test_an_interrupt_while_a_struct_is_handed_back_stays_an_interrupt(
+    at: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from numba.core import serialize
+
+    as_struct(Packed(np.arange(3.0)))  # compiled and its constants unpickled once already
+    monkeypatch.setattr(
+        serialize, "_unpickled_memo", _InterruptedLookup(serialize._unpickled_memo, at)
+    )
+    with pytest.raises(KeyboardInterrupt):
+        as_struct(Packed(np.arange(3.0)))
+    monkeypatch.undo()
+    assert first(as_struct(Packed(np.arange(3.0)))) == 0.0  # and boxing works after
+
+
 def run_interrupted(body: str, timeout: float = 120.0) -> subprocess.CompletedProcess[str]:
     """Run ``body`` with a handler counting SIGINTs and a thread sending one every 23 ms for
     ``SECONDS`` (then none, so that none lands in the script's own bookkeeping); the script

@@ -21,7 +21,8 @@ from typing import Any
 import numba
 import numpy as np
 from numba import types
-from numba.core.extending import intrinsic
+from numba.core import cgutils
+from numba.core.extending import NativeValue, box, intrinsic, unbox
 from numba.experimental import structref
 from numba.experimental.structref import _Utils
 
@@ -53,7 +54,39 @@ class Arrays(structref.StructRefProxy):
         return instance  # type: ignore[no-any-return]
 
 
-structref.define_boxing(ArraysType, Arrays)
+@box(ArraysType)
+def _box(typ, val, c):  # type: ignore[no-untyped-def]
+    """An :class:`Arrays` holding the struct, or NULL with the exception raised on the way.
+
+    numba's own boxing of a StructRef fetches the constructor and the type with two
+    ``numba_unpickle`` calls, which run Python code, where a pending Ctrl-C is raised; it
+    then calls the constructor with whatever came back. A NULL ends the argument list, so
+    the constructor was called with none and a TypeError replaced the KeyboardInterrupt.
+    Here each step runs only if the one before succeeded (no Python code runs with an
+    exception set), and a failure returns NULL with that exception.
+    """
+    meminfo = _Utils(c.context, c.builder, typ).get_struct_ref(val).meminfo
+    held = c.box(types.MemInfoPointer(types.voidptr), meminfo)  # owns the struct's reference
+    result = cgutils.alloca_once_value(c.builder, c.pyapi.get_null_object())
+    make = c.pyapi.unserialize(c.pyapi.serialize_object(Arrays._numba_box_))
+    with c.builder.if_then(cgutils.is_not_null(c.builder, make), likely=True):
+        kind = c.pyapi.unserialize(c.pyapi.serialize_object(typ))
+        with c.builder.if_then(cgutils.is_not_null(c.builder, kind), likely=True):
+            c.builder.store(c.pyapi.call_function_objargs(make, [kind, held]), result)
+        c.pyapi.decref(kind)
+    c.pyapi.decref(make)
+    c.pyapi.decref(held)  # NULL-safe; on failure this frees the struct
+    return c.builder.load(result)
+
+
+@unbox(ArraysType)
+def _unbox(typ, obj, c):  # type: ignore[no-untyped-def]
+    """The struct an :class:`Arrays` holds (as numba's own unboxing of a StructRef)."""
+    held = c.pyapi.object_getattr_string(obj, "_meminfo")
+    meminfo = c.unbox(types.MemInfoPointer(types.voidptr), held).value
+    value = _Utils(c.context, c.builder, typ).new_struct_ref(meminfo)._getvalue()
+    c.pyapi.decref(held)
+    return NativeValue(value)
 
 
 @intrinsic
