@@ -1,7 +1,7 @@
-"""The broad phase: an obstacle far from the chain's box is skipped (its rows hold that
-distance, a lower bound), a part far from a polygon's or an inlet's box gets the box's distance
-(a lower bound), and every row that may matter (below the far distance, the damper's refining,
-the arm's or the probe's closest part) is exactly what it is without it."""
+"""The broad phase: an obstacle far from the chain's box is skipped (its rows not written, that
+distance kept as their lower bound), a part far from a polygon's or an inlet's box gets the
+box's distance (a lower bound), and every row that may matter (below the far distance, the
+damper's refining, the arm's or the probe's closest part) is exactly what it is without it."""
 
 from __future__ import annotations
 
@@ -38,6 +38,10 @@ def measured(case: Case, state: KinematicState, far: float) -> ProximityBuffers:
     real_links(as_struct(packed), chain, np.array(state.origins), case.radius, state.k,
                as_struct(near))  # fmt: skip
     penalties(packed.size, as_struct(near))
+    assert not near.point_penalty[near.skipped].any()  # not written: no repulsion computed
+    skipped = near.skipped  # their rows: the bound (the real links' less their bend)
+    near.point_distance[skipped] = near.bound[skipped, None]
+    near.real_distance[skipped] = near.bound[skipped, None] - near.bends
     return near
 
 
@@ -57,7 +61,6 @@ def test_rows_that_may_matter_are_exact_and_the_others_below_the_truth(
             assert e.min() == b.min()  # the arm's closest part, exact
             proxies += int((b != e).sum())
         skipped += int(broad.skipped.sum())
-        assert not broad.point_penalty[broad.skipped].any()  # no repulsion computed
         k = state.k  # the probe and its holder
         assert min(exact.point_distance[:, k].min(), exact.real_distance[:, k - 1].min()) == min(
             broad.point_distance[:, k].min(), broad.real_distance[:, k - 1].min())  # fmt: skip

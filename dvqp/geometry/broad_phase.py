@@ -52,7 +52,7 @@ def chain_box(chain, ends, period):  # type: ignore[no-untyped-def]
     return l0, lo, hi, zlo, zhi
 
 
-@njit
+@njit(inline="always")
 def obstacle_bound(shapes, j, l0, lo, hi, zlo, zhi):  # type: ignore[no-untyped-def]
     """The distance (m) from the chain's box (:func:`chain_box`) to obstacle j's box: a lower
     bound of every row's clearance to it (the obstacle taken at its nearest period)."""

@@ -11,7 +11,7 @@ import numpy as np
 
 from dvqp.geometry.bend import PRECISION, link_bend, link_point
 from dvqp.geometry.link_pieces import link_clearance
-from dvqp.geometry.measure import OTHER, link_row, point_row
+from dvqp.geometry.measure import OTHER, fill, link_row, point_row
 from solvers.jit import njit
 
 
@@ -29,7 +29,8 @@ def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ign
     for shapes of your own (:data:`OTHER`), the whole link is one piece: the straight row less
     the link's ``δ`` (in ``near.bends``), a bound below the truth by at most ``2 δ``, above
     the margin and above the arm's closest part. Rows that the broad phase left at their box's
-    bound (beyond ``shapes.far``) are measured exactly first wherever they may matter."""
+    bound (beyond ``shapes.far``), or not written (an obstacle it skipped), are measured
+    exactly first wherever they may matter."""
     ends, bends = near.ends, near.bends
     for i in range(ends.shape[0]):
         a, b = origins[ends[i, 0]], origins[ends[i, 1]]
@@ -54,11 +55,14 @@ def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ign
 def _closest(shapes, near, tool):  # type: ignore[no-untyped-def]
     """Every link's row as one piece (its straight row less its bend), and ``(arm, probe)``:
     bounds above the clearance of the arm's closest part and of the probe or its holder, over
-    the exact rows (those not beyond ``shapes.far``)."""
+    the exact rows (those not beyond ``shapes.far``; an obstacle the broad phase skipped has
+    none, and its rows are not written)."""
     ends, bends, points = near.ends, near.bends, near.point_distance
     arm, probe = math.inf, math.inf
     for j in range(near.real_distance.shape[0]):
         far = shapes.far[j]
+        if near.skipped[j]:
+            continue
         for p in range(points.shape[1]):
             if points[j, p] <= far:
                 arm = min(arm, points[j, p])
@@ -82,8 +86,19 @@ def _one_piece(near, j, i) -> None:  # type: ignore[no-untyped-def]
 
 
 @njit(inline="always")
+def _written(near, j) -> None:  # type: ignore[no-untyped-def]
+    """Obstacle j's rows, if the broad phase skipped it, written at its bound (its real rows
+    that less the bend); it stays skipped."""
+    if near.skipped[j]:
+        fill(near, j)
+        for i in range(near.ends.shape[0]):
+            _one_piece(near, j, i)
+
+
+@njit(inline="always")
 def _unskip(near, j) -> None:  # type: ignore[no-untyped-def]
     """Obstacle j, if the broad phase skipped it, is measured: its bounds become rows."""
+    _written(near, j)
     near.skipped[j] = False
 
 
@@ -99,8 +114,9 @@ def _seed(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-def
         lo, hi = (0, points.shape[1]) if which == 0 else (tool, tool + 1)
         for j in range(points.shape[0]):
             for p in range(lo, hi):
-                if points[j, p] > shapes.far[j] and points[j, p] < best:
-                    best, bj, bp = points[j, p], j, p
+                d = near.bound[j] if near.skipped[j] else points[j, p]
+                if d > shapes.far[j] and d < best:
+                    best, bj, bp = d, j, p
         if bj >= 0:
             _unskip(near, bj)
             point_row(shapes, bj, chain, bp, near, True)
@@ -120,9 +136,10 @@ def _broad(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-de
         far = shapes.far[j]
         if far == math.inf or (
             near.skipped[j]  # one bound in every row: none may matter
-            and points[j, 0] - 3.0 * most > max(far, shapes.refine[j], arm, probe)
+            and near.bound[j] - 3.0 * most > max(far, shapes.refine[j], arm, probe)
         ):
             continue
+        _written(near, j)
         for p in range(points.shape[1]):
             if far < points[j, p] < (probe if p == tool else arm):
                 _unskip(near, j)

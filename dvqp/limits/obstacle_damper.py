@@ -93,7 +93,7 @@ def obstacle_distances(near, jacobians, origins, frame_jacobians, radius, reach,
     for j in members:
         if near.skipped[j]:  # far from the whole arm: its bound, no row applies
             for i in range(points):
-                distance[r + i], usable[r + i] = near.point_distance[j, i], False
+                distance[r + i], usable[r + i] = near.bound[j], False
             r += points
             continue
         for i in range(points):
@@ -104,6 +104,11 @@ def obstacle_distances(near, jacobians, origins, frame_jacobians, radius, reach,
                     gradient[r, c] = nl * jacobians[i, 0, c] + nz * jacobians[i, 1, c]
             r += 1
     for j in members:
+        if near.skipped[j]:  # the bound less each link's bend
+            for i in range(ends.shape[0]):
+                distance[r + i], usable[r + i] = near.bound[j] - near.bends[i], False
+            r += ends.shape[0]
+            continue
         for i in range(ends.shape[0]):
             nl, nz, t = near.real_normal[j, i, 0], near.real_normal[j, i, 1], near.real_at[j, i]
             distance[r] = near.real_distance[j, i]

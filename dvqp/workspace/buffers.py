@@ -93,9 +93,12 @@ class ProximityBuffers:
     bends : (L,)
         How far each link's real DV image strays from its straight DV segment, m.
     skipped : (J,) bool
-        The broad phase left obstacle j out: its point and link rows all hold one lower bound
-        of their clearance (no normal), its real rows that less the bend, its penalty rows are
-        not written (``dvqp.geometry.measure``).
+        The broad phase left obstacle j out (``dvqp.geometry.measure``): ``bound[j]`` is a
+        lower bound of the clearance of every point and link to it (its real links': that
+        less each link's bend), and none of its rows is written (they hold an earlier step's
+        values; ``bound`` and ``bends`` are its rows).
+    bound : (J,)
+        That lower bound, m, where ``skipped`` (else not written).
     """
 
     ends: NDArray[np.int64]
@@ -115,6 +118,7 @@ class ProximityBuffers:
     real_t1: Array
     bends: Array
     skipped: NDArray[np.bool_]
+    bound: Array
 
     @classmethod
     def allocate(cls, count: int, k: int, rail: bool = False) -> ProximityBuffers:
@@ -129,7 +133,7 @@ class ProximityBuffers:
                    np.zeros(p), np.zeros((*p, 2)), np.zeros(s), np.zeros((*s, 2)), np.zeros(s),
                    np.zeros((*s, 2)), np.zeros(s), np.zeros(s), np.zeros((*s, 2)), np.zeros(s),
                    np.zeros(s), np.ones(s), np.zeros(ends.shape[0]),
-                   np.zeros(count, np.bool_))  # fmt: skip
+                   np.zeros(count, np.bool_), np.zeros(count))  # fmt: skip
 
 
 @dataclass(frozen=True)
