@@ -22,6 +22,7 @@ import asyncio
 import contextlib
 import gc
 import logging
+import math
 import time
 from collections.abc import Callable, Iterator, Sequence
 from types import ModuleType
@@ -39,6 +40,9 @@ SCENE_TIMEOUT = 600.0
 """How long a scene may run on a worker by default, s (all its backends)."""
 POLL = 0.5
 """How often the scheduler is asked what runs where, s."""
+WAKE = 0.05
+"""How often finished scenes are collected, s. The workers never wait for it: each holds its
+next scene while it runs one (Dask's queuing)."""
 LOCAL_WORKER_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.worker.memory.monitor-interval": "1s",
@@ -191,17 +195,21 @@ def run_dask(
     cancels what has not finished and propagates. A job that fails on a worker for another
     reason than a failed run (e.g. dvqp missing there) raises ``DvqpError("dask: <scene>:
     <error>")``; no worker left for :data:`WORKER_WAIT` s raises :class:`WorkersLostError`.
+
+    Finished scenes are collected from one ``as_completed`` every :data:`WAKE` s. Waiting on
+    the remaining futures after each one instead (``wait(..., FIRST_COMPLETED)``) had the
+    cluster's event loop in this process register on every one of them again: on a
+    200-scene suite that loop's thread used 2.3 s of CPU, 1.0 s now, taken from the cores the
+    workers run on.
     """
     dd = import_distributed()
     total, done = sum(len(job.backends) for job in jobs), 0
     futures = {client.submit(run_job, job, pure=False, retries=1): job for job in jobs}
     remaining, watch = dict(futures), _Watch(client, timeout)
+    completed = dd.as_completed(list(futures))  # (a cancelled one arrives too: not remaining)
     try:
         while remaining:
-            try:
-                finished = dd.wait(list(remaining), POLL, return_when="FIRST_COMPLETED").done
-            except TimeoutError:
-                finished = set()
+            finished = [f for f in completed.next_batch(block=False) if f in remaining]
             late = [f for f in watch.overdue(remaining) if f not in finished]
             client.cancel(late)
             for future in [*finished, *late]:
@@ -211,6 +219,8 @@ def run_dask(
                 done += len(job.backends)
                 if progress is not None:
                     progress(done, total, job.name)
+            if remaining and not finished and not late:
+                time.sleep(WAKE)
     except BaseException:
         client.cancel(list(futures))
         raise
@@ -239,11 +249,16 @@ class _Watch:
         self.client, self.timeout = client, timeout
         self.started: dict[str, float] = {}
         self.alone: float | None = None  # since when no worker is left
+        self.asked = -math.inf  # when the scheduler was last asked
 
     def overdue(self, futures: dict[Any, Job]) -> list[Any]:
         """The futures running longer than the timeout; :class:`WorkersLostError` when no
-        worker has been left for :data:`WORKER_WAIT` s."""
-        now, processing = time.monotonic(), self.client.processing()
+        worker has been left for :data:`WORKER_WAIT` s. The scheduler is asked at most every
+        :data:`POLL` s (none between)."""
+        now = time.monotonic()
+        if now - self.asked < POLL:
+            return []
+        self.asked, processing = now, self.client.processing()
         if processing:
             self.alone = None
         elif self.alone is None:
