@@ -206,7 +206,7 @@ def run_dask(
     total, done = sum(len(job.backends) for job in jobs), 0
     futures = {client.submit(run_job, job, pure=False, retries=1): job for job in jobs}
     remaining, watch = dict(futures), _Watch(client, timeout)
-    completed = dd.as_completed(list(futures))  # (a cancelled one arrives too: not remaining)
+    completed = dd.as_completed(list(futures), loop=client.loop)  # a cancelled one comes too
     try:
         while remaining:
             finished = [f for f in completed.next_batch(block=False) if f in remaining]

@@ -35,11 +35,10 @@ def wrap_period(difference, period):  # type: ignore[no-untyped-def]
     """A difference of values of period ``period`` wrapped into ``[−period/2, period/2)`` (to
     a rounding at its ends): a float or an array (from Python), a float (from compiled code).
     A difference inside it (not within a rounding of its ends) comes back unchanged, bit for
-    bit. The nearest whole
-    number of periods is taken off by ``floor``: compiled, that costs about 1.4 ns a call
-    where Python's float ``%`` (``fmod`` and a floor division) cost about 10 ns
-    (a loop over 10⁵ floats), and the broad phase and the circles call it several hundred
-    times a step."""
+    bit. The nearest whole number of periods is taken off with ``floor``: compiled, about
+    1.4 ns a call, where Python's float ``%`` (``fmod`` and a floor division) took about 10 ns
+    (a loop over 10⁵ floats); the broad phase and the circles call it hundreds of times a
+    step."""
     return difference - period * np.floor(difference / period + 0.5)
 
 
