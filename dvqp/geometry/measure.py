@@ -223,7 +223,7 @@ def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
 @njit(inline="always")
 def _circle_rows(shapes, j, chain, near) -> None:  # type: ignore[no-untyped-def]
     """Every row of circle j, as :func:`point_row` and :func:`link_row` write them (exact),
-    its data read once: a circle's 13 rows took 0.11 µs so, 1.6 µs through those two (whose
+    its data read once: a circle's 13 rows took 0.11 µs so, 1.4–1.6 µs through those two (whose
     calls, with the packed struct and the other kinds' branches, LLVM does not inline), timed
     in a loop over the states of a fifty-obstacles run."""
     cl, cz, r, period = shapes.data[j, 0], shapes.data[j, 1], shapes.data[j, 2], shapes.period

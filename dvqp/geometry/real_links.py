@@ -139,10 +139,10 @@ def _broad(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-de
             and near.bound[j] - 3.0 * most > max(far, shapes.refine[j], arm, probe)
         ):
             continue
-        _written(near, j)
+        _written(near, j)  # its rows: once, here; a row measured below unskips it
         for p in range(points.shape[1]):
             if far < points[j, p] < (probe if p == tool else arm):
-                _unskip(near, j)
+                near.skipped[j] = False
                 point_row(shapes, j, chain, p, near, True)
                 arm = min(arm, points[j, p])
                 probe = min(probe, points[j, p]) if p == tool else probe
@@ -151,7 +151,7 @@ def _broad(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-de
             reported = probe if ends[i, 1] == tool else arm
             if links[j, i] > far and (d <= far or d < shapes.refine[j] + 2.0 * bends[i]
                                       or d < reported):  # fmt: skip
-                _unskip(near, j)
+                near.skipped[j] = False
                 link_row(shapes, j, chain, i, near, True)
                 _one_piece(near, j, i)
                 arm = min(arm, links[j, i] + bends[i])
