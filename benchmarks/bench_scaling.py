@@ -41,9 +41,13 @@ def configurations(workers: int) -> dict[str, list[str]]:
     return {
         "serial": [],
         f"--workers {workers}": ["--workers", str(workers)],
-        f"--scheduler local --workers {workers}": ["--scheduler", "local", "--workers",
-                                                   str(workers)],
-    }  # fmt: skip
+        f"--scheduler local --workers {workers}": [
+            "--scheduler",
+            "local",
+            "--workers",
+            str(workers),
+        ],
+    }
 
 
 def run(command: list[str], out: Path) -> dict[str, object]:
@@ -51,8 +55,14 @@ def run(command: list[str], out: Path) -> dict[str, object]:
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    done = subprocess.run([*command, "--json", str(out)], capture_output=True, text=True,
-                          cwd=ROOT, env=env, check=False)  # fmt: skip
+    done = subprocess.run(
+        [*command, "--json", str(out)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env=env,
+        check=False,
+    )
     wall = time.perf_counter() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if done.returncode != 0:
@@ -72,8 +82,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--backends", default="pinv,daqp,osqp")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args(argv)
-    base = [sys.executable, "-m", "dvqp", "bench", "--count", str(args.count), "--seed",
-            str(args.seed), "--backends", args.backends]  # fmt: skip
+    base = [
+        sys.executable,
+        "-m",
+        "dvqp",
+        "bench",
+        "--count",
+        str(args.count),
+        "--seed",
+        str(args.seed),
+        "--backends",
+        args.backends,
+    ]
     configs = configurations(args.workers)
     names = list(configs)
     print(f"cpus {os.cpu_count()}, load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
@@ -86,22 +106,30 @@ def main(argv: list[str] | None = None) -> int:
             for name in order:
                 result = run(base + configs[name], out)
                 runs[name].append(result)
-                print(f"round {repeat + 1}  {name:<36} wall {result['wall']:6.2f} s  "
-                      f"cpu {result['cpu']:6.2f} s  start-up {result['startup']}")  # fmt: skip
+                print(
+                    f"round {repeat + 1}  {name:<36} wall {result['wall']:6.2f} s  "
+                    f"cpu {result['cpu']:6.2f} s  start-up {result['startup']}"
+                )
     serial = [r["wall"] for r in runs["serial"]]
-    print(f"\n{'configuration':<36} {'median s':>9} {'x serial':>9} {'x (medians)':>12}  "
-          "start-up per worker s (median)  outcomes")  # fmt: skip
+    print(
+        f"\n{'configuration':<36} {'median s':>9} {'x serial':>9} {'x (medians)':>12}  "
+        "start-up per worker s (median)  outcomes"
+    )
     for name in names:
         walls = [r["wall"] for r in runs[name]]
         ratios = [s / w for s, w in zip(serial, walls, strict=True)]
         starts = [r["startup"] for r in runs[name] if r["startup"]]
         per_worker = [statistics.median(s) for s in zip(*starts, strict=False)] if starts else []
-        same = all(not outcome_differences(runs["serial"][0]["results"], r["results"], tol=0.0)
-                   for r in runs[name])  # fmt: skip
-        print(f"{name:<36} {statistics.median(walls):9.2f} {statistics.median(ratios):9.2f} "
-              f"{statistics.median(serial) / statistics.median(walls):12.2f}  "
-              f"{', '.join(f'{s:.2f}' for s in per_worker) or '-':<31} "
-              f"{'same as serial' if same else 'DIFFER'}")  # fmt: skip
+        same = all(
+            not outcome_differences(runs["serial"][0]["results"], r["results"], tol=0.0)
+            for r in runs[name]
+        )
+        print(
+            f"{name:<36} {statistics.median(walls):9.2f} {statistics.median(ratios):9.2f} "
+            f"{statistics.median(serial) / statistics.median(walls):12.2f}  "
+            f"{', '.join(f'{s:.2f}' for s in per_worker) or '-':<31} "
+            f"{'same as serial' if same else 'DIFFER'}"
+        )
     print(f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     return 0
 

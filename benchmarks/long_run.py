@@ -37,8 +37,9 @@ def scene_with(steps: int) -> dvqp.Scene:
     for i in range(int(np.ceil(seconds))):
         sign = 1.0 if i % 2 == 0 else -1.0
         duration = min(1.0, seconds - i)
-        legs.append(f"\n[[motion.jog]]\nduration = {duration}\n"
-                    f"velocity = [{0.05 * sign}, 0.0, 0.0, 0.0]\n")  # fmt: skip
+        legs.append(
+            f"\n[[motion.jog]]\nduration = {duration}\nvelocity = [{0.05 * sign}, 0.0, 0.0, 0.0]\n"
+        )
     return dvqp.scenes.loads(head + "".join(legs), f"long-{steps}.toml")
 
 
@@ -69,21 +70,27 @@ def main(argv: list[str] | None = None) -> int:
     scene = scene_with(args.steps)
     started = time.perf_counter()
     first = dvqp.plan(scene, args.backend)
-    print(f"first run (compiles or loads the cache): {time.perf_counter() - started:.3f} s, "
-          f"{first.n_steps} steps")  # fmt: skip
+    print(
+        f"first run (compiles or loads the cache): {time.perf_counter() - started:.3f} s, "
+        f"{first.n_steps} steps"
+    )
     times = []
     for _ in range(args.repeat):
         started = time.perf_counter()
         traj = dvqp.plan(scene, args.backend)
         times.append(time.perf_counter() - started)
-    print(f"{traj.n_steps} steps with {args.backend}: median {np.median(times):.3f} s "
-          f"({np.median(times) / traj.n_steps * 1e6:.1f} us/step) over {args.repeat} runs; "
-          f"failed steps {int((~traj.success).sum())}")  # fmt: skip
+    print(
+        f"{traj.n_steps} steps with {args.backend}: median {np.median(times):.3f} s "
+        f"({np.median(times) / traj.n_steps * 1e6:.1f} us/step) over {args.repeat} runs; "
+        f"failed steps {int((~traj.success).sum())}"
+    )
     quarter, three, peak, arrays = traced(scene, args.backend)
     growth = (three - quarter) / (traj.n_steps // 2)
-    print(f"memory in use: {quarter / 1e6:.2f} MB at 1/4 of the steps, {three / 1e6:.2f} MB at "
-          f"3/4 ({growth:.1f} bytes per step); peak {peak / 1e6:.2f} MB, the trajectory's "
-          f"arrays {arrays / 1e6:.2f} MB")  # fmt: skip
+    print(
+        f"memory in use: {quarter / 1e6:.2f} MB at 1/4 of the steps, {three / 1e6:.2f} MB at "
+        f"3/4 ({growth:.1f} bytes per step); peak {peak / 1e6:.2f} MB, the trajectory's "
+        f"arrays {arrays / 1e6:.2f} MB"
+    )
     return 0
 
 

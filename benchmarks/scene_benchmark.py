@@ -62,9 +62,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--backends", default="pinv,daqp")
     parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args(argv)
-    files = args.scenes or [str(f) for f in sorted(
-        [*(ROOT / "scenes").glob("*.toml"), *(ROOT / "benchmarks" / "scenes").glob("*.toml")]
-    )]  # fmt: skip
+    files = args.scenes or [
+        str(f)
+        for f in sorted(
+            [*(ROOT / "scenes").glob("*.toml"), *(ROOT / "benchmarks" / "scenes").glob("*.toml")]
+        )
+    ]
     names = [Path(f).stem for f in files]
     paper = str(ROOT / "scenes" / f"{PAPER}.toml")
     backends = args.backends.split(",")
@@ -78,16 +81,19 @@ def main(argv: list[str] | None = None) -> int:
                 steps.setdefault((Path(f).stem, b), []).append(step)
                 ratios.setdefault((Path(f).stem, b), []).append(ratio)
         print(f"repeat {r + 1}/{args.repeat} done", file=sys.stderr)
-    header = f"{'scene':<20}" + "".join(f" {b + ' us':>9} {'/paper':>6} {'spread':>11}"
-                                         for b in backends)  # fmt: skip
+    header = f"{'scene':<20}" + "".join(
+        f" {b + ' us':>9} {'/paper':>6} {'spread':>11}" for b in backends
+    )
     print(header)
     print("-" * len(header))
     for name in names:
         cells = ""
         for b in backends:
             ratio = ratios[name, b]
-            cells += (f" {np.median(steps[name, b]) * 1e6:9.1f} {np.median(ratio):6.2f} "
-                      f"{min(ratio):5.2f}-{max(ratio):<5.2f}")  # fmt: skip
+            cells += (
+                f" {np.median(steps[name, b]) * 1e6:9.1f} {np.median(ratio):6.2f} "
+                f"{min(ratio):5.2f}-{max(ratio):<5.2f}"
+            )
         print(f"{name:<20}{cells}")
     return 0
 

@@ -118,9 +118,15 @@ def run(name: str, args: argparse.Namespace) -> dict[str, np.ndarray]:
         total = time.perf_counter() - started
         started = time.perf_counter()
         Solution.checked(
-            problem, sol.x, backend=name, tolerance=sol.tolerance, status=sol.status,
-            y=sol.y, z=sol.z, z_box=sol.z_box,
-        )  # fmt: skip
+            problem,
+            sol.x,
+            backend=name,
+            tolerance=sol.tolerance,
+            status=sol.status,
+            y=sol.y,
+            z=sol.z,
+            z_box=sol.z_box,
+        )
         check = time.perf_counter() - started
         if k < warmup:
             continue

@@ -55,8 +55,14 @@ def measure(args: list[str], env: dict[str, str]) -> dict[str, float]:
     process (``import`` for ``import dvqp`` alone)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
-    out = subprocess.run([sys.executable, "-c", PROBE, *args], env=env, capture_output=True,
-                         text=True, check=False, cwd=ROOT)  # fmt: skip
+    out = subprocess.run(
+        [sys.executable, "-c", PROBE, *args],
+        env=env,
+        capture_output=True,
+        text=True,
+        check=False,
+        cwd=ROOT,
+    )
     wall = time.perf_counter() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -75,21 +81,23 @@ def main(argv: list[str] | None = None) -> int:
             ("cold: import dvqp", ["import"]),
             ("cold: dvqp --help", ["--help"]),
             ("cold: dvqp backends", ["backends"]),
-            (f"cold: dvqp plan ({args.backend})", ["plan", args.scene, "--backend",
-                                                   args.backend, "-o", trajectory]),
+            (
+                f"cold: dvqp plan ({args.backend})",
+                ["plan", args.scene, "--backend", args.backend, "-o", trajectory],
+            ),
             ("then: dvqp plot", ["plot", trajectory, "-o", str(Path(tmp) / "run.png")]),
             ("cached: dvqp plan", ["plan", args.scene, "--backend", args.backend]),
             ("then: dvqp compare (every backend)", ["compare", args.scene]),
-        ]  # fmt: skip
+        ]
         env = {**os.environ, "NUMBA_CACHE_DIR": str(Path(tmp) / "numba"), "MPLBACKEND": "Agg"}
         rows = [(label, measure(command, env)) for label, command in runs]
         env["NUMBA_CACHE_DIR"] = str(Path(tmp) / "numba-readme")
-        rows.append(("cold: dvqp compare (README's first command)",
-                     measure(["compare", args.scene], env)))  # fmt: skip
+        rows.append(
+            ("cold: dvqp compare (README's first command)", measure(["compare", args.scene], env))
+        )
     print(f"{'command':<45} {'wall s':>7} {'cpu s':>7} {'compiled':>9} {'exit':>5}")
     for label, m in rows:
-        print(f"{label:<45} {m['wall']:7.2f} {m['cpu']:7.2f} {m['compiled']:9.0f} "
-              f"{m['code']:5.0f}")  # fmt: skip
+        print(f"{label:<45} {m['wall']:7.2f} {m['cpu']:7.2f} {m['compiled']:9.0f} {m['code']:5.0f}")
     return 0
 
 

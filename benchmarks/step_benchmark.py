@@ -90,8 +90,11 @@ def isolated(function, *args):  # type: ignore[no-untyped-def]
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("scene", nargs="?", default=str(ROOT / "scenes" / "paper-two-inlets.toml"))
-    parser.add_argument("--backends", help="comma-separated (default: pinv, every plain name and "
-                        "the qpsolvers: path of each direct adapter)")  # fmt: skip
+    parser.add_argument(
+        "--backends",
+        help="comma-separated (default: pinv, every plain name and "
+        "the qpsolvers: path of each direct adapter)",
+    )
     parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args(argv)
     scene = dvqp.load_scene(args.scene)
@@ -121,14 +124,19 @@ def main(argv: list[str] | None = None) -> int:
 
 def report(scene, backends, got, iterations, peer, repeat) -> None:  # type: ignore[no-untyped-def]
     """Print the table: medians (µs) of the full step, resolver, solver and rest; ratios."""
-    med = {b: {f: float(np.median(np.concatenate(got[b][f]))) * 1e6 for f in FIELDS}
-           for b in backends}  # fmt: skip
+    med = {
+        b: {f: float(np.median(np.concatenate(got[b][f]))) * 1e6 for f in FIELDS} for b in backends
+    }
     pink_med = float(np.median(np.concatenate(peer))) * 1e6 if peer else None
     base = med.get("pinv", {}).get("step_time")
-    print(f"scene {scene.name}: {len(got[backends[0]]['step_time'][0]) + 1} steps x {repeat} "
-          f"repeats, {len(scene.obstacles)} obstacles, {len(scene.limits)} limits")  # fmt: skip
-    header = (f"{'backend':<20} {'step us':>8} {'resolve':>8} {'solver':>7} {'rest':>7} "
-              f"{'iters':>5} {'/pinv':>6} {'/pink':>6} {'qpsolvers/direct':>16}")  # fmt: skip
+    print(
+        f"scene {scene.name}: {len(got[backends[0]]['step_time'][0]) + 1} steps x {repeat} "
+        f"repeats, {len(scene.obstacles)} obstacles, {len(scene.limits)} limits"
+    )
+    header = (
+        f"{'backend':<20} {'step us':>8} {'resolve':>8} {'solver':>7} {'rest':>7} "
+        f"{'iters':>5} {'/pinv':>6} {'/pink':>6} {'qpsolvers/direct':>16}"
+    )
     print(header)
     print("-" * len(header))
     for b in backends:
@@ -140,8 +148,10 @@ def report(scene, backends, got, iterations, peer, repeat) -> None:  # type: ign
         generic = f"qpsolvers:{b}"
         vs = f"{med[generic]['step_time'] / m['step_time']:16.2f}" if generic in med else " " * 16
         rest = m["step_time"] - m["solver_time"]
-        print(f"{b:<20} {m['step_time']:8.1f} {m['solve_time']:8.1f} {m['solver_time']:7.1f} "
-              f"{rest:7.1f} {it} {ratio} {vs_pink} {vs}")  # fmt: skip
+        print(
+            f"{b:<20} {m['step_time']:8.1f} {m['solve_time']:8.1f} {m['solver_time']:7.1f} "
+            f"{rest:7.1f} {it} {ratio} {vs_pink} {vs}"
+        )
     if pink_med is not None:
         print(f"{'pink (peer)':<20} {pink_med:8.1f}")
     else:

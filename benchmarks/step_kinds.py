@@ -84,8 +84,10 @@ def main(argv: list[str] | None = None) -> int:
     for _ in range(args.repeat):
         for name, times in kinds(scene, args.backend).items():
             found.setdefault(name, []).append(times)
-    medians = {k: float(np.median(np.concatenate(v))) * 1e6 if sum(map(len, v)) else np.nan
-               for k, v in found.items()}  # fmt: skip
+    medians = {
+        k: float(np.median(np.concatenate(v))) * 1e6 if sum(map(len, v)) else np.nan
+        for k, v in found.items()
+    }
     counts = {k: sum(map(len, v)) for k, v in found.items()}
     print(f"scene {scene.name}, backend {args.backend}, {args.repeat} repeats")
     print(f"{'kind':<22} {'steps':>7} {'median us':>10} {'x plain':>8}")

@@ -31,16 +31,53 @@ if TYPE_CHECKING:
     from dvqp import Scene, Trajectory
 
 FIELDS = (
-    "scene", "file", "backend", "settings", "success", "steps", "failures", "slowed", "relaxed",
-    "braking", "substepped", "nominal_duration", "path_duration", "max_deviation", "median_step_us",
-    "p95_step_us", "median_solver_us", "median_rest_us", "median_iterations", "refused_calls",
-    "refusals", "qp_solves", "unanswered_solves", "primal_residual", "dual_residual", "duality_gap",
-    "ratio_to_pinv", "max_task_error", "min_clearance", "closest", "min_probe_clearance",
-    "min_tilt", "min_self_distance", "closest_pair", "min_link_height", "lowest_link",
-    "max_joint_acceleration", "max_limit_excess", "worst_limit", "start_broken",
-    "max_joint_limit_violation", "max_velocity_limit_violation", "final_tracking_error",
-    "final_joint_speed", "braking_time", "error",
-)  # fmt: skip
+    "scene",
+    "file",
+    "backend",
+    "settings",
+    "success",
+    "steps",
+    "failures",
+    "slowed",
+    "relaxed",
+    "braking",
+    "substepped",
+    "nominal_duration",
+    "path_duration",
+    "max_deviation",
+    "median_step_us",
+    "p95_step_us",
+    "median_solver_us",
+    "median_rest_us",
+    "median_iterations",
+    "refused_calls",
+    "refusals",
+    "qp_solves",
+    "unanswered_solves",
+    "primal_residual",
+    "dual_residual",
+    "duality_gap",
+    "ratio_to_pinv",
+    "max_task_error",
+    "min_clearance",
+    "closest",
+    "min_probe_clearance",
+    "min_tilt",
+    "min_self_distance",
+    "closest_pair",
+    "min_link_height",
+    "lowest_link",
+    "max_joint_acceleration",
+    "max_limit_excess",
+    "worst_limit",
+    "start_broken",
+    "max_joint_limit_violation",
+    "max_velocity_limit_violation",
+    "final_tracking_error",
+    "final_joint_speed",
+    "braking_time",
+    "error",
+)
 """Keys of a result row, in table / CSV order."""
 
 Row = dict[str, Any]
@@ -203,10 +240,13 @@ def run_error(scene: Scene, traj: Trajectory) -> str | None:
 
 
 def run_scene(
-    path: str, backends: Sequence[str], progress: Callable[[str], None] | None = None,
-    options: dict[str, dict[str, Any]] | None = None, tier: str = "default",
+    path: str,
+    backends: Sequence[str],
+    progress: Callable[[str], None] | None = None,
+    options: dict[str, dict[str, Any]] | None = None,
+    tier: str = "default",
     timing: str | None = None,
-) -> list[Row]:  # fmt: skip
+) -> list[Row]:
     """Load a scene and run it with every backend (``options``: settings by backend, over the
     ``tier``'s, :mod:`solvers.tiers`; ``timing``: a path scene's, :func:`dvqp.plan`); the rows
     in ``backends`` order. A run that raises a :class:`~dvqp.errors.DvqpError` gives an
@@ -216,8 +256,13 @@ def run_scene(
     rows = []
     for backend in backends:
         try:
-            traj = plan(scene, backend, options=given.get(backend), tier=tier,
-                        timing=timing if scene.path is not None else None)  # fmt: skip
+            traj = plan(
+                scene,
+                backend,
+                options=given.get(backend),
+                tier=tier,
+                timing=timing if scene.path is not None else None,
+            )
             rows.append(summarize(scene, traj, tier))
         except DvqpError as exc:
             rows.append(error_row(scene, backend, exc))
@@ -271,12 +316,15 @@ def compare(
 
     if jobs <= 1 or len(paths) <= 1:
         for path in paths:
-            results[path] = run_scene(path, backends, lambda b, p=path: tick(1, f"{p} {b}"),
-                                      options, tier, timing)  # fmt: skip
+            results[path] = run_scene(
+                path, backends, lambda b, p=path: tick(1, f"{p} {b}"), options, tier, timing
+            )
     else:
         with ProcessPoolExecutor(max_workers=jobs, initializer=quiet_worker) as pool:
-            futures = {pool.submit(run_scene, path, list(backends), None, options, tier,
-                                   timing): path for path in paths}  # fmt: skip
+            futures = {
+                pool.submit(run_scene, path, list(backends), None, options, tier, timing): path
+                for path in paths
+            }
             for future in as_completed(futures):
                 results[futures[future]] = future.result()
                 tick(len(backends), futures[future])
@@ -291,8 +339,12 @@ def rows_to_csv(rows: Sequence[Row], fields: Sequence[str] = FIELDS) -> str:
 def machine() -> dict[str, Any]:
     """Platform, processor, CPU count and Python version of this machine."""
     processor = platform.processor() or platform.machine()
-    return {"platform": platform.platform(), "processor": processor, "cpu_count": os.cpu_count(),
-            "python": platform.python_version()}  # fmt: skip
+    return {
+        "platform": platform.platform(),
+        "processor": processor,
+        "cpu_count": os.cpu_count(),
+        "python": platform.python_version(),
+    }
 
 
 def quiet_worker() -> None:

@@ -135,11 +135,21 @@ def plan(
     c = scene_commands(scene)
     scaled = scene_timing(scene, timing) == "scaled"
     traj = simulate(
-        scene.robot, scene.pipe_radius, resolver, scene.q0, c.velocity, scene.dt,
-        obstacles=scene.obstacles, reference=c.reference[:-1] if c.feedback_gain > 0 else None,
-        feedback_gain=c.feedback_gain, progress=progress, notice=notice, stop=stop, watch=watch,
+        scene.robot,
+        scene.pipe_radius,
+        resolver,
+        scene.q0,
+        c.velocity,
+        scene.dt,
+        obstacles=scene.obstacles,
+        reference=c.reference[:-1] if c.feedback_gain > 0 else None,
+        feedback_gain=c.feedback_gain,
+        progress=progress,
+        notice=notice,
+        stop=stop,
+        watch=watch,
         time_scaling=scaled,
-    )  # fmt: skip
+    )
     if scaled:  # the reference where the run had reached on the path
         nodes = np.arange(c.reference.shape[0])
         u = traj.path_time / scene.dt
@@ -183,12 +193,16 @@ def path_figures(scene: Scene, traj: Trajectory) -> dict[str, float | None]:
     }
 
 
-def backend_settings(scene: Scene, backend: str, options: dict[str, Any] | None = None,
-                     tier: str = "default") -> dict[str, Any]:  # fmt: skip
+def backend_settings(
+    scene: Scene, backend: str, options: dict[str, Any] | None = None, tier: str = "default"
+) -> dict[str, Any]:
     """The settings a run of ``scene`` gives ``backend``: the ``tier``'s
     (:mod:`solvers.tiers`), under the scene's ``[solvers.<backend>]``, under ``options``."""
-    return {**tier_options(backend, tier), **scene.solver_options.get(backend, {}),
-            **(options or {})}  # fmt: skip
+    return {
+        **tier_options(backend, tier),
+        **scene.solver_options.get(backend, {}),
+        **(options or {}),
+    }
 
 
 def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> None:
@@ -221,8 +235,9 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
         also = f"; it starts outside its limits: {started}" if started else ""
         raise LimitViolationError(
             f"{where}: {count} of {traj.t.shape[0]} samples break a limit{detail}{also}",
-            sample, float(traj.limit_excess[sample]),
-        )  # fmt: skip
+            sample,
+            float(traj.limit_excess[sample]),
+        )
     too_fast = _too_fast(scene, traj)
     if too_fast is not None:
         raise LimitViolationError(f"{where}: {too_fast[2]}", too_fast[0], too_fast[1])
@@ -238,8 +253,9 @@ def check_run(scene: Scene, traj: Trajectory, limits: Sequence[Limit] = ()) -> N
     if unfinished is not None:
         raise UnreachableTargetError(f"{where}: {unfinished}", step=traj.n_steps)
     position, heading = final_errors(traj) if traj.tracking_error.shape[0] else (0.0, 0.0)
-    if scene.path is not None and (position > scene.path.tolerance
-                                   or heading > scene.path.heading_tolerance):  # fmt: skip
+    if scene.path is not None and (
+        position > scene.path.tolerance or heading > scene.path.heading_tolerance
+    ):
         raise UnreachableTargetError(
             f"{where}: target not reached at t = {traj.t[-1]:.3f} s: tracking error "
             f"{position * 1e3:.3g} mm / {heading:.3g} rad (tolerance "
@@ -264,10 +280,15 @@ def _too_fast(scene: Scene, traj: Trajectory) -> tuple[int, float, str] | None:
         return None
     k, joint = np.unravel_index(int(np.argmax(over)), over.shape)
     count = int(np.sum(over.max(axis=1) > SPEED_TOLERANCE))
-    return int(k), float(over[k, joint]), (
-        f"{count} of {traj.n_steps} steps break a joint velocity limit: worst at t = "
-        f"{traj.t[k]:.3f} s, joint{joint + 1} at {abs(traj.qdot[k, joint]):.4g} rad/s "
-        f"(qd_max {scene.robot.qd_max[joint]:.4g})")  # fmt: skip
+    return (
+        int(k),
+        float(over[k, joint]),
+        (
+            f"{count} of {traj.n_steps} steps break a joint velocity limit: worst at t = "
+            f"{traj.t[k]:.3f} s, joint{joint + 1} at {abs(traj.qdot[k, joint]):.4g} rad/s "
+            f"(qd_max {scene.robot.qd_max[joint]:.4g})"
+        ),
+    )
 
 
 def _unfinished(scene: Scene, traj: Trajectory) -> str | None:
@@ -277,6 +298,8 @@ def _unfinished(scene: Scene, traj: Trajectory) -> str | None:
     nominal = scene.dt * (scene_commands(scene).reference.shape[0] - 1)
     if traj.path_time[-1] >= nominal - 1e-6 * scene.dt:
         return None
-    return (f"the path was not finished: {traj.path_time[-1] / nominal:.0%} of it in "
-            f"{traj.t[-1]:.3f} s (the limits held the tool back; at most "
-            f"{MAX_SLOWDOWN:g}x the nominal {nominal:.3f} s)")  # fmt: skip
+    return (
+        f"the path was not finished: {traj.path_time[-1] / nominal:.0%} of it in "
+        f"{traj.t[-1]:.3f} s (the limits held the tool back; at most "
+        f"{MAX_SLOWDOWN:g}x the nominal {nominal:.3f} s)"
+    )

@@ -94,8 +94,15 @@ def export_qps(
     work = _work_folder(target)
     try:
         calls = _Calls(work, re.sub(r"[^A-Za-z0-9._-]", "_", scene.name))
-        traj = plan(scene, backend, progress=progress, notice=notice, options=options, watch=calls,
-                    tier=tier)  # fmt: skip
+        traj = plan(
+            scene,
+            backend,
+            progress=progress,
+            notice=notice,
+            options=options,
+            watch=calls,
+            tier=tier,
+        )
         settings = backend_settings(scene, backend, options, tier)
         index = calls.finish(scene, traj, backend, tier, settings)
         _put_in_place(work, target)
@@ -120,8 +127,9 @@ class _Calls:
         self.tolerance: float | None = None
         """The residual check's absolute tolerance of the backend (None: no call)."""
 
-    def __call__(self, step: int, kind: str, problem: solvers.Problem,
-                 solution: solvers.Solution) -> None:  # fmt: skip
+    def __call__(
+        self, step: int, kind: str, problem: solvers.Problem, solution: solvers.Solution
+    ) -> None:
         import qpsolvers
 
         call = self.per_step[step]
@@ -131,44 +139,72 @@ class _Calls:
         qpsolvers.Problem(p.P, p.q, p.G, p.h, p.A, p.b, p.lb, p.ub).save(str(self.folder / name))
         found = bool(solution.found and solution.x is not None)
         self.tolerance = solution.tolerance
-        self.entries.append({
-            "file": name, "answer": f"{ANSWERS}/{name}", "solve": len(self.entries),
-            "step": step, "call": call, "kind": kind, "variables": p.n,
-            "equalities": p.n_eq, "inequalities": p.n_in, "found": found,
-            "refusal": "" if found else solution.refusal, "solver_status": str(solution.status),
-            "iterations": None if solution.iterations is None else int(solution.iterations),
-            "retried": bool(solution.retried),
-            "warm_start": self.warm.get(kind), **active_rows(p, solution),
-        })  # fmt: skip
+        self.entries.append(
+            {
+                "file": name,
+                "answer": f"{ANSWERS}/{name}",
+                "solve": len(self.entries),
+                "step": step,
+                "call": call,
+                "kind": kind,
+                "variables": p.n,
+                "equalities": p.n_eq,
+                "inequalities": p.n_in,
+                "found": found,
+                "refusal": "" if found else solution.refusal,
+                "solver_status": str(solution.status),
+                "iterations": None if solution.iterations is None else int(solution.iterations),
+                "retried": bool(solution.retried),
+                "warm_start": self.warm.get(kind),
+                **active_rows(p, solution),
+            }
+        )
         s = solution  # x and the multipliers (empty: absent, or the call refused)
-        self.answers.append({key: EMPTY if value is None or not found else np.array(value)
-                             for key, value in (("x", s.x), ("y", s.y), ("z", s.z),
-                                                ("z_box", s.z_box))})  # fmt: skip
+        self.answers.append(
+            {
+                key: EMPTY if value is None or not found else np.array(value)
+                for key, value in (("x", s.x), ("y", s.y), ("z", s.z), ("z_box", s.z_box))
+            }
+        )
         self.warm[kind] = name if found else None  # a refused call resets its backend: cold
 
-    def finish(self, scene: Scene, traj: Trajectory, backend: str, tier: str,
-               settings: dict[str, Any]) -> dict[str, Any]:  # fmt: skip
+    def finish(
+        self, scene: Scene, traj: Trajectory, backend: str, tier: str, settings: dict[str, Any]
+    ) -> dict[str, Any]:
         """Write the answers and the index (the run over); return the index."""
         (self.folder / ANSWERS).mkdir()
         for entry, answer in zip(self.entries, self.answers, strict=True):
             entry["step_status"] = str(traj.status[entry["step"]])
             entry["substeps"] = int(traj.substeps[entry["step"]])
-            np.savez(self.folder / entry["answer"], **answer, found=np.array(entry["found"]),
-                     kind=np.array(entry["kind"]), step_status=np.array(entry["step_status"]),
-                     solver_status=np.array(entry["solver_status"]))  # fmt: skip
+            np.savez(
+                self.folder / entry["answer"],
+                **answer,
+                found=np.array(entry["found"]),
+                kind=np.array(entry["kind"]),
+                step_status=np.array(entry["step_status"]),
+                solver_status=np.array(entry["solver_status"]),
+            )
         try:
             check_run(scene, traj)
             error = ""
         except (UnreachableTargetError, LimitViolationError) as exc:
             error = str(exc)
         index = {
-            "format": FORMAT, "dvqp": __version__, "scene": scene.name, "source": scene.source,
-            "backend": backend, "tier": tier, "settings": settings, "dt": scene.dt,
-            "steps": traj.n_steps, "brake_start": traj.brake_start, "error": error,
-            "tolerance": self.tolerance, "no_backend_call": sorted(
-                set(range(traj.n_steps)) - set(self.per_step)),
+            "format": FORMAT,
+            "dvqp": __version__,
+            "scene": scene.name,
+            "source": scene.source,
+            "backend": backend,
+            "tier": tier,
+            "settings": settings,
+            "dt": scene.dt,
+            "steps": traj.n_steps,
+            "brake_start": traj.brake_start,
+            "error": error,
+            "tolerance": self.tolerance,
+            "no_backend_call": sorted(set(range(traj.n_steps)) - set(self.per_step)),
             "problems": self.entries,
-        }  # fmt: skip
+        }
         text = json.dumps(index, indent=1, allow_nan=False)
         (self.folder / INDEX).write_text(text + "\n", encoding="utf-8")
         return index
@@ -203,11 +239,15 @@ def _target(folder: Path, force: bool) -> Path:
         raise ParameterError("output", f"{folder}: not a folder")
     if folder.is_dir() and any(folder.iterdir()):
         if not force:
-            raise ParameterError("output", f"{folder}: not empty (--force replaces an earlier "
-                                 "export)")  # fmt: skip
+            raise ParameterError(
+                "output", f"{folder}: not empty (--force replaces an earlier export)"
+            )
         if not _is_export(folder):
-            raise ParameterError("output", f"{folder}: not empty and not an export of dvqp "
-                                 f"export-qps (no {INDEX} of one): not replaced")  # fmt: skip
+            raise ParameterError(
+                "output",
+                f"{folder}: not empty and not an export of dvqp "
+                f"export-qps (no {INDEX} of one): not replaced",
+            )
     return folder
 
 

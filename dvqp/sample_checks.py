@@ -23,8 +23,9 @@ def worst_sample_excess(
     if candidates.shape[0] == 0:
         return None
     spec = scene.spec().with_extra(limits=limits)
-    stepper = Stepper(scene.robot, scene.pipe_radius, PseudoinverseResolver(spec), traj.q[0],
-                      scene.dt)  # fmt: skip
+    stepper = Stepper(
+        scene.robot, scene.pipe_radius, PseudoinverseResolver(spec), traj.q[0], scene.dt
+    )
     stepper.start(traj.q[0])
     found = []
     for k in candidates[np.argsort(traj.limit_excess[candidates])[-20:]]:

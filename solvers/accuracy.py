@@ -101,8 +101,10 @@ class AccuracyTally:
         """Shifted geometric mean of each metric (None: no solve counted)."""
         if not self.solves:
             return None
-        return {name: SHIFT * math.expm1(total / self.solves)
-                for name, total in zip(METRICS, self.log_sums, strict=True)}  # fmt: skip
+        return {
+            name: SHIFT * math.expm1(total / self.solves)
+            for name, total in zip(METRICS, self.log_sums, strict=True)
+        }
 
     def to_dict(self) -> dict[str, float | int]:
         """JSON-ready: ``solves``, ``unanswered`` and the three means (none if no solve)."""

@@ -120,12 +120,17 @@ class DaqpBackend(StatefulBackend):
         A, G, lb, ub, empty = problem.A, problem.G, problem.lb, problem.ub, EMPTY_VECTOR
         self._bound = problem
         self._stack = (
-            problem.P, problem.q,
-            EMPTY_MATRIX if A is None else A, empty if A is None else problem.b,
-            EMPTY_MATRIX if G is None else G, empty if G is None else problem.h,
-            empty if lb is None else lb, empty if ub is None else ub,
-            self._data, *self._layout[:4],
-        )  # fmt: skip
+            problem.P,
+            problem.q,
+            EMPTY_MATRIX if A is None else A,
+            empty if A is None else problem.b,
+            EMPTY_MATRIX if G is None else G,
+            empty if G is None else problem.h,
+            empty if lb is None else lb,
+            empty if ub is None else ub,
+            self._data,
+            *self._layout[:4],
+        )
 
     def _fill(self, problem: Problem) -> None:
         """Copy ``q``, ``G``, ``h``, ``A``, ``b``, ``lb``, ``ub`` into the set-up's buffers."""
@@ -237,7 +242,15 @@ class DaqpBackend(StatefulBackend):
         y, z, box = self._cuts
         # Model.solve returns fresh copies of x and lam: the solution keeps them uncopied.
         return judged(
-            problem, values, x, lam[y], lam[z], None if box is None else lam[box],
-            self.name, self.tolerance, EXIT_FLAGS.get(flag) or str(flag), info["iterations"],
+            problem,
+            values,
+            x,
+            lam[y],
+            lam[z],
+            None if box is None else lam[box],
+            self.name,
+            self.tolerance,
+            EXIT_FLAGS.get(flag) or str(flag),
+            info["iterations"],
             solver_time,
-        )  # fmt: skip
+        )

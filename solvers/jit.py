@@ -100,8 +100,9 @@ class _EntryFiles(IndexDataCacheFile):
         """Delete ``path`` (if it can be) and say so."""
         with contextlib.suppress(OSError):
             os.unlink(path)
-        note(f"compile cache entry {path} could not be read ({_reason(exc)}): "
-             "discarded, recompiling")  # fmt: skip
+        note(
+            f"compile cache entry {path} could not be read ({_reason(exc)}): discarded, recompiling"
+        )
 
     def _load_data(self, name: str) -> Any:
         with open(self._data_path(name), "rb") as fh:
@@ -147,8 +148,11 @@ class SoftCache(FunctionCache):
         try:
             super().save_overload(sig, data)
         except Exception as exc:  # a full disk: compiled all the same, not cached
-            note(f"compile cache not written ({self._cache_path}: {_reason(exc)}): "
-                 "compiled code is not cached", once="unsaved")  # fmt: skip
+            note(
+                f"compile cache not written ({self._cache_path}: {_reason(exc)}): "
+                "compiled code is not cached",
+                once="unsaved",
+            )
 
 
 def _cache_for(function: Callable[..., Any]) -> SoftCache | NullCache:
@@ -190,10 +194,12 @@ def entry_files(roots: list[Path]) -> dict[Path, list[Path]]:
     for folder, names in sorted(stems.items()):
         files = sorted(folder.iterdir()) if folder.is_dir() else []
         found[folder] = [
-            p for p in files
-            if p.is_file() and p.name.split(".")[0] in names
+            p
+            for p in files
+            if p.is_file()
+            and p.name.split(".")[0] in names
             and any(p.name.endswith(s) or f"{s}.tmp." in p.name for s in _ENTRY_SUFFIXES)
-        ]  # fmt: skip
+        ]
     return found
 
 

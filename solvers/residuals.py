@@ -206,7 +206,11 @@ def passing(values: tuple[float, ...], tolerance: float) -> Residuals | None:
         return None
     residuals = _new(Residuals)  # a frozen dataclass, filled without its slower __init__
     residuals.__dict__.update(
-        equality=equality, inequality=inequality, bounds=bounds,
-        stationarity=stationarity, complementarity=complementarity, duality_gap=gap,
-    )  # fmt: skip
+        equality=equality,
+        inequality=inequality,
+        bounds=bounds,
+        stationarity=stationarity,
+        complementarity=complementarity,
+        duality_gap=gap,
+    )
     return residuals

@@ -109,8 +109,13 @@ class RowDropping:
         copy = self._copy
         if copy is None or copy.source is not problem:
             p, n = problem.G.shape
-            copy = self._copy = _Copy(problem, np.full(p, -1, np.int64), np.full(p, -1, np.int64),
-                                      np.zeros((p, n)), np.full(p, math.inf))  # fmt: skip
+            copy = self._copy = _Copy(
+                problem,
+                np.full(p, -1, np.int64),
+                np.full(p, -1, np.int64),
+                np.zeros((p, n)),
+                np.full(p, math.inf),
+            )
         used = compact(problem.G, problem.h, copy.slot_of, copy.row_of, copy.G, copy.h)
         solution = self.inner.solve(copy.sized(used), initvals)
         z = solution.z

@@ -171,9 +171,18 @@ class Solution:
         """
         values = None if x is None else quick(problem, x, y, z, z_box)
         return judged(
-            problem, MISFITTING if values is None else values, x, y, z, z_box,
-            backend, tolerance, status, iterations, solver_time,
-        )  # fmt: skip
+            problem,
+            MISFITTING if values is None else values,
+            x,
+            y,
+            z,
+            z_box,
+            backend,
+            tolerance,
+            status,
+            iterations,
+            solver_time,
+        )
 
     @classmethod
     def failure(
@@ -189,8 +198,19 @@ class Solution:
         solver_time: float = 0.0,
     ) -> Solution:
         """Build a solution for a solve that produced no answer at all (e.g. an exception)."""
-        return cls(problem, None, status, False, backend, tolerance, None, solve_time,
-                   message=message, retried=retried, solver_time=solver_time)  # fmt: skip
+        return cls(
+            problem,
+            None,
+            status,
+            False,
+            backend,
+            tolerance,
+            None,
+            solve_time,
+            message=message,
+            retried=retried,
+            solver_time=solver_time,
+        )
 
     @property
     def refusal(self) -> str:
@@ -283,15 +303,53 @@ def judged(
     """
     residuals = passing(values, tolerance)
     if residuals is not None:
-        return Solution(problem, x, status, True, backend, tolerance, iterations, 0.0,
-                        y, z, z_box, residuals, "", False, solver_time)  # fmt: skip
+        return Solution(
+            problem,
+            x,
+            status,
+            True,
+            backend,
+            tolerance,
+            iterations,
+            0.0,
+            y,
+            z,
+            z_box,
+            residuals,
+            "",
+            False,
+            solver_time,
+        )
     if values[0] == MISFIT:
         return Solution.checked(
-            problem, x, backend=backend, tolerance=tolerance, status=status,
-            iterations=iterations, y=y, z=z, z_box=z_box, solver_time=solver_time,
-        )  # fmt: skip
+            problem,
+            x,
+            backend=backend,
+            tolerance=tolerance,
+            status=status,
+            iterations=iterations,
+            y=y,
+            z=z,
+            z_box=z_box,
+            solver_time=solver_time,
+        )
     return _verdict(
-        Solution(problem, x, status, False, backend, tolerance, iterations, 0.0,
-                 y, z, z_box, None, "", False, solver_time),
+        Solution(
+            problem,
+            x,
+            status,
+            False,
+            backend,
+            tolerance,
+            iterations,
+            0.0,
+            y,
+            z,
+            z_box,
+            None,
+            "",
+            False,
+            solver_time,
+        ),
         values,
-    )  # fmt: skip
+    )

@@ -151,8 +151,10 @@ class StatefulBackend:
         unknown = sorted(set(settings) - self.known_settings())
         if unknown:
             accepted = ", ".join(sorted(self.known_settings()))
-            raise SolverError(f"{self.name}: unknown setting {', '.join(map(repr, unknown))} "
-                              f"(accepted: {accepted})")  # fmt: skip
+            raise SolverError(
+                f"{self.name}: unknown setting {', '.join(map(repr, unknown))} "
+                f"(accepted: {accepted})"
+            )
         self.tolerance = self.default_tolerance if tolerance is None else float(tolerance)
         self.settings: dict[str, Any] = {**self.default_settings, **settings}
         self._structure: Hashable | None = None

@@ -44,8 +44,9 @@ def scene(name: str) -> Scene:
     return load_scene(ROOT / "scenes" / f"{name}.toml")
 
 
-def configurations(robot: Robot, q0: ArrayLike, count: int, seed: int, spread: float,
-                   radius: float = PIPE_RADIUS) -> list[NDArray[np.float64]]:  # fmt: skip
+def configurations(
+    robot: Robot, q0: ArrayLike, count: int, seed: int, spread: float, radius: float = PIPE_RADIUS
+) -> list[NDArray[np.float64]]:
     """Uniform offsets of at most ``spread`` rad around ``q0`` (singular ones left out)."""
     rng = np.random.default_rng(seed)
     found = []
@@ -76,14 +77,16 @@ def near_set(state: KinematicState) -> ObstacleSet:
     inside point 3's 2 cm margin, one holding point 4 inside, one over link 4's middle, one
     grazing the probe, one far."""
     p = state.guarded[:, :2]
-    return ObstacleSet([
-        Obstacle(p[1], 0.02),
-        Obstacle(p[2] + np.array([0.0, 0.05 - 5e-5]), 0.03),
-        Obstacle(p[3] + np.array([0.01, 0.0]), 0.03),
-        Obstacle(0.5 * (p[3] + p[4]) + np.array([0.0, 0.035]), 0.03),
-        Obstacle(p[-1] + np.array([0.0, 0.045]), 0.04),
-        Obstacle(np.array([-0.5, -1.0]), 0.05),
-    ])  # fmt: skip
+    return ObstacleSet(
+        [
+            Obstacle(p[1], 0.02),
+            Obstacle(p[2] + np.array([0.0, 0.05 - 5e-5]), 0.03),
+            Obstacle(p[3] + np.array([0.01, 0.0]), 0.03),
+            Obstacle(0.5 * (p[3] + p[4]) + np.array([0.0, 0.035]), 0.03),
+            Obstacle(p[-1] + np.array([0.0, 0.045]), 0.04),
+            Obstacle(np.array([-0.5, -1.0]), 0.05),
+        ]
+    )
 
 
 def tight_limits(state: KinematicState, deceleration: float) -> tuple[Limit, ...]:
@@ -97,9 +100,16 @@ def tight_limits(state: KinematicState, deceleration: float) -> tuple[Limit, ...
     )
 
 
-def damper_rows(stepper: Stepper, limit: VelocityDamper, q: ArrayLike, dt: float = DT,
-                *, fd: bool = False, atol: float = 1e-12,
-                gradient: bool = True) -> Constraint:  # fmt: skip
+def damper_rows(
+    stepper: Stepper,
+    limit: VelocityDamper,
+    q: ArrayLike,
+    dt: float = DT,
+    *,
+    fd: bool = False,
+    atol: float = 1e-12,
+    gradient: bool = True,
+) -> Constraint:
     """Load ``q``, prepare a step of ``dt`` and check the rows ``limit`` wrote against the
     distances it keeps, measured independently: the rows that apply (gradient defined, below
     the reach) and their labels, ``h`` by the damper rule, ``G = −∂d/∂Q`` by the old NumPy
@@ -112,8 +122,12 @@ def damper_rows(stepper: Stepper, limit: VelocityDamper, q: ArrayLike, dt: float
     refine = None  # the links of an obstacle in several dampers: refined below the largest margin
     if isinstance(limit, ObstacleDamper):
         dampers = [d for d in stepper.resolver.spec.limits if type(d) is ObstacleDamper]
-        refine = np.array([max(d.margin for d in dampers if any(o is x for x in d.obstacles))
-                           for o in limit.obstacles])  # fmt: skip
+        refine = np.array(
+            [
+                max(d.margin for d in dampers if any(o is x for x in d.obstacles))
+                for o in limit.obstacles
+            ]
+        )
     union, state = stepper.layout.shapes, KinematicState.compute(stepper.robot, q, radius)
     closest = closest_parts(union, state, radius) if union else None  # over the step's obstacles
     found = measure(limit, state, refine, closest)
@@ -123,14 +137,16 @@ def damper_rows(stepper: Stepper, limit: VelocityDamper, q: ArrayLike, dt: float
     assert isinstance(rows, Constraint)
     on = found.applies
     assert rows.labels == tuple(np.asarray(found.labels, dtype=object)[on])
-    want = damper_rhs(found.value[on], found.safe[on], limit.gain, dt, limit.tolerance,
-                      limit.deceleration)  # fmt: skip
+    want = damper_rhs(
+        found.value[on], found.safe[on], limit.gain, dt, limit.tolerance, limit.deceleration
+    )
     np.testing.assert_allclose(rows.h, want, rtol=0, atol=atol)
     if gradient and found.gradient is not None:
         np.testing.assert_allclose(rows.G, -found.gradient[on], rtol=0, atol=1e-12)
     if gradient and (fd or found.gradient is None):
-        numeric = distance_jacobian(limit, stepper.robot, q, radius, refine=refine,
-                                    union=union or None)[on]  # fmt: skip
+        numeric = distance_jacobian(
+            limit, stepper.robot, q, radius, refine=refine, union=union or None
+        )[on]
         scale = max(float(np.abs(numeric).max(initial=0.0)), 1e-3)
         np.testing.assert_allclose(-rows.G, numeric, rtol=0, atol=2e-6 * scale)
     return rows

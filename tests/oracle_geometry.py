@@ -289,8 +289,9 @@ def _inlet_curve(phi: Array, r: float, big: float) -> Array:
     return np.stack([big * np.arcsin(r * np.cos(phi) / big), r * np.sin(phi)], axis=-1)
 
 
-def inlet_points(center: Array, r: float, big: float, lz: Array, period: float
-                 ) -> tuple[Array, Array]:  # fmt: skip
+def inlet_points(
+    center: Array, r: float, big: float, lz: Array, period: float
+) -> tuple[Array, Array]:
     """Nearest outline point of each point by a grid of φ then golden section on the squared
     distance; inside where ``(R sin(Δl/R))² + Δz² < r²`` (|Δl| < πR/2)."""
     p = np.asarray(lz, dtype=np.float64) - center
@@ -312,13 +313,15 @@ def inlet_points(center: Array, r: float, big: float, lz: Array, period: float
     off = p - _inlet_curve(0.5 * (lo + hi), r, big)
     d = np.sqrt((off**2).sum(axis=1))
     inside = (np.abs(p[:, 0]) < 0.5 * np.pi * big) & (
-        (big * np.sin(p[:, 0] / big)) ** 2 + p[:, 1] ** 2 < r * r)  # fmt: skip
+        (big * np.sin(p[:, 0] / big)) ** 2 + p[:, 1] ** 2 < r * r
+    )
     sign = np.where(inside, -1.0, 1.0)
     return sign * d, sign[:, None] * off / np.maximum(d, 1e-300)[:, None]
 
 
-def inlet_segments(center: Array, r: float, big: float, a: Array, b: Array, period: float
-                   ) -> tuple[Array, Array, Array]:  # fmt: skip
+def inlet_segments(
+    center: Array, r: float, big: float, a: Array, b: Array, period: float
+) -> tuple[Array, Array, Array]:
     """Least signed distance along each segment: 129 samples, then golden section between the
     best one's neighbours (the signed distance of a convex region is convex along a line)."""
     b = short_way(a, b, period)
@@ -360,8 +363,9 @@ class UserInlet(Shape):
         return self.center[1] - self.radius, self.center[1] + self.radius
 
     def outline(self) -> Array:
-        return self.center + _inlet_curve(np.linspace(0, 2 * np.pi, 200), self.radius,
-                                          self.pipe_radius)  # fmt: skip
+        return self.center + _inlet_curve(
+            np.linspace(0, 2 * np.pi, 200), self.radius, self.pipe_radius
+        )
 
     def point_distance(self, lz: Array, period: float) -> tuple[Array, Array]:
         return inlet_points(self.center, self.radius, self.pipe_radius, lz, period)

@@ -31,8 +31,18 @@ Array = NDArray[np.float64]
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 RHO_MIN = 1e-9
 HEADING_FLOOR = 1e-6
-FIELDS = ("q", "origins", "axes", "frame_jacobians", "guarded", "guarded_jacobians", "points",
-          "point_jacobians", "tool", "tool_jacobian")  # fmt: skip
+FIELDS = (
+    "q",
+    "origins",
+    "axes",
+    "frame_jacobians",
+    "guarded",
+    "guarded_jacobians",
+    "points",
+    "point_jacobians",
+    "tool",
+    "tool_jacobian",
+)
 """The array fields of a :class:`~dvqp.KinematicState`."""
 
 
@@ -66,8 +76,9 @@ def dv_rows(origins: ArrayLike, linear_jacobians: ArrayLike, radius: float) -> A
     rho2 = x * x + y * y
     rho = np.sqrt(rho2)
     jx, jy = jv[:, 0], jv[:, 1]
-    return np.stack([radius / rho2 * (x * jy - y * jx), jv[:, 2], x / rho * jx + y / rho * jy],
-                    axis=1)  # fmt: skip
+    return np.stack(
+        [radius / rho2 * (x * jy - y * jx), jv[:, 2], x / rho * jx + y / rho * jy], axis=1
+    )
 
 
 def heading(origin: ArrayLike, axis: ArrayLike) -> tuple[float, Array]:
@@ -83,8 +94,9 @@ def heading(origin: ArrayLike, axis: ArrayLike) -> tuple[float, Array]:
     k = 1.0 / max(c * c + s * s, HEADING_FLOOR)
     dc_ox = zy / rho - c * ox / (rho * rho)
     dc_oy = -zx / rho - c * oy / (rho * rho)
-    grad = np.array([-s * dc_ox * k, -s * dc_oy * k, 0.0, s * oy / rho * k, -s * ox / rho * k,
-                     c * k])  # fmt: skip
+    grad = np.array(
+        [-s * dc_ox * k, -s * dc_oy * k, 0.0, s * oy / rho * k, -s * ox / rho * k, c * k]
+    )
     return math.atan2(s, c), grad
 
 
@@ -130,8 +142,13 @@ def free_frame_robot() -> Robot:
     ``(0.3, 0, 0)``; body point ``"riding"`` rides on the PY joint at ``(0.2, 0, 0.05)``."""
     model = pin.Model()
     parent = 0
-    joints = (pin.JointModelPX(), pin.JointModelPY(), pin.JointModelPZ(), pin.JointModelRZ(),
-              pin.JointModelRY())  # fmt: skip
+    joints = (
+        pin.JointModelPX(),
+        pin.JointModelPY(),
+        pin.JointModelPZ(),
+        pin.JointModelRZ(),
+        pin.JointModelRY(),
+    )
     for i, joint in enumerate(joints):
         parent = model.addJoint(parent, joint, pin.SE3.Identity(), f"j{i}")
         if i == 1:
@@ -148,8 +165,13 @@ def free_frame_q(origin: ArrayLike, axis: ArrayLike) -> Array:
     z axis along ``axis`` (normalised)."""
     a = np.asarray(axis, dtype=np.float64)
     a = a / np.linalg.norm(a)
-    return np.array([*np.asarray(origin, dtype=np.float64), math.atan2(a[1], a[0]),
-                     math.acos(np.clip(a[2], -1.0, 1.0))])  # fmt: skip
+    return np.array(
+        [
+            *np.asarray(origin, dtype=np.float64),
+            math.atan2(a[1], a[0]),
+            math.acos(np.clip(a[2], -1.0, 1.0)),
+        ]
+    )
 
 
 def on_surface(l: float, z: float, h: float, radius: float) -> Array:

@@ -44,8 +44,14 @@ Array = NDArray[np.float64]
 # -- the damper rule and the joint boxes (the old NumPy code) ------------------------------
 
 
-def damper_rhs(distance: Array, safe: float | Array, gain: float, dt: float, depth: float,
-               deceleration: float = math.inf) -> Array:  # fmt: skip
+def damper_rhs(
+    distance: Array,
+    safe: float | Array,
+    gain: float,
+    dt: float,
+    depth: float,
+    deceleration: float = math.inf,
+) -> Array:
     """``γ/dt · (d − d_safe)``, capped above ``d_safe`` by the braking speed
     ``sqrt(2 a (d − d_safe))``; below it, a drift of at most ``δ`` is pulled back no faster
     than ``a·dt``, and deeper the distance may only not shrink (0)."""
@@ -133,8 +139,12 @@ def guarded_links(k: int, rail: bool) -> Array:
 def link_pairs(k: int, rail: bool = False) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """The pairs ``(i, j)``, ``i < j``, of guarded links with no point in common, listed."""
     ends = guarded_links(k, rail)
-    pairs = [(i, j) for i in range(len(ends)) for j in range(i + 1, len(ends))
-             if len({*ends[i], *ends[j]}) == 4]  # fmt: skip
+    pairs = [
+        (i, j)
+        for i in range(len(ends))
+        for j in range(i + 1, len(ends))
+        if len({*ends[i], *ends[j]}) == 4
+    ]
     return np.array([p[0] for p in pairs], np.int64), np.array([p[1] for p in pairs], np.int64)
 
 
@@ -220,21 +230,32 @@ def measure(
         u, du = tilt_cosine(state)
         d = tilt_sine(state)
         gradient = (-u / max(d, 1e-9)) * du
-        return Measured(np.array([d]), gradient[None, :], np.array([limit.safe]),
-                        ("probe/tilt",), np.ones(1, bool))  # fmt: skip
+        return Measured(
+            np.array([d]),
+            gradient[None, :],
+            np.array([limit.safe]),
+            ("probe/tilt",),
+            np.ones(1, bool),
+        )
     if type(limit) is SelfCollision:
         i, j = link_pairs(k, state.rail)
         value = self_distances(np.array(state.origins), k)
         labels = tuple(f"{link_name(a, k)}/{link_name(b, k)}" for a, b in zip(i, j, strict=True))
-        return Measured(value, None, np.full(value.shape, limit.margin), labels,
-                        value < limit.margin + limit.influence)  # fmt: skip
+        return Measured(
+            value,
+            None,
+            np.full(value.shape, limit.margin),
+            labels,
+            value < limit.margin + limit.influence,
+        )
     if isinstance(limit, VelocityDamper):
         found = limit.distances(state)
         value = np.asarray(found.value, dtype=float)
         labels = found.describe() if found.describe is not None else ()
         safe = np.broadcast_to(np.asarray(found.safe, dtype=float), value.shape).copy()
-        return Measured(value, np.asarray(found.gradient).reshape(-1, n), safe, labels,
-                        value < limit.reach)  # fmt: skip
+        return Measured(
+            value, np.asarray(found.gradient).reshape(-1, n), safe, labels, value < limit.reach
+        )
     raise TypeError(f"{type(limit).__name__} keeps no distances")
 
 
@@ -275,12 +296,19 @@ def _heights(limit: object, state: KinematicState) -> Measured:
         return float(state.guarded[ends[i, 0] if a[:2] @ e >= -1e-9 * (e @ e) else ends[i, 1], 2])
 
     value = np.array([*state.guarded[points, 2], *(low(i) for i in links)])
-    labels = (*(f"{point_name(i, k)}/height" for i in points),
-              *(f"{link_name(i, k)}/height" for i in links))  # fmt: skip
+    labels = (
+        *(f"{point_name(i, k)}/height" for i in points),
+        *(f"{link_name(i, k)}/height" for i in links),
+    )
 
     applies = [inside(o[ends[i, 0]], o[ends[i, 1]]) for i in links]
-    return Measured(value, None, np.full(value.shape, limit.safe), labels,  # type: ignore[attr-defined]
-                    np.array([True] * len(points) + applies))  # fmt: skip
+    return Measured(
+        value,
+        None,
+        np.full(value.shape, limit.safe),
+        labels,  # type: ignore[attr-defined]
+        np.array([True] * len(points) + applies),
+    )
 
 
 def bends(a: Array, b: Array) -> tuple[Array, Array]:
@@ -366,9 +394,14 @@ def first_pieces(t: float, bend: float) -> Array:
     return np.array([[a, b] for a, b in itertools.pairwise(cut) if b > a])
 
 
-def real_clearances(obstacles: Sequence[object], frames: object, radius: float, refine: Array,
-                    closest: tuple[float, float] | None = None,
-                    jac: Array | None = None) -> tuple[Array, Array, Array, Array]:  # fmt: skip
+def real_clearances(
+    obstacles: Sequence[object],
+    frames: object,
+    radius: float,
+    refine: Array,
+    closest: tuple[float, float] | None = None,
+    jac: Array | None = None,
+) -> tuple[Array, Array, Array, Array]:
     """Each link's clearance to each obstacle as dvqp defines it (``dvqp.geometry.real_links``),
     rebuilt from other parts: the straight pieces' distances by
     :func:`dvqp.geometry.segment_distances`, their bends by :func:`bend` (sampling and
@@ -424,10 +457,12 @@ def real_clearances(obstacles: Sequence[object], frames: object, radius: float, 
         return value, t, (normal != 0.0).any(axis=-1), np.zeros((*value.shape, 0))
     gradient = np.zeros((*value.shape, jac.shape[2]))
     pairs = list(np.ndindex(value.shape))
-    start = np.array([(1 - piece[j, i, 0]) * o[ends[i, 0]] + piece[j, i, 0] * o[ends[i, 1]]
-                      for j, i in pairs]).reshape(-1, 3)  # fmt: skip
-    stop = np.array([(1 - piece[j, i, 1]) * o[ends[i, 0]] + piece[j, i, 1] * o[ends[i, 1]]
-                     for j, i in pairs]).reshape(-1, 3)  # fmt: skip
+    start = np.array(
+        [(1 - piece[j, i, 0]) * o[ends[i, 0]] + piece[j, i, 0] * o[ends[i, 1]] for j, i in pairs]
+    ).reshape(-1, 3)
+    stop = np.array(
+        [(1 - piece[j, i, 1]) * o[ends[i, 0]] + piece[j, i, 1] * o[ends[i, 1]] for j, i in pairs]
+    ).reshape(-1, 3)
     piece_bends = bends(start, stop) if pairs else (np.zeros(0), np.zeros(0))
     for r, (j, i) in enumerate(pairs):
         a, b = ends[i]
@@ -435,8 +470,9 @@ def real_clearances(obstacles: Sequence[object], frames: object, radius: float, 
         s = (t[j, i] - t0) / (t1 - t0)
         turn0, turn1 = _turn(o, jac, a, b, t0), _turn(o, jac, a, b, t1)
         z0, z1 = ((1 - x) * jac[a, 2] + x * jac[b, 2] for x in (t0, t1))
-        gradient[j, i] = (normal[j, i, 0] * radius * ((1 - s) * turn0 + s * turn1)
-                          + normal[j, i, 1] * ((1 - s) * z0 + s * z1))  # fmt: skip
+        gradient[j, i] = normal[j, i, 0] * radius * ((1 - s) * turn0 + s * turn1) + normal[
+            j, i, 1
+        ] * ((1 - s) * z0 + s * z1)
         g, w = piece_bends[0][r], piece_bends[1][r]
         if g != 0.0:
             at = _turn(o, jac, a, b, t0 + w * (t1 - t0)) - (1 - w) * turn0 - w * turn1
@@ -474,14 +510,25 @@ def _clearances(
     labels = (
         *(f"{point_name(i, k)}/obstacles[{j}]" for j in range(count) for i in range(len(jac))),
         *(f"{link_name(i, k)}/obstacles[{j}]" for j in range(count) for i in range(len(ends))),
-    )  # fmt: skip
-    return Measured(value, gradient, np.full(value.shape, limit.margin), labels,
-                    usable & (value < limit.influence))  # fmt: skip
+    )
+    return Measured(
+        value,
+        gradient,
+        np.full(value.shape, limit.margin),
+        labels,
+        usable & (value < limit.influence),
+    )
 
 
-def distance_jacobian(limit: object, robot: Robot, q: Array, radius: float,
-                      eps: float = 1e-7, refine: Array | None = None,
-                      union: Sequence[object] | None = None) -> Array:  # fmt: skip
+def distance_jacobian(
+    limit: object,
+    robot: Robot,
+    q: Array,
+    radius: float,
+    eps: float = 1e-7,
+    refine: Array | None = None,
+    union: Sequence[object] | None = None,
+) -> Array:
     """Central differences of every distance of ``limit`` at ``q`` (p, n)."""
 
     def values(v: Array) -> Array:
@@ -512,27 +559,36 @@ def verified(limit: object, state: KinematicState) -> Verified | None:
     if type(limit) is JointPositionLimit:
         q = np.array(state.q)
         names = tuple(f"joint{i + 1}" for i in range(state.n))
-        return Verified(np.concatenate([limit.q_max - q, q - limit.q_min]),
-                        np.zeros(2 * state.n), limit.tolerance, names + names,
-                        "joint position", "rad")  # fmt: skip
+        return Verified(
+            np.concatenate([limit.q_max - q, q - limit.q_min]),
+            np.zeros(2 * state.n),
+            limit.tolerance,
+            names + names,
+            "joint position",
+            "rad",
+        )
     if not isinstance(limit, VelocityDamper):
         return None
     if type(limit) is TiltLimit:
         if limit.min_tilt == 0.0:
             return None
         angle = math.asin(min(tilt_sine(state), 1.0))
-        return Verified(np.array([angle]), np.array([limit.min_tilt]), limit.tolerance,
-                        ("probe/tilt",), "tilt", "rad")  # fmt: skip
+        return Verified(
+            np.array([angle]),
+            np.array([limit.min_tilt]),
+            limit.tolerance,
+            ("probe/tilt",),
+            "tilt",
+            "rad",
+        )
     found = measure(limit, state)
     if found.value.shape[0] == 0:
         return None
     labels = found.labels or tuple(f"{limit.name}{i + 1}" for i in range(found.value.shape[0]))
-    return Verified(found.value, found.safe, limit.tolerance, labels, limit.quantity,
-                    limit.unit)  # fmt: skip
+    return Verified(found.value, found.safe, limit.tolerance, labels, limit.quantity, limit.unit)
 
 
-def worst_excess(limits: Sequence[object], start: KinematicState,
-                 state: KinematicState) -> Excess:  # fmt: skip
+def worst_excess(limits: Sequence[object], start: KinematicState, state: KinematicState) -> Excess:
     """The old rule: per value ``over = min(safe, value at start) − value``; the worst is the
     largest ``over / tolerance`` (a NaN first), the joint room ahead of the dampers."""
     worst, worst_ratio = NO_EXCESS, -math.inf
@@ -552,11 +608,19 @@ def worst_excess(limits: Sequence[object], start: KinematicState,
         if type(limit) is JointPositionLimit:
             q = float(state.q[i % state.n])
             bound = q - over[i] if i < state.n else q + over[i]
-            found = Excess(float(over[i]), now.tolerance, label, now.quantity, now.unit, q,
-                           float(bound))  # fmt: skip
+            found = Excess(
+                float(over[i]), now.tolerance, label, now.quantity, now.unit, q, float(bound)
+            )
         else:
-            found = Excess(float(over[i]), now.tolerance, label, now.quantity, now.unit,
-                           float(now.values[i]), float(over[i] + now.values[i]))  # fmt: skip
+            found = Excess(
+                float(over[i]),
+                now.tolerance,
+                label,
+                now.quantity,
+                now.unit,
+                float(now.values[i]),
+                float(over[i] + now.values[i]),
+            )
         worst, worst_ratio = found, float(ratio[i])
         if math.isnan(ratio[i]):
             break
@@ -567,6 +631,5 @@ def assert_excess(found: Excess, want: Excess, atol: float = 1e-12) -> None:
     """Two excesses agree: values to ``atol``, words exactly."""
     assert (found.label, found.quantity, found.unit) == (want.label, want.quantity, want.unit)
     assert found.tolerance == want.tolerance
-    for a, b in ((found.value, want.value), (found.actual, want.actual),
-                 (found.bound, want.bound)):  # fmt: skip
+    for a, b in ((found.value, want.value), (found.actual, want.actual), (found.bound, want.bound)):
         assert a == b or abs(a - b) <= atol, (found, want)

@@ -50,8 +50,9 @@ Array = NDArray[np.float64]
 # -- the step ---------------------------------------------------------------------------------
 
 
-def eq18(jac: Array, xdot: Array, g: Array, weights: Array | None = None,
-         damping: float = 0.0) -> Array:  # fmt: skip
+def eq18(
+    jac: Array, xdot: Array, g: Array, weights: Array | None = None, damping: float = 0.0
+) -> Array:
     """Eq. 18 in its weighted form, literally: ``J⁺ ẋ + (I − J⁺ J) W⁻¹ g`` with
     ``J⁺ = W⁻¹ Jᵀ (J W⁻¹ Jᵀ + μ² I)⁻¹`` (``W = I`` by default)."""
     n, m = jac.shape[1], jac.shape[0]
@@ -145,9 +146,13 @@ def _polygon(vertices: Array, p: Array, period: float) -> Array:
     vertices' mean (wrapped)."""
     ref = vertices[:, 0].mean()
     out = np.empty(p.shape[0])
-    _polygon_loop(np.ascontiguousarray(vertices[:, 0] - ref), np.ascontiguousarray(vertices[:, 1]),
-                  np.ascontiguousarray(wrapped(p[:, 0] - ref, period)),
-                  np.ascontiguousarray(p[:, 1]), out)  # fmt: skip
+    _polygon_loop(
+        np.ascontiguousarray(vertices[:, 0] - ref),
+        np.ascontiguousarray(vertices[:, 1]),
+        np.ascontiguousarray(wrapped(p[:, 0] - ref, period)),
+        np.ascontiguousarray(p[:, 1]),
+        out,
+    )
     return out
 
 
@@ -156,8 +161,9 @@ def point_distances(obstacles: Sequence[Shape], p: Array, period: float) -> Arra
     out = []
     for shape in obstacles:
         if type(shape) is Circle:
-            d = np.column_stack([wrapped(p[:, 0] - shape.center[0], period),
-                                 p[:, 1] - shape.center[1]])  # fmt: skip
+            d = np.column_stack(
+                [wrapped(p[:, 0] - shape.center[0], period), p[:, 1] - shape.center[1]]
+            )
             out.append(np.linalg.norm(d, axis=1) - shape.radius)
         elif type(shape) is Band:
             out.append(np.maximum(shape.z_min - p[:, 1], p[:, 1] - shape.z_max))
@@ -170,8 +176,9 @@ def point_distances(obstacles: Sequence[Shape], p: Array, period: float) -> Arra
     return np.array(out).reshape(len(out), p.shape[0])
 
 
-def link_distances(obstacles: Sequence[Shape], guarded: Array, period: float, k: int,
-                   samples: int = 401) -> Array:  # fmt: skip
+def link_distances(
+    obstacles: Sequence[Shape], guarded: Array, period: float, k: int, samples: int = 401
+) -> Array:
     """Signed distance (m) of every guarded link (of an arm with k body points) to every
     obstacle, brute force: each link sampled at ``samples`` points, then again at ``samples``
     points between the neighbours of each obstacle's closest sample: (J, L)."""
@@ -216,9 +223,14 @@ def self_distances(origins: Array, k: int) -> Array:
     order."""
     ends = guarded_links(k, origins.shape[0] > k + 1)
     i, j = link_pairs(k, origins.shape[0] > k + 1)
-    return np.array([segment_distance(origins[ends[a, 0]], origins[ends[a, 1]],
-                                      origins[ends[b, 0]], origins[ends[b, 1]])
-                     for a, b in zip(i, j, strict=True)])  # fmt: skip
+    return np.array(
+        [
+            segment_distance(
+                origins[ends[a, 0]], origins[ends[a, 1]], origins[ends[b, 0]], origins[ends[b, 1]]
+            )
+            for a, b in zip(i, j, strict=True)
+        ]
+    )
 
 
 # -- the verification -------------------------------------------------------------------------
@@ -248,29 +260,47 @@ def verified_values(limits: tuple, robot: Robot, q: Array, radius: float) -> lis
         elif kind is ObstacleDamper and len(limit.obstacles):
             points = point_distances(limit.obstacles, f.guarded[:, :2], period)
             dampers = [d for d in limits if type(d) is ObstacleDamper]
-            refine = np.array([max(d.margin for d in dampers if any(o is x for x in d.obstacles))
-                               for o in limit.obstacles])  # fmt: skip
+            refine = np.array(
+                [
+                    max(d.margin for d in dampers if any(o is x for x in d.obstacles))
+                    for o in limit.obstacles
+                ]
+            )
             union = list({id(x): x for d in dampers for x in d.obstacles}.values())
-            links = real_clearances(limit.obstacles, f, radius, refine,
-                                    closest_parts(union, f, radius))[0]  # fmt: skip
+            links = real_clearances(
+                limit.obstacles, f, radius, refine, closest_parts(union, f, radius)
+            )[0]
             values = np.concatenate([points.ravel(), links.ravel()])
             out.append(Verified(values, limit.margin, limit.tolerance, limit.quantity))
         elif kind in (SurfaceHeight, ProbeHeight):
             body = kind is SurfaceHeight
             links = [*range(f.k - 1), *([f.k] if f.rail else [])] if body else [f.k - 1]
             ends = guarded_links(f.k, f.rail)
-            lows = [chord_low(f.origins[ends[i, 0]], f.origins[ends[i, 1]], radius)[0]
-                    for i in links]  # fmt: skip
+            lows = [
+                chord_low(f.origins[ends[i, 0]], f.origins[ends[i, 1]], radius)[0] for i in links
+            ]
             heights = f.guarded[: f.k, 2] if body else f.guarded[f.k : f.k + 1, 2]
-            out.append(Verified(np.concatenate([heights, lows]), limit.safe, limit.tolerance,
-                                limit.quantity))  # fmt: skip
+            out.append(
+                Verified(
+                    np.concatenate([heights, lows]), limit.safe, limit.tolerance, limit.quantity
+                )
+            )
         elif kind is TiltLimit and limit.min_tilt > 0.0:
             angle = tilt(f)
-            out.append(Verified(np.array([min(angle, math.pi - angle)]), limit.min_tilt,
-                                limit.tolerance, limit.quantity))  # fmt: skip
+            out.append(
+                Verified(
+                    np.array([min(angle, math.pi - angle)]),
+                    limit.min_tilt,
+                    limit.tolerance,
+                    limit.quantity,
+                )
+            )
         elif kind is SelfCollision:
-            out.append(Verified(self_distances(f.origins, f.k), limit.margin, limit.tolerance,
-                                limit.quantity))  # fmt: skip
+            out.append(
+                Verified(
+                    self_distances(f.origins, f.k), limit.margin, limit.tolerance, limit.quantity
+                )
+            )
     return out
 
 
@@ -290,8 +320,9 @@ def worst_excess(start: list[Verified], now: list[Verified]) -> tuple[float, flo
 # -- optimality -------------------------------------------------------------------------------
 
 
-def active_rows(G: Array | None, h: Array | None, lb: Array, ub: Array, x: Array,
-                tol: float = 1e-7) -> Array:  # fmt: skip
+def active_rows(
+    G: Array | None, h: Array | None, lb: Array, ub: Array, x: Array, tol: float = 1e-7
+) -> Array:
     """The outward normals (rows) of the inequalities ``x`` holds within ``tol`` of equality:
     rows of ``G``, ``−e_i`` at a lower bound, ``e_i`` at an upper bound."""
     n = x.shape[0]
@@ -323,9 +354,18 @@ def nnls(M: Array, d: Array, tol: float = 1e-13) -> tuple[Array, float]:
     return z, float(np.linalg.norm(M @ z - d))
 
 
-def kkt_residual(P: Array, q: Array, A: Array, b: Array, G: Array | None, h: Array | None,
-                 lb: Array, ub: Array, x: Array,
-                 relaxed: float | None = None) -> float:  # fmt: skip
+def kkt_residual(
+    P: Array,
+    q: Array,
+    A: Array,
+    b: Array,
+    G: Array | None,
+    h: Array | None,
+    lb: Array,
+    ub: Array,
+    x: Array,
+    relaxed: float | None = None,
+) -> float:
     """How far ``x`` is from optimal for ``min ½ xᵀPx + qᵀx`` s.t. ``A x = b`` (or, if
     ``relaxed`` = ρ, with ``+ ½ ρ ‖A x − b‖²`` in the cost instead), ``G x ≤ h``,
     ``lb ≤ x ≤ ub``: the smallest ``‖∇f + Aᵀν + Σ λ_i a_i‖`` over free ν and ``λ ≥ 0`` on
@@ -335,8 +375,10 @@ def kkt_residual(P: Array, q: Array, A: Array, b: Array, G: Array | None, h: Arr
     rows = active_rows(G, h, lb, ub, x).T  # (n, a)
     if relaxed is None:  # the part of a vector that no Aᵀν cancels
         project = lambda v: v - A.T @ np.linalg.lstsq(A.T, v, rcond=None)[0]  # noqa: E731
-        target, columns = project(grad), np.column_stack([project(c) for c in rows.T] or
-                                                         [np.zeros(x.shape[0])])  # fmt: skip
+        target, columns = (
+            project(grad),
+            np.column_stack([project(c) for c in rows.T] or [np.zeros(x.shape[0])]),
+        )
     else:
         grad = grad + relaxed * A.T @ (A @ x - b)
         target, columns = grad, rows if rows.shape[1] else np.zeros((x.shape[0], 1))

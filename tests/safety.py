@@ -43,8 +43,9 @@ def clearances(scene: Scene, q: np.ndarray) -> tuple[float, float]:
     return float(min(links.min(), points.min())), float(links[:, k - 1].min())
 
 
-def real_link_distances(obstacles: Sequence[Shape], f: Frames, radius: float,
-                        samples: int = 401) -> np.ndarray:  # fmt: skip
+def real_link_distances(
+    obstacles: Sequence[Shape], f: Frames, radius: float, samples: int = 401
+) -> np.ndarray:
     """Signed distance (m) of every real link (the straight 3-D segment, each sample mapped to
     the developed view) to every obstacle, (J, L): ``samples`` samples, then ``samples`` more
     between the neighbours of each obstacle's closest one."""
@@ -111,8 +112,13 @@ def worst_breach(scene: Scene, qs: np.ndarray) -> dict[str, float]:
     c0, _ = clearances(scene, qs[0])
     h0, p0 = heights(scene, qs[0])
     t0 = tilt(scene, qs[0])
-    out = {"clearance": -math.inf, "height": -math.inf, "probe height": -math.inf,
-           "tilt": -math.inf, "joint": -math.inf}  # fmt: skip
+    out = {
+        "clearance": -math.inf,
+        "height": -math.inf,
+        "probe height": -math.inf,
+        "tilt": -math.inf,
+        "joint": -math.inf,
+    }
     for q in qs:
         if len(scene.obstacles):
             c, _ = clearances(scene, q)

@@ -12,8 +12,9 @@ from pathlib import Path
 import pytest
 
 
-def assert_a_taken_port_is_refused(start: Callable[[int], int],
-                                   capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+def assert_a_taken_port_is_refused(
+    start: Callable[[int], int], capsys: pytest.CaptureFixture[str]
+) -> None:
     """``start(port)`` on a loopback port something already listens on: exit 2 and one line
     naming the address."""
     with socket.socket() as taken:
@@ -29,8 +30,9 @@ def assert_a_taken_port_is_refused(start: Callable[[int], int],
 def serving(argv: list[str], cwd: Path) -> Iterator[subprocess.Popen[str]]:
     """The command ``argv`` running (stdout and stderr piped, text), killed if still alive at
     the end."""
-    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            cwd=cwd)  # fmt: skip
+    proc = subprocess.Popen(
+        argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=cwd
+    )
     try:
         yield proc
     finally:

@@ -86,8 +86,9 @@ def kkt_residuals(
     ), scale
 
 
-def _duality_gap(p: Problem, x: np.ndarray, y: np.ndarray | None, z: np.ndarray | None,
-                 z_box: np.ndarray | None) -> float:  # fmt: skip
+def _duality_gap(
+    p: Problem, x: np.ndarray, y: np.ndarray | None, z: np.ndarray | None, z_box: np.ndarray | None
+) -> float:
     """qpbenchmark's gap over the rows and bounds with a finite right-hand side."""
     total = float(x @ p.P @ x + p.q @ x)
     if y is not None and p.b is not None:

@@ -44,9 +44,15 @@ def run(dt: float, backend: str = "daqp", **kw: object) -> dvqp.Trajectory:
     resolver = make_resolver(backend, scene.spec())
     c = scene_commands(scene)
     return dvqp.simulate(
-        scene.robot, scene.pipe_radius, resolver, scene.q0, c.velocity, scene.dt,
-        obstacles=scene.obstacles, **kw,  # type: ignore[arg-type]
-    )  # fmt: skip
+        scene.robot,
+        scene.pipe_radius,
+        resolver,
+        scene.q0,
+        c.velocity,
+        scene.dt,
+        obstacles=scene.obstacles,
+        **kw,  # type: ignore[arg-type]
+    )
 
 
 def test_a_large_step_that_breaks_a_limit_is_split_and_then_keeps_it() -> None:
@@ -113,8 +119,12 @@ def in_the_way(robot: Robot) -> ObstacleSet:
 def clearance(robot: Robot, obstacles: ObstacleSet, q: np.ndarray) -> float:
     """Smallest clearance of the guarded parts at ``q`` (oracle: Pinocchio, brute force)."""
     f = frames(robot, q, PIPE_RADIUS)
-    return float(min(point_distances(obstacles, f.guarded[:, :2], PERIOD).min(),
-                     link_distances(obstacles, f.guarded, PERIOD, f.k).min()))  # fmt: skip
+    return float(
+        min(
+            point_distances(obstacles, f.guarded[:, :2], PERIOD).min(),
+            link_distances(obstacles, f.guarded, PERIOD, f.k).min(),
+        )
+    )
 
 
 def along(robot: Robot, obstacles: ObstacleSet, a: np.ndarray, b: np.ndarray) -> float:
@@ -206,8 +216,14 @@ def test_a_split_step_is_also_checked_along_its_straight_motion(robot: Robot) ->
     beyond = Q_A + 2.0 * (Q_B - Q_A)
     far = ObstacleSet([Obstacle(frames(robot, beyond, PIPE_RADIUS).guarded[-1, :2], 0.01)])
     assert clearance(robot, far, beyond) < -0.009
-    assert min(along(robot, far, Q_A, DETOUR), along(robot, far, DETOUR, Q_B),
-               along(robot, far, Q_A, Q_B)) > 0.005  # fmt: skip
+    assert (
+        min(
+            along(robot, far, Q_A, DETOUR),
+            along(robot, far, DETOUR, Q_B),
+            along(robot, far, Q_A, Q_B),
+        )
+        > 0.005
+    )
     free = Scripted(robot, far, lambda q, dt: beyond if dt == 1.0 else script(q, dt))
     moved = advance(free, np.zeros(4), 1.0)
     assert moved.step.success and moved.substeps == 2 and moved.step.status == "optimal"

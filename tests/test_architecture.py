@@ -110,10 +110,11 @@ def import_graph(package: str) -> dict[str, set[str]]:
     paths = modules(package)
     names = {module_name(p) for p in paths}
     graph = {
-        module_name(p): imports_of(p.read_text(encoding="utf-8"), module_name(p),
-                                   p.name == "__init__.py", names)
+        module_name(p): imports_of(
+            p.read_text(encoding="utf-8"), module_name(p), p.name == "__init__.py", names
+        )
         for p in paths
-    }  # fmt: skip
+    }
     if package == "solvers":  # the registry imports the direct adapters by name
         from solvers.registry import DIRECT
 
@@ -156,12 +157,17 @@ def test_imports_in_functions_under_type_checking_and_relative_ones_count() -> N
     )
     names = {module_name(p) for p in modules("dvqp")}
     found = imports_of(source, "dvqp.geometry.shapes.probe", False, names)
-    assert found == {"dvqp.step", "dvqp.geometry.proximity", "dvqp.planning",
-                     "dvqp.geometry.shapes.band"}  # fmt: skip
+    assert found == {
+        "dvqp.step",
+        "dvqp.geometry.proximity",
+        "dvqp.planning",
+        "dvqp.geometry.shapes.band",
+    }
     # a module of another package runs that package's __init__ first
     assert imports_of("from dvqp.cli.report import x", "dvqp.bench.a", False, names) == {
-        "dvqp.cli.report", "dvqp.cli"
-    }  # fmt: skip
+        "dvqp.cli.report",
+        "dvqp.cli",
+    }
     cycle = find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}})
     assert cycle == ["a", "b", "c", "a"]
 

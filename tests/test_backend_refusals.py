@@ -15,8 +15,9 @@ from dvqp.cli import main
 from dvqp.comparison import summarize
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
-INFEASIBLE = solvers.Problem(np.eye(3), np.zeros(3), G=np.array([[1.0, 0, 0], [-1.0, 0, 0]]),
-                             h=np.array([-1.0, -1.0]))  # fmt: skip
+INFEASIBLE = solvers.Problem(
+    np.eye(3), np.zeros(3), G=np.array([[1.0, 0, 0], [-1.0, 0, 0]]), h=np.array([-1.0, -1.0])
+)
 """x1 <= -1 and x1 >= 1."""
 
 
@@ -35,17 +36,23 @@ def test_no_backend_warns_of_an_infeasible_problem_and_its_refusal_is_named(name
 
 def test_a_refusal_is_named_from_the_status_word_never_accepted_by_it() -> None:
     answer = np.array([5.0, 0.0, 0.0])  # breaks x1 <= -1
-    cases = {"PROXQP_MAX_ITER_REACHED": "iteration limit", "maximum iterations reached":
-             "iteration limit", "time limit reached": "time limit", "PrimalInfeasible":
-             "infeasible", "solved": "inaccurate"}  # fmt: skip
+    cases = {
+        "PROXQP_MAX_ITER_REACHED": "iteration limit",
+        "maximum iterations reached": "iteration limit",
+        "time limit reached": "time limit",
+        "PrimalInfeasible": "infeasible",
+        "solved": "inaccurate",
+    }
     for status, kind in cases.items():
-        solution = solvers.Solution.checked(INFEASIBLE, answer, backend="b", tolerance=1e-6,
-                                            status=status)  # fmt: skip
+        solution = solvers.Solution.checked(
+            INFEASIBLE, answer, backend="b", tolerance=1e-6, status=status
+        )
         assert (solution.found, solution.refusal) == (False, kind), status
     assert set(cases.values()) <= set(solvers.REFUSALS)
     feasible = solvers.Problem(np.eye(3), np.zeros(3))
-    solution = solvers.Solution.checked(feasible, np.zeros(3), backend="b", tolerance=1e-6,
-                                        status="PROXQP_MAX_ITER_REACHED")  # fmt: skip
+    solution = solvers.Solution.checked(
+        feasible, np.zeros(3), backend="b", tolerance=1e-6, status="PROXQP_MAX_ITER_REACHED"
+    )
     assert (solution.found, solution.refusal) == (True, "")  # the check decides, not the word
 
 

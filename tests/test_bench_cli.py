@@ -61,8 +61,20 @@ def test_bench_prints_a_summary_and_writes_json_csv_and_scene_files(
 ) -> None:
     out = tmp_path / "a.json"
     csv_out, scenes = str(tmp_path / "a.csv"), str(tmp_path / "s")
-    code = bench("--count", "3", "--seed", "5", "--backends", "pinv,daqp", "--json", str(out),
-                 "--csv", csv_out, "--save-scenes", scenes)  # fmt: skip
+    code = bench(
+        "--count",
+        "3",
+        "--seed",
+        "5",
+        "--backends",
+        "pinv,daqp",
+        "--json",
+        str(out),
+        "--csv",
+        csv_out,
+        "--save-scenes",
+        scenes,
+    )
     assert code == 0
     printed = capsys.readouterr().out
     assert printed.splitlines()[0].split()[:4] == ["backend", "runs", "ok", "success"]
@@ -74,13 +86,28 @@ def test_bench_prints_a_summary_and_writes_json_csv_and_scene_files(
         (i, b) for i in range(3) for b in ("pinv", "daqp")
     ]
     for r in doc["results"]:
-        assert {"scene", "backend", "success", "final_tool", "median_step_us", "mean_step_us",
-                "mean_solve_us", "parallel"} <= set(r)  # fmt: skip
+        assert {
+            "scene",
+            "backend",
+            "success",
+            "final_tool",
+            "median_step_us",
+            "mean_step_us",
+            "mean_solve_us",
+            "parallel",
+        } <= set(r)
         assert r["parallel"] is False and len(r["final_tool"]) == 4
     for figures in doc["summary"].values():
-        assert {"success_rate", "failed_steps", "relaxed_steps", "step_time_sgm_ratio",
-                "solve_time_sgm_ratio", "worst_limit_excess", "worst_task_error",
-                "max_distance_to_qp_median_m"} <= set(figures)  # fmt: skip
+        assert {
+            "success_rate",
+            "failed_steps",
+            "relaxed_steps",
+            "step_time_sgm_ratio",
+            "solve_time_sgm_ratio",
+            "worst_limit_excess",
+            "worst_task_error",
+            "max_distance_to_qp_median_m",
+        } <= set(figures)
     with open(tmp_path / "a.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
     assert len(rows) == 6 and rows[1]["backend"] == "daqp" and rows[1]["parallel"] == "false"
@@ -162,8 +189,21 @@ def test_a_local_pool_gives_the_same_outcomes_marked_parallel(tmp_path: Path) ->
 
     one, two = tmp_path / "one.json", tmp_path / "two.json"
     assert bench("--count", "2", "--seed", "4", "--backends", "pinv", "--json", str(one)) == 0
-    assert bench("--count", "2", "--seed", "4", "--backends", "pinv", "--json", str(two),
-                 "--workers", "2") == 0  # fmt: skip
+    assert (
+        bench(
+            "--count",
+            "2",
+            "--seed",
+            "4",
+            "--backends",
+            "pinv",
+            "--json",
+            str(two),
+            "--workers",
+            "2",
+        )
+        == 0
+    )
     a, b = strict_json(one), strict_json(two)
     assert outcome_differences(a["results"], b["results"]) == []
     assert b["execution"]["parallel"] is True and all(r["parallel"] for r in b["results"])
@@ -189,10 +229,23 @@ def test_a_real_sigint_stops_cleanly_and_keeps_what_finished(tmp_path: Path) -> 
     # takes longer than the wait below, and no scene would have finished when Ctrl-C comes
     warm = [sys.executable, "-m", "dvqp", "bench", "--count", "1", "--backends", "pinv"]
     assert subprocess.run(warm, capture_output=True, timeout=300).returncode == 0
-    argv = ["bench", "--count", "400", "--backends", "pinv", "--json", str(out),
-            "--save-scenes", str(scenes)]  # fmt: skip
-    proc = subprocess.Popen([sys.executable, "-m", "dvqp", *argv], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    argv = [
+        "bench",
+        "--count",
+        "400",
+        "--backends",
+        "pinv",
+        "--json",
+        str(out),
+        "--save-scenes",
+        str(scenes),
+    ]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "dvqp", *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     deadline = time.monotonic() + 60.0
     while not scenes.is_dir() and time.monotonic() < deadline:  # written as the runs start
         time.sleep(0.1)

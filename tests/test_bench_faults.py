@@ -32,8 +32,9 @@ def start(*argv: str, script: str | None = None) -> subprocess.Popen[str]:
     """``dvqp bench --seed 3 --backends pinv,daqp ARGV`` in a new process (through ``script``,
     Python run before the command line, if given)."""
     cmd = BENCH if script is None else [sys.executable, "-c", script, *BENCH[3:]]
-    return subprocess.Popen([*cmd, *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=ENV)  # fmt: skip
+    return subprocess.Popen(
+        [*cmd, *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV
+    )
 
 
 def scenes_in(partial: Path, at_least: int, timeout: float = 60.0) -> list[dict]:
@@ -82,8 +83,9 @@ def test_results_are_on_disk_scene_by_scene_even_if_the_bench_is_killed(tmp_path
 
 def test_a_killed_pool_worker_costs_nothing_its_scene_is_run_again(tmp_path: Path) -> None:
     out = tmp_path / "a.json"
-    proc = start("--count", "16", "--workers", "2", "--json", str(out), "--csv",
-                 str(tmp_path / "a.csv"))  # fmt: skip
+    proc = start(
+        "--count", "16", "--workers", "2", "--json", str(out), "--csv", str(tmp_path / "a.csv")
+    )
     scenes_in(tmp_path / "a.json.partial", 1)  # the first, run here: the pool starts next
     deadline = time.monotonic() + 30.0
     while not (workers := children(proc.pid)) and time.monotonic() < deadline:
@@ -159,11 +161,20 @@ def test_ctrl_c_stops_a_pool_bench_at_once_and_keeps_what_finished(tmp_path: Pat
 def scheduler() -> Iterator[tuple[str, list[subprocess.Popen[bytes]]]]:
     """A Dask scheduler (here) and two worker processes without a nanny."""
     dd = pytest.importorskip("dask.distributed")
-    with dd.LocalCluster(n_workers=0, processes=False, protocol="tcp",
-                         dashboard_address=None) as cluster:  # fmt: skip
+    with dd.LocalCluster(
+        n_workers=0, processes=False, protocol="tcp", dashboard_address=None
+    ) as cluster:
         address = cluster.scheduler_address
-        cmd = [sys.executable, "-m", "distributed.cli.dask_worker", address, "--no-nanny",
-               "--nthreads", "1", "--no-dashboard"]  # fmt: skip
+        cmd = [
+            sys.executable,
+            "-m",
+            "distributed.cli.dask_worker",
+            address,
+            "--no-nanny",
+            "--nthreads",
+            "1",
+            "--no-dashboard",
+        ]
         workers = [subprocess.Popen(cmd, stderr=subprocess.DEVNULL, env=ENV) for _ in range(2)]
         try:
             with dd.Client(address) as client:

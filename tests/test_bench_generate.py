@@ -85,8 +85,12 @@ def test_toml_text_writes_exact_numbers_and_refuses_nan() -> None:
     }
     text = dumps(doc, "two\nlines")
     assert text.startswith("# two\n# lines\n")
-    assert tomllib.loads(text) == {"name": 'a "b"', "flag": True, "n": 3,
-                                   "pipe": {"radius": 0.1 + 0.2},
-                                   "obstacles": [{"shape": "band", "z": [0.4, 0.45]}]}  # fmt: skip
+    assert tomllib.loads(text) == {
+        "name": 'a "b"',
+        "flag": True,
+        "n": 3,
+        "pipe": {"radius": 0.1 + 0.2},
+        "obstacles": [{"shape": "band", "z": [0.4, 0.45]}],
+    }
     with pytest.raises(ParameterError):
         value_text(float("nan"))

@@ -23,10 +23,22 @@ from dvqp.errors import ParameterError
 
 def row(scene: str, backend: str, step: float | None, solve: float | None, **more: Any) -> dict:
     """A result row with the keys the summary reads."""
-    base = {"index": int(scene[-1]), "scene": scene, "backend": backend, "success": True,
-            "steps": 100, "failures": 0, "relaxed": 0, "substepped": 0, "error": None,
-            "mean_step_us": step, "mean_solve_us": solve, "max_limit_excess": 0.0,
-            "max_task_error": 1e-15, "final_tool": [0.3, 0.35, 0.08, 0.0]}  # fmt: skip
+    base = {
+        "index": int(scene[-1]),
+        "scene": scene,
+        "backend": backend,
+        "success": True,
+        "steps": 100,
+        "failures": 0,
+        "relaxed": 0,
+        "substepped": 0,
+        "error": None,
+        "mean_step_us": step,
+        "mean_solve_us": solve,
+        "max_limit_excess": 0.0,
+        "max_task_error": 1e-15,
+        "final_tool": [0.3, 0.35, 0.08, 0.0],
+    }
     return {**base, **more}
 
 
@@ -45,13 +57,27 @@ def test_the_shifted_geometric_mean_matches_a_hand_computation() -> None:
 
 def test_backends_are_compared_on_the_scenes_every_backend_ran() -> None:
     rows = [
-        row("s0", "pinv", 100.0, 10.0), row("s0", "daqp", 300.0, 200.0),
-        row("s1", "pinv", 200.0, 20.0), row("s1", "daqp", 500.0, 400.0),
+        row("s0", "pinv", 100.0, 10.0),
+        row("s0", "daqp", 300.0, 200.0),
+        row("s1", "pinv", 200.0, 20.0),
+        row("s1", "daqp", 500.0, 400.0),
         row("s2", "pinv", 100.0, 10.0),  # daqp raised on s2: no timing, s2 left out
-        row("s2", "daqp", None, None, success=False, steps=None, failures=None,
-            relaxed=None, substepped=None, final_tool=None, error="boom",
-            max_limit_excess=None, max_task_error=None),
-    ]  # fmt: skip
+        row(
+            "s2",
+            "daqp",
+            None,
+            None,
+            success=False,
+            steps=None,
+            failures=None,
+            relaxed=None,
+            substepped=None,
+            final_tool=None,
+            error="boom",
+            max_limit_excess=None,
+            max_task_error=None,
+        ),
+    ]
     s = summarize_backends(rows, ["pinv", "daqp"], shift=10.0)
     pinv = math.sqrt(110 * 210) - 10
     daqp = math.sqrt(310 * 510) - 10
@@ -94,8 +120,9 @@ def test_qp_disagreement_is_the_largest_spread_among_successful_qp_runs() -> Non
         row("s0", "daqp", 1, 1, final_tool=[0.3, 0.35, 0.08, 0.0]),
         row("s0", "osqp", 1, 1, final_tool=[0.3, 0.35 + 3e-6, 0.08 + 4e-6, 0.1]),
         row("s0", "clarabel", 1, 1, final_tool=[1.0, 1.0, 1.0, 0.0], success=False),
-        row("s1", "daqp", 1, 1), row("s1", "osqp", 1, 1),
-    ]  # fmt: skip
+        row("s1", "daqp", 1, 1),
+        row("s1", "osqp", 1, 1),
+    ]
     d = qp_disagreement(rows)
     assert d["max_spread_m"] == pytest.approx(5e-6)
     assert d["scene"] == "s0" and d["backends"] == ["daqp", "osqp"]
@@ -123,8 +150,13 @@ def test_json_and_csv_of_a_suite_hold_no_nan() -> None:
     suite = make_suite(rows, ["pinv"], seed=3, count=1, where=Where("local", 4))
     doc = json.loads(bench_json(suite))
     assert doc["results"][0]["min_clearance"] is None and doc["results"][0]["parallel"] is True
-    assert doc["execution"] == {"kind": "local", "workers": 4, "scheduler": None,
-                                "startup": [], "parallel": True}  # fmt: skip
+    assert doc["execution"] == {
+        "kind": "local",
+        "workers": 4,
+        "scheduler": None,
+        "startup": [],
+        "parallel": True,
+    }
     assert {"results", "summary", "machine", "versions", "seed", "count"} <= set(doc)
     lines = rows_to_csv(suite).splitlines()
     assert len(lines) == 2 and "nan" not in lines[1].lower() and "inf" not in lines[1].lower()

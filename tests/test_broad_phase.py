@@ -35,8 +35,9 @@ def measured(case: Case, state: KinematicState, far: float) -> ProximityBuffers:
     near = ProximityBuffers.sized(len(shapes), state.guarded.shape[0], ends)
     chain = np.ascontiguousarray(state.guarded)
     measure_chain(as_struct(packed), chain, as_struct(near))
-    real_links(as_struct(packed), chain, np.array(state.origins), case.radius, state.k,
-               as_struct(near))  # fmt: skip
+    real_links(
+        as_struct(packed), chain, np.array(state.origins), case.radius, state.k, as_struct(near)
+    )
     penalties(packed.size, as_struct(near))
     assert not near.point_penalty[near.skipped].any()  # not written: no repulsion computed
     skipped = near.skipped  # their rows: the bound (the real links' less their bend)
@@ -63,7 +64,8 @@ def test_rows_that_may_matter_are_exact_and_the_others_below_the_truth(
         skipped += int(broad.skipped.sum())
         k = state.k  # the probe and its holder
         assert min(exact.point_distance[:, k].min(), exact.real_distance[:, k - 1].min()) == min(
-            broad.point_distance[:, k].min(), broad.real_distance[:, k - 1].min())  # fmt: skip
+            broad.point_distance[:, k].min(), broad.real_distance[:, k - 1].min()
+        )
     if spread > 0.1:
         assert proxies > 0 and skipped > 0  # the broad phase did skip rows and obstacles
 

@@ -38,8 +38,9 @@ def tight_rows(s: Scene, traj: Trajectory, tol: float = 1e-6) -> Counter[str]:
             assert isinstance(rows, Constraint)
             slack = rows.h - rows.G @ traj.qdot[k]
             assert slack.min(initial=0.0) > -tol, f"step {k} breaks a row"
-            tight.update(label for label, value in zip(rows.labels, slack, strict=True)
-                         if value < tol)  # fmt: skip
+            tight.update(
+                label for label, value in zip(rows.labels, slack, strict=True) if value < tol
+            )
     return tight
 
 

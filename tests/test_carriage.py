@@ -67,8 +67,9 @@ def test_the_summary_names_the_carriage_link(capsys: pytest.CaptureFixture[str])
 def test_the_carriage_link_s_rows_are_minus_the_gradient_of_its_clearance() -> None:
     s = scene("carriage-clamp")
     limit = next(lim for lim in s.spec().limits if isinstance(lim, ObstacleDamper))
-    stepper = dvqp.Stepper(s.robot, s.pipe_radius, dvqp.QPResolver(s.spec(), "daqp"), s.q0,
-                           s.dt, s.obstacles)  # fmt: skip
+    stepper = dvqp.Stepper(
+        s.robot, s.pipe_radius, dvqp.QPResolver(s.spec(), "daqp"), s.q0, s.dt, s.obstacles
+    )
     stepper.start(s.q0)
     rows = damper_rows(stepper, limit, s.q0, fd=True)
     assert any(label.startswith("carriage/") for label in rows.labels)

@@ -153,18 +153,59 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
     assert code == 0
     captured = capsys.readouterr()
     lines = captured.out.splitlines()
-    assert lines[0].split() == ["scene", "backend", "ok", "steps", "med", "us", "p95", "us",
-                                "solver", "us", "rest", "us", "iters", "x", "pinv", "task",
-                                "err", "clearance", "m", "closest", "self", "m",
-                                "qdd", "excess", "q",
-                                "viol", "rad", "qd", "viol", "rad/s", "slowed", "relaxed",
-                                "path", "dev", "m", "refused",
-                                "r_prim", "r_dual", "gap", "split",
-                                "fails", "end", "qd", "brake", "s"]  # fmt: skip
+    assert lines[0].split() == [
+        "scene",
+        "backend",
+        "ok",
+        "steps",
+        "med",
+        "us",
+        "p95",
+        "us",
+        "solver",
+        "us",
+        "rest",
+        "us",
+        "iters",
+        "x",
+        "pinv",
+        "task",
+        "err",
+        "clearance",
+        "m",
+        "closest",
+        "self",
+        "m",
+        "qdd",
+        "excess",
+        "q",
+        "viol",
+        "rad",
+        "qd",
+        "viol",
+        "rad/s",
+        "slowed",
+        "relaxed",
+        "path",
+        "dev",
+        "m",
+        "refused",
+        "r_prim",
+        "r_dual",
+        "gap",
+        "split",
+        "fails",
+        "end",
+        "qd",
+        "brake",
+        "s",
+    ]
     assert [line.split()[:4] for line in lines[2:6]] == [
-        ["one", "pinv", "yes", "21"], ["one", "daqp", "yes", "23"],
-        ["two", "pinv", "yes", "21"], ["two", "daqp", "yes", "23"],
-    ]  # fmt: skip
+        ["one", "pinv", "yes", "21"],
+        ["one", "daqp", "yes", "23"],
+        ["two", "pinv", "yes", "21"],
+        ["two", "daqp", "yes", "23"],
+    ]
     assert no_traceback(captured.err)
     doc = json.loads(js.read_text(encoding="utf-8"), parse_constant=pytest.fail)  # no NaN/inf
     assert set(doc["machine"]) == {"platform", "processor", "cpu_count", "python"}
@@ -172,10 +213,22 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
     assert doc["backends"] == ["pinv", "daqp"] and len(doc["results"]) == 4
     first = doc["results"][0]
     assert first["ratio_to_pinv"] == 1.0 and first["success"] is True and first["steps"] == 21
-    keys = ["median_step_us", "p95_step_us", "max_task_error", "min_clearance",
-            "min_probe_clearance", "min_tilt", "max_limit_excess", "max_joint_limit_violation",
-            "max_velocity_limit_violation", "failures", "relaxed", "substepped",
-            "braking_time", "refused_calls"]  # fmt: skip
+    keys = [
+        "median_step_us",
+        "p95_step_us",
+        "max_task_error",
+        "min_clearance",
+        "min_probe_clearance",
+        "min_tilt",
+        "max_limit_excess",
+        "max_joint_limit_violation",
+        "max_velocity_limit_violation",
+        "failures",
+        "relaxed",
+        "substepped",
+        "braking_time",
+        "refused_calls",
+    ]
     for key in keys:
         assert isinstance(first[key], (int, float)), key
     assert [r["final_joint_speed"] for r in doc["results"]] == [0.0] * 4  # every run at rest
@@ -300,9 +353,11 @@ def test_an_output_that_is_a_directory_exits_2_before_the_run(
 
 @pytest.mark.parametrize("suffix", [".npz", ".csv"])
 def test_a_full_disk_while_saving_is_one_line_and_leaves_nothing(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
     suffix: str,
-) -> None:  # fmt: skip
+) -> None:
     def full(fh, *args: object, **kwargs: object) -> None:  # type: ignore[no-untyped-def]
         fh.write(b"half a file")
         raise OSError(errno.ENOSPC, "No space left on device")
@@ -373,11 +428,23 @@ LONG = "[[motion.jog]]\nduration = 7500.0\nvelocity = [0.0, 0.0, 0.0, 0.0]"  # 1
 
 
 @pytest.mark.parametrize(
-    "args", [["plan", "{scene}", "--backend", "pinv", "-o", "{tmp}/t.npz"],
-             ["compare", "{scene}", "{tmp}/two.toml", "--backends", "pinv,daqp", "--jobs", "2",
-              "--json", "{tmp}/c.json"]],
+    "args",
+    [
+        ["plan", "{scene}", "--backend", "pinv", "-o", "{tmp}/t.npz"],
+        [
+            "compare",
+            "{scene}",
+            "{tmp}/two.toml",
+            "--backends",
+            "pinv,daqp",
+            "--jobs",
+            "2",
+            "--json",
+            "{tmp}/c.json",
+        ],
+    ],
     ids=["plan", "compare --jobs 2"],
-)  # fmt: skip
+)
 @pytest.mark.skipif(
     not sys.platform.startswith("linux"), reason="workers are forked (inherit the handler) on Linux"
 )
@@ -385,8 +452,12 @@ def test_a_real_sigint_stops_cleanly_with_exit_130(tmp_path: Path, args: list[st
     scene = write_scene(tmp_path, motion=LONG)
     write_scene(tmp_path, "two", motion=LONG)
     argv = [a.format(scene=scene, tmp=tmp_path) for a in args]
-    proc = subprocess.Popen([sys.executable, "-m", "dvqp", *argv], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "dvqp", *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     assert proc.stderr is not None
     note = proc.stderr.readline()  # announced before the run starts
     assert note.startswith(f"dvqp: note: {scene}: about 1.5e+06 steps"), note

@@ -29,8 +29,10 @@ from solvers.jit import SoftCache, _EntryFiles, njit
 from tests.test_cli import write_scene
 
 ROOT = Path(__file__).resolve().parent.parent
-NOTE = re.compile(r"dvqp: note: compile cache entry (.+) could not be read \((.+)\): "
-                  r"discarded, recompiling")  # fmt: skip
+NOTE = re.compile(
+    r"dvqp: note: compile cache entry (.+) could not be read \((.+)\): "
+    r"discarded, recompiling"
+)
 
 
 def stable(out: str) -> list[str]:
@@ -165,20 +167,30 @@ def test_every_compiled_function_of_dvqp_and_solvers_has_the_soft_cache() -> Non
         pkg = importlib.import_module(package)
         for info in pkgutil.walk_packages(pkg.__path__, f"{package}."):
             module = importlib.import_module(info.name)
-            dispatchers += [v for v in vars(module).values() if isinstance(v, Dispatcher)
-                            and v.py_func.__module__ == info.name]  # fmt: skip
+            dispatchers += [
+                v
+                for v in vars(module).values()
+                if isinstance(v, Dispatcher) and v.py_func.__module__ == info.name
+            ]
     assert len(dispatchers) > 60
     assert all(isinstance(d._cache, SoftCache) for d in dispatchers)
 
 
 def test_the_command_line_sees_every_module_with_compiled_functions() -> None:
-    probe = ("import dvqp.cli.main\nfrom solvers.jit import CACHES\n"
-             "print('\\n'.join(sorted({c.source for c in CACHES})))")  # fmt: skip
-    run = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
-                         cwd=ROOT, check=True)  # fmt: skip
+    probe = (
+        "import dvqp.cli.main\nfrom solvers.jit import CACHES\n"
+        "print('\\n'.join(sorted({c.source for c in CACHES})))"
+    )
+    run = subprocess.run(
+        [sys.executable, "-c", probe], capture_output=True, text=True, cwd=ROOT, check=True
+    )
     kernels = re.compile(r"^@(njit|compiled_on_first_call)\b", re.MULTILINE)
-    expected = {str(p) for pkg in ("dvqp", "solvers") for p in (ROOT / pkg).rglob("*.py")
-                if kernels.search(p.read_text())}  # fmt: skip
+    expected = {
+        str(p)
+        for pkg in ("dvqp", "solvers")
+        for p in (ROOT / pkg).rglob("*.py")
+        if kernels.search(p.read_text())
+    }
     assert set(run.stdout.split()) == expected
 
 
@@ -190,13 +202,20 @@ def test_cache_clear_removes_dvqp_entries_only_and_says_how_many(
     mine = SoftCache(_twice)  # a cached function outside dvqp and solvers
     monkeypatch.setattr(solvers.jit, "CACHES", [*caches, mine])
     step, solver, other = (Path(c.cache_path) for c in (*caches, mine))
-    removed = {step / "stages.evaluate-44.py311.nbi": 100,
-               step / "stages.evaluate-44.py311.1.nbc": 1000,
-               step / "stages.old-9.py311.2.nbc": 10,  # an older line's orphan
-               step / "stages.evaluate-44.py311.nbi.tmp.0a1b": 5,  # a write cut short
-               solver / "_fast.x-1.py311.nbi": 7}  # fmt: skip
-    kept = [step / "engine.run-3.py311.nbi", step / "stages.cpython-311.pyc", step / "notes.txt",
-            solver / "registry.nbc", other / "test_compile_cache._twice-1.py311.nbi"]  # fmt: skip
+    removed = {
+        step / "stages.evaluate-44.py311.nbi": 100,
+        step / "stages.evaluate-44.py311.1.nbc": 1000,
+        step / "stages.old-9.py311.2.nbc": 10,  # an older line's orphan
+        step / "stages.evaluate-44.py311.nbi.tmp.0a1b": 5,  # a write cut short
+        solver / "_fast.x-1.py311.nbi": 7,
+    }
+    kept = [
+        step / "engine.run-3.py311.nbi",
+        step / "stages.cpython-311.pyc",
+        step / "notes.txt",
+        solver / "registry.nbc",
+        other / "test_compile_cache._twice-1.py311.nbi",
+    ]
     for path, size in [*removed.items(), *((p, 3) for p in kept)]:
         path.write_bytes(b"x" * size)
     assert main(["cache", "path"]) == 0
@@ -226,8 +245,10 @@ def test_a_plan_over_a_damaged_cache_exits_0_with_a_note_and_the_next_runs_clean
     env, argv, expected = filled
     cache = Path(env["NUMBA_CACHE_DIR"])
     (struct,) = cache.glob("workspace_*")
-    damaged = [next(cache.glob("kinematics_*/model.kinematics-*.nbi")),
-               *(next(struct.glob(f"struct._make-*.{k}.nbc")) for k in (1, 2, 3))]  # fmt: skip
+    damaged = [
+        next(cache.glob("kinematics_*/model.kinematics-*.nbi")),
+        *(next(struct.glob(f"struct._make-*.{k}.nbc")) for k in (1, 2, 3)),
+    ]
     cut(damaged[0])
     garble(damaged[1])
     damaged[2].write_bytes(b"")

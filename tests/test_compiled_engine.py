@@ -62,14 +62,19 @@ def scaled_commands(s: dvqp.Scene, traj: dvqp.Trajectory) -> tuple[np.ndarray, .
     n, k = c.velocity.shape[0], traj.brake_start
     u = traj.path_time / s.dt
     span = np.minimum(1.0, n - u[:k])
-    at = lambda v: np.column_stack([np.interp(v, np.arange(n + 1), col)  # noqa: E731
-                                    for col in c.reference.T])  # fmt: skip
+
+    def at(v):
+        return np.column_stack([np.interp(v, np.arange(n + 1), col) for col in c.reference.T])
+
     v = (at(u[:k] + span) - at(u[:k])) / s.dt
     xdot = v + c.feedback_gain * dv_error(at(u[:k]), traj.tool[:k], s.pipe_radius)
     rate = (u[1 : k + 1] - u[:k]) / span
     still = np.zeros((traj.n_steps - k, 4))
-    return (np.vstack([xdot, still]), np.vstack([v, still]),
-            np.concatenate([rate, np.ones(traj.n_steps - k)]))  # fmt: skip
+    return (
+        np.vstack([xdot, still]),
+        np.vstack([v, still]),
+        np.concatenate([rate, np.ones(traj.n_steps - k)]),
+    )
 
 
 def slowed_residual(p: object, x: np.ndarray, v: np.ndarray, rate: float, rho: float) -> float:
@@ -79,14 +84,27 @@ def slowed_residual(p: object, x: np.ndarray, v: np.ndarray, rate: float, rho: f
     P = np.zeros((n + 1, n + 1))
     P[:n, :n], P[n, n] = p.P, w  # type: ignore[attr-defined]
     G = None if p.G is None else np.column_stack([p.G, np.zeros(p.G.shape[0])])  # type: ignore[attr-defined]
-    return kkt_residual(P, np.append(p.q, -w), np.column_stack([p.A, -v]), p.b - v, G, p.h,  # type: ignore[attr-defined]
-                        np.append(p.lb, 0.0), np.append(p.ub, 1.0), np.append(x, rate))  # type: ignore[attr-defined]  # fmt: skip
+    return kkt_residual(
+        P,
+        np.append(p.q, -w),
+        np.column_stack([p.A, -v]),
+        p.b - v,
+        G,
+        p.h,  # type: ignore[attr-defined]
+        np.append(p.lb, 0.0),
+        np.append(p.ub, 1.0),
+        np.append(x, rate),
+    )  # type: ignore[attr-defined]
 
 
 def checked_samples(traj: dvqp.Trajectory) -> list[int]:
     """Every 40th sample, the last and the extremes of the recorded figures."""
-    extremes = (np.argmin(traj.min_clearance), np.argmin(traj.self_distance),
-                np.argmax(traj.limit_excess), np.argmin(traj.probe_clearance))  # fmt: skip
+    extremes = (
+        np.argmin(traj.min_clearance),
+        np.argmin(traj.self_distance),
+        np.argmax(traj.limit_excess),
+        np.argmin(traj.probe_clearance),
+    )
     return sorted({*range(0, traj.n_steps + 1, 40), traj.n_steps, *map(int, extremes)})
 
 
@@ -102,16 +120,18 @@ def test_every_sample_of_a_run_is_the_state_its_joints_reach(name: str, backend:
     s, traj = scene(name), run(name, backend)
     R, period = s.pipe_radius, 2.0 * math.pi * s.pipe_radius
     scale = max(1.0, float(np.abs(traj.q).max()))
-    np.testing.assert_allclose(traj.q[1:], traj.q[:-1] + s.dt * traj.qdot, rtol=0,
-                               atol=1e-13 * scale)  # fmt: skip
+    np.testing.assert_allclose(
+        traj.q[1:], traj.q[:-1] + s.dt * traj.qdot, rtol=0, atol=1e-13 * scale
+    )
     for k in checked_samples(traj):
         f = frames(s.robot, traj.q[k], R)
         np.testing.assert_allclose(wrapped(traj.tool[k, 0] - f.tool[0], period), 0.0, atol=1e-12)
         np.testing.assert_allclose(traj.tool[k, 1:3], f.tool[1:3], rtol=0, atol=1e-12)
         assert wrapped(traj.tool[k, 3] - f.tool[3], 2 * math.pi) == pytest.approx(0.0, abs=1e-12)
         points = traj.points[k]
-        np.testing.assert_allclose(wrapped(points[:, 0] - f.guarded[: f.k, 0], period), 0.0,
-                                   atol=1e-12)  # fmt: skip
+        np.testing.assert_allclose(
+            wrapped(points[:, 0] - f.guarded[: f.k, 0], period), 0.0, atol=1e-12
+        )
         np.testing.assert_allclose(points[:, 1:], f.guarded[: f.k, 1:], rtol=0, atol=1e-12)
         assert traj.tilt[k] == pytest.approx(tilt(f), abs=1e-9)
         true = self_distances(f.origins, f.k).min()
@@ -200,8 +220,9 @@ def test_every_answer_of_the_qp_is_optimal_for_the_problem_of_its_step(name: str
     assert not traj.qdot[-1].any() and traj.status[-1] == "optimal"  # at rest, exactly
 
 
-@pytest.mark.parametrize(("name", "spread"), [("pipe-rack", 0.3), ("fold", 0.8),
-                                              ("paper-two-inlets", 0.3)])  # fmt: skip
+@pytest.mark.parametrize(
+    ("name", "spread"), [("pipe-rack", 0.3), ("fold", 0.8), ("paper-two-inlets", 0.3)]
+)
 def test_the_worst_excess_of_a_state_is_recomputed_independently(name: str, spread: float) -> None:
     s = scene(name)
     spec = s.spec()
@@ -243,11 +264,19 @@ def test_parts_of_your_own_run_on_the_same_state_between_the_compiled_stages() -
     assert np.all(s.robot.qd_max <= 10.0)
     spec = s.spec()
     objective = dvqp.Objective((*spec.objective.terms, _Nothing()), gain=spec.objective.gain)
-    ours = dvqp.StepSpec(spec.tasks, objective, (*spec.limits, _PlainLimit()), spec.weights,
-                         spec.task_weight)  # fmt: skip
+    ours = dvqp.StepSpec(
+        spec.tasks, objective, (*spec.limits, _PlainLimit()), spec.weights, spec.task_weight
+    )
     c = scene_commands(s)
-    traj = dvqp.simulate(s.robot, s.pipe_radius, QPResolver(ours, "daqp"), s.q0, c.velocity,
-                         s.dt, obstacles=s.obstacles)  # fmt: skip
+    traj = dvqp.simulate(
+        s.robot,
+        s.pipe_radius,
+        QPResolver(ours, "daqp"),
+        s.q0,
+        c.velocity,
+        s.dt,
+        obstacles=s.obstacles,
+    )
     plain = run("paper-two-inlets", "daqp")
     for field in ("q", "qdot", "w", "limit_excess", "min_clearance", "task_error"):
         np.testing.assert_array_equal(getattr(traj, field), getattr(plain, field), err_msg=field)
@@ -265,8 +294,9 @@ class _Unchanged(dvqp.limits.SelfCollision):
     """Derives from a built-in limit and implements nothing of its own."""
 
 
-def test_a_subclass_of_a_built_in_part_is_a_part_of_your_own(robot: dvqp.Robot,
-                                                            q0: np.ndarray) -> None:  # fmt: skip
+def test_a_subclass_of_a_built_in_part_is_a_part_of_your_own(
+    robot: dvqp.Robot, q0: np.ndarray
+) -> None:
     spec = dvqp.StepSpec((dvqp.ToolTask(),), dvqp.Objective((_Level(0.08),)))
     step = Stepper(robot, 0.254, PseudoinverseResolver(spec), q0, 0.005)
     step.start(q0)

@@ -60,8 +60,9 @@ def assert_matches_the_oracle(state: KinematicState, obstacles: ObstacleSet) -> 
     inlets = np.array([isinstance(s, Inlet) for s in obstacles])
     for name in ("distance", "normal", "penalty", "penalty_gradient"):
         a, b = getattr(mine.points, name), getattr(numpy.points, name)
-        np.testing.assert_allclose(a[~inlets], b[~inlets], rtol=0, atol=1e-12,
-                                   err_msg=f"points {name}")  # fmt: skip
+        np.testing.assert_allclose(
+            a[~inlets], b[~inlets], rtol=0, atol=1e-12, err_msg=f"points {name}"
+        )
         tol = 1e-6 if "normal" in name or "gradient" in name else 1e-9
         np.testing.assert_allclose(a[inlets], b[inlets], rtol=0, atol=tol, err_msg=name)
     period = 2 * math.pi * state.radius
@@ -73,8 +74,7 @@ def assert_matches_the_oracle(state: KinematicState, obstacles: ObstacleSet) -> 
         ends = short_way(starts, stops, period)
         if isinstance(shape, Inlet):
             np.testing.assert_allclose(d, numpy.links.distance[j], rtol=0, atol=1e-9)
-            at_t, n_at_t = twin(shape).point_distance(starts + t[:, None] * (ends - starts),
-                                                      period)  # fmt: skip
+            at_t, n_at_t = twin(shape).point_distance(starts + t[:, None] * (ends - starts), period)
             np.testing.assert_allclose(at_t, d, rtol=0, atol=1e-9)
             np.testing.assert_allclose(n_at_t, n, rtol=0, atol=1e-6)
             continue
@@ -83,8 +83,7 @@ def assert_matches_the_oracle(state: KinematicState, obstacles: ObstacleSet) -> 
             a, b = getattr(mine.links, name)[j][out], getattr(numpy.links, name)[j][out]
             np.testing.assert_allclose(a, b, rtol=0, atol=1e-12, err_msg=f"link {name} {j}")
         np.testing.assert_allclose(d, numpy.links.distance[j], rtol=0, atol=1e-9)
-        at_t, n_at_t = polygon_points(shape.vertices, starts + t[:, None] * (ends - starts),
-                                      period)  # fmt: skip
+        at_t, n_at_t = polygon_points(shape.vertices, starts + t[:, None] * (ends - starts), period)
         np.testing.assert_allclose(at_t, d, rtol=0, atol=1e-12)
         np.testing.assert_allclose(n_at_t, n, rtol=0, atol=1e-9)
     return mine
@@ -183,8 +182,9 @@ def test_shapes_of_one_s_own_among_dvqp_s_give_the_rows_of_the_same_geometry() -
                     if own == 5 and side == "links":  # the deepest point of a link, searched
                         continue
                     got = getattr(getattr(near, side), name)
-                    np.testing.assert_allclose(got[own], got[mine], rtol=0, atol=1e-12,
-                                               err_msg=f"{side} {name} {own}")  # fmt: skip
+                    np.testing.assert_allclose(
+                        got[own], got[mine], rtol=0, atol=1e-12, err_msg=f"{side} {name} {own}"
+                    )
         np.testing.assert_allclose(near.links.distance[5], near.links.distance[2], atol=1e-9)
     assert Dot.calls.count("point_distance") == Dot.calls.count("segment_distance") == 10
 

@@ -22,8 +22,7 @@ def assert_matches_pinocchio(robot: Robot, q: np.ndarray, radius: float) -> Kine
     """Every field of the compiled state equals the Pinocchio/NumPy reference to 1e-12."""
     state = KinematicState.compute(robot, q, radius)
     for field, want in oracle.reference(robot, q, radius).items():
-        np.testing.assert_allclose(getattr(state, field), want, rtol=0, atol=1e-12,
-                                   err_msg=field)  # fmt: skip
+        np.testing.assert_allclose(getattr(state, field), want, rtol=0, atol=1e-12, err_msg=field)
     return state
 
 
@@ -41,8 +40,9 @@ def test_the_urdf_arm_has_continuous_joints_and_matches_the_arm_built_in_code() 
         mine = KinematicState.compute(urdf, q, 0.254)
         theirs = KinematicState.compute(paper, q, 0.254)
         for field in oracle.FIELDS:
-            np.testing.assert_allclose(getattr(mine, field), getattr(theirs, field), rtol=0,
-                                       atol=1e-12, err_msg=field)  # fmt: skip
+            np.testing.assert_allclose(
+                getattr(mine, field), getattr(theirs, field), rtol=0, atol=1e-12, err_msg=field
+            )
 
 
 def placement(rpy: tuple[float, float, float], xyz: tuple[float, float, float]) -> pin.SE3:
@@ -67,8 +67,9 @@ def mixed_joint_robot() -> Robot:
         at = placement(rpys[-1 - i], offsets[-1 - i])
         model.addFrame(pin.Frame(f"f{i}", parent, 0, at, pin.FrameType.OP_FRAME))
         if i == 1:  # a side branch off joint j1: its q sits between the chain's
-            side = model.addJoint(parent, pin.JointModelRZ(), placement((0.1, 0, 0), (0, 0.1, 0)),
-                                  "side")  # fmt: skip
+            side = model.addJoint(
+                parent, pin.JointModelRZ(), placement((0.1, 0, 0), (0, 0.1, 0)), "side"
+            )
             model.addFrame(pin.Frame("s", side, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME))
     return Robot(model, ["f0", "f1", "f2"], "f3", q_min=-3.0, q_max=3.0)
 
@@ -97,8 +98,9 @@ def test_the_developed_view_rows_of_prismatic_joints_equal_finite_differences() 
         state = KinematicState.compute(robot, q, r)
         fd = central_difference(lambda v: KinematicState.compute(robot, v, r).tool, q, 1e-7, wrap)
         np.testing.assert_allclose(state.tool_jacobian, fd, rtol=1e-6, atol=1e-7)
-        fd = central_difference(lambda v: KinematicState.compute(robot, v, r).guarded, q, 1e-7,
-                                wrap)  # fmt: skip
+        fd = central_difference(
+            lambda v: KinematicState.compute(robot, v, r).guarded, q, 1e-7, wrap
+        )
         np.testing.assert_allclose(state.guarded_jacobians, fd, rtol=1e-6, atol=1e-7)
 
 
@@ -132,11 +134,15 @@ def _model_with(joint: pin.JointModel) -> pin.Model:
 
 @pytest.mark.parametrize(
     "joint",
-    [pin.JointModelTranslation(), pin.JointModelSphericalZYX(), pin.JointModelHZ(),
-     pin.JointModelHelicalUnaligned(0.0, 0.6, 0.8, 0.1),
-     pin.JointModelUniversal(1.0, 0.0, 0.0, 0.0, 1.0, 0.0)],
+    [
+        pin.JointModelTranslation(),
+        pin.JointModelSphericalZYX(),
+        pin.JointModelHZ(),
+        pin.JointModelHelicalUnaligned(0.0, 0.6, 0.8, 0.1),
+        pin.JointModelUniversal(1.0, 0.0, 0.0, 0.0, 1.0, 0.0),
+    ],
     ids=lambda j: j.shortname(),
-)  # fmt: skip
+)
 def test_a_joint_that_is_not_revolute_or_prismatic_is_refused_when_the_robot_is_built(
     joint: pin.JointModel,
 ) -> None:
@@ -147,10 +153,14 @@ def test_a_joint_that_is_not_revolute_or_prismatic_is_refused_when_the_robot_is_
 
 @pytest.mark.parametrize(
     "joint",
-    [pin.JointModelSpherical(), pin.JointModelPlanar(), pin.JointModelFreeFlyer(),
-     pin.JointModelRUBZ()],
+    [
+        pin.JointModelSpherical(),
+        pin.JointModelPlanar(),
+        pin.JointModelFreeFlyer(),
+        pin.JointModelRUBZ(),
+    ],
     ids=lambda j: j.shortname(),
-)  # fmt: skip
+)
 def test_a_joint_whose_configuration_is_not_its_velocity_is_refused(
     joint: pin.JointModel,
 ) -> None:

@@ -57,15 +57,19 @@ from tests.oracle_limits import damper_rhs, joint_box, segment_distance
 from tests.oracle_objective import total
 
 
-def assert_problem(s: Stepper, limits: Sequence[Limit], dt: float, *, fd: bool = False,
-                   gradient: bool = True) -> int:  # fmt: skip
+def assert_problem(
+    s: Stepper, limits: Sequence[Limit], dt: float, *, fd: bool = False, gradient: bool = True
+) -> int:
     """At the loaded state, every damper's rows are what it keeps (:func:`damper_rows`), the
     box is the joint limits' (and a user's boxes'), and the problem holds exactly these rows
     (damper rows first, in the spec's order, then the other limits' rows; a row that does not
     apply is ``0 · Q̇ ≤ +inf``). Returns the rows that apply."""
     q = s.state.q.copy()
-    rows = [damper_rows(s, limit, q, dt, fd=fd, atol=1e-9, gradient=gradient)
-            for limit in limits if isinstance(limit, VelocityDamper)]  # fmt: skip
+    rows = [
+        damper_rows(s, limit, q, dt, fd=fd, atol=1e-9, gradient=gradient)
+        for limit in limits
+        if isinstance(limit, VelocityDamper)
+    ]
     s.load(q)
     s.prepare(np.zeros(4), dt)
     rows += [s.rows(limit) for limit in limits if isinstance(limit, Cap)]
@@ -91,8 +95,7 @@ def assert_problem(s: Stepper, limits: Sequence[Limit], dt: float, *, fd: bool =
 def test_a_scene_s_limits_write_the_rows_of_what_they_keep(name: str) -> None:
     sc = scene(name)
     limits = sc.spec().limits
-    found = configurations(sc.robot, sc.q0, 12, seed=1, spread=SCENES[name],
-                           radius=sc.pipe_radius)  # fmt: skip
+    found = configurations(sc.robot, sc.q0, 12, seed=1, spread=SCENES[name], radius=sc.pipe_radius)
     assert len(found) >= 6
     s = Stepper(sc.robot, sc.pipe_radius, QPResolver(sc.spec(), "daqp"), sc.q0, DT)
     s.start(sc.q0)
@@ -145,10 +148,13 @@ def test_the_arm_s_link_pairs_are_the_brute_force_pairs(robot: Robot, q0: np.nda
 def test_the_scalar_damper_value_is_the_old_damper_rhs_bit_for_bit() -> None:
     rng = np.random.default_rng(6)
     safe, depth = 0.01, 1e-4
-    d = np.concatenate([
-        safe + rng.uniform(-0.05, 0.2, 500), safe + rng.uniform(-2e-4, 2e-4, 500),
-        [safe, safe - depth, safe + depth, np.nextafter(safe - depth, 0.0), -1.0],
-    ])  # fmt: skip
+    d = np.concatenate(
+        [
+            safe + rng.uniform(-0.05, 0.2, 500),
+            safe + rng.uniform(-2e-4, 2e-4, 500),
+            [safe, safe - depth, safe + depth, np.nextafter(safe - depth, 0.0), -1.0],
+        ]
+    )
     for gain in (0.1, 0.5, 1.0):
         for dt in (1e-3, 0.005, 0.1):
             for decel in (math.inf, 1.0, 0.2, 1e-3):
@@ -171,8 +177,12 @@ class Mine(VelocityDamper):
 
     def distances(self, state: KinematicState) -> Distances:
         at = [1, 3]
-        return Distances(np.array(state.guarded[at, 2]), np.array(state.guarded_jacobians[at, 2]),
-                         self.floors, lambda: ("mine/point2", "mine/point4"))  # fmt: skip
+        return Distances(
+            np.array(state.guarded[at, 2]),
+            np.array(state.guarded_jacobians[at, 2]),
+            self.floors,
+            lambda: ("mine/point2", "mine/point4"),
+        )
 
 
 @njit(cache=True)
@@ -206,8 +216,7 @@ class Compiled(VelocityDamper):
         return Kernel(_tool_z, (s.tool, s.tool_jacobian, distance, gradient, usable))
 
     def distances(self, state: KinematicState) -> Distances:
-        return Distances(state.tool[1:2], state.tool_jacobian[1:2], self.z_min,
-                         lambda: ("tool/z",))  # fmt: skip
+        return Distances(state.tool[1:2], state.tool_jacobian[1:2], self.z_min, lambda: ("tool/z",))
 
 
 class Cap(Limit):

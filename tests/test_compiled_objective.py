@@ -159,8 +159,9 @@ class Reach(ObjectiveTerm):
 
     def kernel(self, plan: StepPlan) -> Kernel:
         s = plan.state
-        return Kernel(_reach, (s.tool, s.tool_jacobian, plan.objective_value,
-                               plan.objective_gradient))  # fmt: skip
+        return Kernel(
+            _reach, (s.tool, s.tool_jacobian, plan.objective_value, plan.objective_gradient)
+        )
 
     def evaluate(self, state: KinematicState) -> Term:
         return Term(float(state.tool[0]), np.array(state.tool_jacobian[0]))
@@ -194,8 +195,9 @@ def test_a_shape_of_one_s_own_counts_in_the_obstacle_terms() -> None:
     configurations = case.configurations(10, 0.1)
     values = assert_objective(case, ours, configurations)
     assert "point_distance" in Dot.calls and "segment_distance" in Dot.calls
-    np.testing.assert_allclose(values, assert_objective(case, dvqp_s, configurations),
-                               rtol=0, atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        values, assert_objective(case, dvqp_s, configurations), rtol=0, atol=1e-12
+    )
 
 
 def test_terms_and_dampers_over_overlapping_sets_each_read_their_own_shapes() -> None:
@@ -205,8 +207,14 @@ def test_terms_and_dampers_over_overlapping_sets_each_read_their_own_shapes() ->
     shapes = list(case.obstacles)
     objective = paper_objective(ObstacleSet(shapes[:5]), vector_gains=True)
     damper = ObstacleDamper(ObstacleSet([shapes[4], shapes[2], shapes[7]]), 0.005, 0.1)
-    s = stepping.stepper(case.robot, case.q0, objective=objective, limits=[damper],
-                         backend="daqp", obstacles=ObstacleSet(shapes[5:]))  # fmt: skip
+    s = stepping.stepper(
+        case.robot,
+        case.q0,
+        objective=objective,
+        limits=[damper],
+        backend="daqp",
+        obstacles=ObstacleSet(shapes[5:]),
+    )
     for q in case.configurations(8, 0.1):
         assert s.load(q)
         want = total(objective.terms, case.state(q))

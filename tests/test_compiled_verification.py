@@ -23,8 +23,9 @@ def walks(found: Sequence[np.ndarray]) -> list[tuple[np.ndarray, np.ndarray]]:
     return [(a, b) for a in found[:3] for b in found] + [(b, found[0]) for b in found]
 
 
-def assert_verification(s: Stepper, limits: Sequence[Limit], pairs: Sequence[tuple],
-                        radius: float = PIPE_RADIUS) -> None:  # fmt: skip
+def assert_verification(
+    s: Stepper, limits: Sequence[Limit], pairs: Sequence[tuple], radius: float = PIPE_RADIUS
+) -> None:
     """From each start, the stepper's worst excess at each configuration is the oracle's."""
     robot = s.robot
     for start, q in pairs:
@@ -102,8 +103,9 @@ def expected_rows(limit: object, k: int, pairs: int, rail: bool) -> int:
     if isinstance(limit, TiltLimit):
         return int(limit.min_tilt > 0.0)
     # heights: the points, then the link chords (body links and carriage; the holder)
-    return {"SurfaceHeight": 2 * k - 1 + rail, "ProbeHeight": 2,
-            "SelfCollision": pairs}[type(limit).__name__]  # fmt: skip
+    return {"SurfaceHeight": 2 * k - 1 + rail, "ProbeHeight": 2, "SelfCollision": pairs}[
+        type(limit).__name__
+    ]
 
 
 def test_every_bundled_scene_s_limits_are_in_its_step() -> None:
@@ -140,8 +142,12 @@ class Floors(VelocityDamper):
 
     def distances(self, state: KinematicState) -> Distances:
         k = state.k
-        return Distances(np.array(state.points[:, 2]), np.array(state.point_jacobians[:, 2]),
-                         self.floors, lambda: tuple(f"floor{i + 1}" for i in range(k)))  # fmt: skip
+        return Distances(
+            np.array(state.points[:, 2]),
+            np.array(state.point_jacobians[:, 2]),
+            self.floors,
+            lambda: tuple(f"floor{i + 1}" for i in range(k)),
+        )
 
 
 def test_a_user_s_damper_is_verified_as_dvqp_s_are(robot: Robot, q0: np.ndarray) -> None:

@@ -23,9 +23,15 @@ from dvqp import Trajectory
 DEBIAN = "/usr/bin/chromium"
 CHROMIUM = DEBIAN if Path(DEBIAN).exists() else shutil.which("chromium")
 FLAGS = [
-    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-    "--disable-background-networking", "--disable-component-update", "--disable-sync",
-]  # fmt: skip
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 
 pytestmark = pytest.mark.skipif(
     CHROMIUM is None, reason="no Chromium installed (apt-get install chromium)"
@@ -51,8 +57,9 @@ def console():  # type: ignore[no-untyped-def]
 
 def pixels(page: Any, rgb: tuple[int, int, int], tolerance: int) -> int:
     """Pixels of the developed view within ``tolerance`` of the colour ``rgb``."""
-    return int(page.evaluate(
-        """([rgb, tol]) => {
+    return int(
+        page.evaluate(
+            """([rgb, tol]) => {
             const c = document.getElementById("dv");
             const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
             let n = 0;
@@ -60,8 +67,10 @@ def pixels(page: Any, rgb: tuple[int, int, int], tolerance: int) -> int:
                 if (Math.abs(d[i] - rgb[0]) <= tol && Math.abs(d[i + 1] - rgb[1]) <= tol
                     && Math.abs(d[i + 2] - rgb[2]) <= tol) n++;
             return n;
-        }""", [list(rgb), tolerance],
-    ))  # fmt: skip
+        }""",
+            [list(rgb), tolerance],
+        )
+    )
 
 
 def probe(page: Any) -> tuple[float, float]:
@@ -78,9 +87,13 @@ def test_jog_in_chromium_moves_the_probe_and_saves_a_trajectory(console, tmp_pat
     errors: list[str] = []
     with sync_api.sync_playwright() as p:
         browser = p.chromium.launch_persistent_context(
-            str(tmp_path / "profile"), executable_path=CHROMIUM, headless=True, args=FLAGS,
-            accept_downloads=True, viewport={"width": 1280, "height": 900},
-        )  # fmt: skip
+            str(tmp_path / "profile"),
+            executable_path=CHROMIUM,
+            headless=True,
+            args=FLAGS,
+            accept_downloads=True,
+            viewport={"width": 1280, "height": 900},
+        )
         page = browser.new_page()
         page.on("pageerror", lambda exc: errors.append(str(exc)))
         page.goto(console.url("/"))
@@ -110,8 +123,9 @@ def test_jog_in_chromium_moves_the_probe_and_saves_a_trajectory(console, tmp_pat
             page.click("#save")
         download.value.save_as(tmp_path / "driven.npz")
         page.click("#reset")
-        page.wait_for_function("() => parseFloat(document.getElementById('st-time')"
-                               ".textContent.slice(2)) < 0.5")  # fmt: skip
+        page.wait_for_function(
+            "() => parseFloat(document.getElementById('st-time').textContent.slice(2)) < 0.5"
+        )
         page.close()
         browser.close()
     traj = Trajectory.load(tmp_path / "driven.npz")
@@ -119,8 +133,10 @@ def test_jog_in_chromium_moves_the_probe_and_saves_a_trajectory(console, tmp_pat
     assert 0.01 < traj.tool[-1, 1] - traj.tool[0, 1] < 0.03  # and 0.4 s of z+
     assert traj.ok and traj.scene_text
     assert not errors and not metrics["errors"] and len(metrics["latencies"]) == 1
-    print(f"key press to drawn motion: {metrics['latencies'][0]:.1f} ms; screenshot "
-          f"{tmp_path / 'console.png'}")  # fmt: skip
+    print(
+        f"key press to drawn motion: {metrics['latencies'][0]:.1f} ms; screenshot "
+        f"{tmp_path / 'console.png'}"
+    )
     deadline = time.monotonic() + 5
     while console.console.clock.running and time.monotonic() < deadline:
         time.sleep(0.02)

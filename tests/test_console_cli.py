@@ -61,8 +61,11 @@ def parse(*argv: str) -> argparse.Namespace:
 def test_the_arguments_and_their_defaults() -> None:
     args = parse(str(PAPER))
     assert (args.backend, args.host, args.port, args.run) == (
-        "daqp", "127.0.0.1", 8765, console_cli.run
-    )  # fmt: skip
+        "daqp",
+        "127.0.0.1",
+        8765,
+        console_cli.run,
+    )
     assert parse(str(PAPER), "--port", "0", "--host", "::1").port == 0
     with pytest.raises(SystemExit):
         parse(str(PAPER), "--port", "70000")
@@ -84,9 +87,11 @@ def test_without_the_extra_it_says_what_to_install(monkeypatch, capsys) -> None:
 
 @pytest.mark.parametrize(
     ("argv", "message"),
-    [(["nope.toml"], "dvqp: nope.toml: cannot read: No such file or directory\n"),
-     ([str(PAPER), "--backend", "nope"], "dvqp: unknown backend 'nope'; installed: pinv")],
-)  # fmt: skip
+    [
+        (["nope.toml"], "dvqp: nope.toml: cannot read: No such file or directory\n"),
+        ([str(PAPER), "--backend", "nope"], "dvqp: unknown backend 'nope'; installed: pinv"),
+    ],
+)
 def test_bad_input_is_one_line_and_exit_2(argv: list[str], message: str, capsys) -> None:  # type: ignore[no-untyped-def]
     pytest.importorskip("aiohttp", reason="the console extra is not installed")
     assert _run(parse(*argv)) == 2
@@ -96,8 +101,9 @@ def test_bad_input_is_one_line_and_exit_2(argv: list[str], message: str, capsys)
 
 def test_a_port_in_use_is_one_line_and_exit_2(capsys) -> None:  # type: ignore[no-untyped-def]
     pytest.importorskip("aiohttp", reason="the console extra is not installed")
-    assert_a_taken_port_is_refused(lambda port: _run(parse(str(PAPER), "--port", str(port))),
-                                   capsys)  # fmt: skip
+    assert_a_taken_port_is_refused(
+        lambda port: _run(parse(str(PAPER), "--port", str(port))), capsys
+    )
 
 
 def get(url: str) -> int:

@@ -67,9 +67,15 @@ def test_a_foreign_host_header_is_refused(server: RunningConsole):
 
 @pytest.mark.parametrize(
     ("origin", "accepted"),
-    [(None, True), ("same", True), ("http://evil.example", False),
-     ("http://127.0.0.1:1", False), ("null", False), ("file://", False)],
-)  # fmt: skip
+    [
+        (None, True),
+        ("same", True),
+        ("http://evil.example", False),
+        ("http://127.0.0.1:1", False),
+        ("null", False),
+        ("file://", False),
+    ],
+)
 def test_a_websocket_from_another_origin_is_refused(
     server: RunningConsole, origin: str | None, accepted: bool
 ):
@@ -109,17 +115,30 @@ def test_a_client_gets_the_scene_then_states_at_30_hz_or_more(server: RunningCon
 
 
 GARBAGE = [
-    "not json", "", "[0.05, 0, 0, 0]", "null", '"jog"', "{}", '{"type": "fly"}',
-    '{"type": 3}', '{"type": "jog"}', '{"type": "jog", "velocity": [1, 2, 3]}',
+    "not json",
+    "",
+    "[0.05, 0, 0, 0]",
+    "null",
+    '"jog"',
+    "{}",
+    '{"type": "fly"}',
+    '{"type": 3}',
+    '{"type": "jog"}',
+    '{"type": "jog", "velocity": [1, 2, 3]}',
     '{"type": "jog", "velocity": [NaN, 0, 0, 0]}',
     '{"type": "jog", "velocity": [Infinity, 0, 0, 0]}',
-    '{"type": "jog", "velocity": [1e999, 0, 0, 0]}', '{"type": "jog", "velocity": ["1", 0, 0, 0]}',
-    '{"type": "jog", "velocity": [true, 0, 0, 0]}', '{"type": "jog", "velocity": {"l": 1}}',
+    '{"type": "jog", "velocity": [1e999, 0, 0, 0]}',
+    '{"type": "jog", "velocity": ["1", 0, 0, 0]}',
+    '{"type": "jog", "velocity": [true, 0, 0, 0]}',
+    '{"type": "jog", "velocity": {"l": 1}}',
     '{"type": "jog", "velocity": [' + "9" * 4000 + ", 0, 0, 0]}",
-    '{"type": "stop", "now": true}', '{"type": "reset", "type2": 1}', "[" * 2000 + "]" * 2000,
+    '{"type": "stop", "now": true}',
+    '{"type": "reset", "type2": 1}',
+    "[" * 2000 + "]" * 2000,
     '{"type": "jog", "velocity": [0.05, 0, 0, 0], "pad": "' + "x" * 5000 + '"}',
-    '{"type": "jog" "velocity": []}', "\x00\xff",
-]  # fmt: skip
+    '{"type": "jog" "velocity": []}',
+    "\x00\xff",
+]
 
 
 def test_garbage_gets_error_replies_and_changes_nothing(server: RunningConsole):
@@ -150,8 +169,10 @@ def test_a_huge_frame_closes_only_its_connection(server: RunningConsole):
             async with http.ws_connect(server.url("/ws")) as ws:
                 await ws.receive_json()
                 await ws.send_str("x" * (2 << 20))
-                while (await ws.receive()).type not in (aiohttp.WSMsgType.CLOSE,
-                                                        aiohttp.WSMsgType.CLOSED):  # fmt: skip
+                while (await ws.receive()).type not in (
+                    aiohttp.WSMsgType.CLOSE,
+                    aiohttp.WSMsgType.CLOSED,
+                ):
                     pass
             async with http.ws_connect(server.url("/ws")) as ws:
                 return (await ws.receive_json())["type"] == "scene"

@@ -48,12 +48,12 @@ def test_the_tool_and_point_rows_equal_finite_differences_including_the_seam(l: 
     for _ in range(10):
         q = random_frame(l, rng)
         state = KinematicState.compute(FREE, q, R)
-        fd = central_difference(lambda v: KinematicState.compute(FREE, v, R).tool, q, 1e-7,
-                                wrap_lz)  # fmt: skip
+        fd = central_difference(lambda v: KinematicState.compute(FREE, v, R).tool, q, 1e-7, wrap_lz)
         scale = np.abs(state.tool_jacobian).max()
         np.testing.assert_allclose(state.tool_jacobian, fd, rtol=1e-6, atol=1e-6 * scale)
-        fd = central_difference(lambda v: KinematicState.compute(FREE, v, R).guarded, q, 1e-7,
-                                wrap_lz)  # fmt: skip
+        fd = central_difference(
+            lambda v: KinematicState.compute(FREE, v, R).guarded, q, 1e-7, wrap_lz
+        )
         np.testing.assert_allclose(state.guarded_jacobians, fd, rtol=1e-6, atol=1e-7)
 
 
@@ -64,8 +64,9 @@ def test_the_map_and_its_rows_equal_the_formulas(l: float) -> None:
         q = random_frame(l, rng)
         state = KinematicState.compute(FREE, q, R)
         for field, want in oracle.reference(FREE, q, R).items():
-            np.testing.assert_allclose(getattr(state, field), want, rtol=0, atol=1e-12,
-                                       err_msg=field)  # fmt: skip
+            np.testing.assert_allclose(
+                getattr(state, field), want, rtol=0, atol=1e-12, err_msg=field
+            )
 
 
 def test_the_coordinates_recover_the_frame_position() -> None:

@@ -191,16 +191,26 @@ def test_the_stored_answer_passes_solvers_residual_check_on_the_file(exported) -
         assert failed_checks(res, tolerance, scale) == [], e["file"]
 
 
-def test_the_command_writes_the_export_and_refuses_to_overwrite_it(scene_file: Path,
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+def test_the_command_writes_the_export_and_refuses_to_overwrite_it(
+    scene_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "qps"
     assert main(["export-qps", str(scene_file), "--backend", "daqp", "-o", str(out)]) == 0
     assert "of 80 steps" in capsys.readouterr().out
     written = json.loads((out / INDEX).read_text())
     assert main(["export-qps", str(scene_file), "-o", str(out)]) == 2
     assert capsys.readouterr().err.endswith(": not empty (--force replaces an earlier export)\n")
-    argv = ["export-qps", str(scene_file), "--backend", "osqp", "-o", str(out), "--force",
-            "--solver-option", "osqp.eps_abs=1e-7"]  # fmt: skip
+    argv = [
+        "export-qps",
+        str(scene_file),
+        "--backend",
+        "osqp",
+        "-o",
+        str(out),
+        "--force",
+        "--solver-option",
+        "osqp.eps_abs=1e-7",
+    ]
     assert main(argv) == 0
     again = json.loads((out / INDEX).read_text())
     assert again["backend"] == "osqp" and again["settings"] == {"eps_abs": 1e-7}
@@ -209,10 +219,21 @@ def test_the_command_writes_the_export_and_refuses_to_overwrite_it(scene_file: P
     assert sorted(p.name for p in tmp_path.iterdir()) == ["qps"]  # nothing else left
 
 
-@pytest.mark.parametrize("case", ["pinv", "unknown backend", "bad scene", "foreign folder",
-                                  "a file", "missing parent", "bad setting"])  # fmt: skip
-def test_bad_input_is_one_line_exit_2_and_nothing_written(case: str, scene_file: Path,
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+@pytest.mark.parametrize(
+    "case",
+    [
+        "pinv",
+        "unknown backend",
+        "bad scene",
+        "foreign folder",
+        "a file",
+        "missing parent",
+        "bad setting",
+    ],
+)
+def test_bad_input_is_one_line_exit_2_and_nothing_written(
+    case: str, scene_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     scene, out, extra = str(scene_file), tmp_path / "qps", []
     backend = {"pinv": "pinv", "unknown backend": "nope"}.get(case, "daqp")
     if case == "bad scene":

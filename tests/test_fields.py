@@ -71,14 +71,18 @@ def deep(n: int) -> int:
     ("raise_", "reason"),
     [
         (overflow, "cannot be used (FloatingPointError: overflow encountered in scalar multiply)"),
-        (lambda: round(float("inf")),
-         "cannot be used (OverflowError: cannot convert float infinity to integer)"),
+        (
+            lambda: round(float("inf")),
+            "cannot be used (OverflowError: cannot convert float infinity to integer)",
+        ),
         (lambda: deep(0), "cannot be used (RecursionError: maximum recursion depth exceeded)"),
-        (lambda: int("x"),
-         "cannot be used (ValueError: invalid literal for int() with base 10: 'x')"),
+        (
+            lambda: int("x"),
+            "cannot be used (ValueError: invalid literal for int() with base 10: 'x')",
+        ),
     ],
     ids=["numpy overflow", "OverflowError", "RecursionError", "ValueError"],
-)  # fmt: skip
+)
 def test_the_guard_turns_numeric_failures_into_one_scene_error(
     raise_: Callable[[], object], reason: str
 ) -> None:
@@ -91,10 +95,13 @@ def test_the_guard_maps_constructor_and_dvqp_errors_and_passes_scene_errors() ->
     f = Fields(SRC)
     cases = [
         (ParameterError("radius", "must be > 0"), "pipe", "x.toml: pipe.radius: must be > 0"),
-        (SingularConfigurationError("axis"), "robot.q0",
-         "x.toml: robot.q0: singular configuration: axis"),
+        (
+            SingularConfigurationError("axis"),
+            "robot.q0",
+            "x.toml: robot.q0: singular configuration: axis",
+        ),
         (SceneError(SRC, "a.b", "as it was"), "pipe", "x.toml: a.b: as it was"),
-    ]  # fmt: skip
+    ]
     for exc, prefix, message in cases:
         with pytest.raises(SceneError) as info, f.guard(prefix):
             raise exc

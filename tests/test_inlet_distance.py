@@ -15,8 +15,11 @@ from dvqp.geometry.shapes import Inlet
 
 R = 0.254
 PERIOD = 2 * math.pi * R
-INLETS = [Inlet(np.array([0.1, 0.2]), 0.075, R), Inlet(np.array([-0.3, 0.5]), 0.2, R),
-          Inlet(np.array([0.0, 0.0]), 0.25, R)]  # r/R 0.3, 0.79, 0.98  # fmt: skip
+INLETS = [
+    Inlet(np.array([0.1, 0.2]), 0.075, R),
+    Inlet(np.array([-0.3, 0.5]), 0.2, R),
+    Inlet(np.array([0.0, 0.0]), 0.25, R),
+]  # r/R 0.3, 0.79, 0.98
 DENSE = 200_000
 
 
@@ -52,7 +55,8 @@ def signed(inlet: Inlet, tree: Dense, p: np.ndarray) -> np.ndarray:
     d = tree.query(p)[0]
     off = p - inlet.center
     inside = ((R * np.sin(off[:, 0] / R)) ** 2 + off[:, 1] ** 2 < inlet.radius**2) & (
-        np.abs(off[:, 0]) < 0.5 * math.pi * R)  # fmt: skip
+        np.abs(off[:, 0]) < 0.5 * math.pi * R
+    )
     return np.where(inside, -d, d)
 
 
@@ -148,8 +152,10 @@ def test_the_gradients_are_the_finite_differences(a: tuple, du: float, dv: float
     for axis in range(2):
         e = np.zeros(2)
         e[axis] = h
-        fd = (distances([inlet], (p + e)[None], PERIOD)[0] -
-              distances([inlet], (p - e)[None], PERIOD)[0])[0, 0] / (2 * h)  # fmt: skip
+        fd = (
+            distances([inlet], (p + e)[None], PERIOD)[0]
+            - distances([inlet], (p - e)[None], PERIOD)[0]
+        )[0, 0] / (2 * h)
         assert abs(fd - n[0, 0, axis]) < tolerance or _kinked(inlet, p)
         e_hat = np.array([du, dv]) / max(math.hypot(du, dv), 1e-300)
         turning = t in (0.0, 1.0) and abs(nseg @ e_hat) < 0.05  # an end about to give way

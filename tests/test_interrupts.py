@@ -84,7 +84,8 @@ def run_interrupted(body: str, timeout: float = 120.0) -> subprocess.CompletedPr
     """Run ``body`` with a handler counting SIGINTs and a thread sending one every 23 ms for
     ``SECONDS`` (then none, so that none lands in the script's own bookkeeping); the script
     ends by printing ``counted <handled> <caught>``."""
-    script = textwrap.dedent("""
+    script = (
+        textwrap.dedent("""
         import os, signal, threading, time
         handled = caught = 0
         def handler(signum, frame):
@@ -98,7 +99,9 @@ def run_interrupted(body: str, timeout: float = 120.0) -> subprocess.CompletedPr
                 os.kill(os.getpid(), signal.SIGINT)
         def work():
             pass
-        """) + textwrap.dedent(body) + textwrap.dedent("""
+        """)
+        + textwrap.dedent(body)
+        + textwrap.dedent("""
         signal.signal(signal.SIGINT, handler)
         sender = threading.Thread(target=send, daemon=True)
         sender.start()
@@ -115,9 +118,11 @@ def run_interrupted(body: str, timeout: float = 120.0) -> subprocess.CompletedPr
                 caught += 1
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         print("counted", handled, caught)
-        """)  # fmt: skip
-    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                          timeout=timeout, cwd=ROOT)  # fmt: skip
+        """)
+    )
+    return subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=timeout, cwd=ROOT
+    )
 
 
 def counts(done: subprocess.CompletedProcess[str]) -> tuple[int, int]:
@@ -135,7 +140,7 @@ def test_no_interrupt_is_lost_while_a_run_steps() -> None:
         SECONDS = 4.0
         def work():
             plan(scene, "pinv")
-        """)  # fmt: skip
+        """)
     handled, caught = counts(done)
     assert done.returncode == 0 and handled > 50 and caught == handled
 
@@ -155,7 +160,7 @@ def test_a_solver_that_catches_the_interrupt_gives_it_back(backend: str) -> None
         def work():
             backend.reset()
             backend.solve(problem)
-        """)  # fmt: skip
+        """)
     handled, caught = counts(done)
     assert done.returncode == 0 and handled > 10 and caught == handled
 

@@ -51,12 +51,16 @@ def test_the_joint_limits_intersect_into_one_box(q0: np.ndarray) -> None:
     limits and the acceleration box: one box, their intersection, at every step."""
     q_min, q_max = q0 - 0.1, q0 + 0.1
     q_min[0], q_max[3] = -np.inf, np.inf
-    limited = Robot.ndt13(LINK_LENGTHS, q_min=q_min, q_max=q_max,
-                          qd_max=np.linspace(0.5, 3.0, 13))  # fmt: skip
+    limited = Robot.ndt13(LINK_LENGTHS, q_min=q_min, q_max=q_max, qd_max=np.linspace(0.5, 3.0, 13))
     tighter = Robot.ndt13(LINK_LENGTHS, q_min=q0 - 0.15, q_max=q0 + 0.05, qd_max=2.0)
     acceleration = AccelerationLimit(limited, np.linspace(2.0, 12.0, 13))
-    limits = (JointPositionLimit(limited), JointVelocityLimit(limited),
-              JointPositionLimit(tighter), JointVelocityLimit(tighter), acceleration)  # fmt: skip
+    limits = (
+        JointPositionLimit(limited),
+        JointVelocityLimit(limited),
+        JointPositionLimit(tighter),
+        JointVelocityLimit(tighter),
+        acceleration,
+    )
     s = stepping.stepper(limited, q0, limits=limits, backend="daqp")
     rng = np.random.default_rng(3)
     past = 0

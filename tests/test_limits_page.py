@@ -90,18 +90,24 @@ def test_the_curves_are_the_quantities_the_run_recorded(name: str) -> None:
         least = np.min([c.values for c in curves(page, "clearance").values()], axis=0)
         assert (least >= traj.min_clearance - 1e-12).all()
         np.testing.assert_allclose(least, traj.min_clearance, rtol=0, atol=1e-5)
-    np.testing.assert_allclose(curves(page, "self distance")["non-adjacent links"].values,
-                               traj.self_distance, rtol=0, atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        curves(page, "self distance")["non-adjacent links"].values,
+        traj.self_distance,
+        rtol=0,
+        atol=1e-12,
+    )
     heights = curves(page, "height")
     np.testing.assert_allclose(heights["link chords"].values, traj.link_height, atol=1e-12)
     np.testing.assert_allclose(heights["holder"].values, traj.holder_height, atol=1e-12)
     np.testing.assert_allclose(heights["probe"].values, traj.tool[:, 2], atol=1e-12)
-    np.testing.assert_allclose(heights["body points"].values, traj.points[:, :, 2].min(axis=1),
-                               atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        heights["body points"].values, traj.points[:, :, 2].min(axis=1), atol=1e-12
+    )
     if "tilt" in page.panels:  # asin(sin θ): the tilt from radial, on either side
         tilt = np.minimum(traj.tilt, np.pi - traj.tilt)
-        np.testing.assert_allclose(curves(page, "tilt")["probe from radial"].values, tilt,
-                                   atol=1e-9)  # fmt: skip
+        np.testing.assert_allclose(
+            curves(page, "tilt")["probe from radial"].values, tilt, atol=1e-9
+        )
     robot = sc.robot
     for i, c in enumerate(curves(page, "joint speed").values()):
         np.testing.assert_allclose(c.values, np.abs(traj.qdot[:, i]) / robot.qd_max[i])
@@ -111,8 +117,9 @@ def test_the_curves_are_the_quantities_the_run_recorded(name: str) -> None:
             0.5 * (robot.q_max[i] + robot.q_min[i]),
             0.5 * (robot.q_max[i] - robot.q_min[i]),
         )
-        np.testing.assert_allclose(c.values, np.abs(traj.q[:, i] - middle) / half,
-                                   rtol=0, atol=1e-12)  # fmt: skip
+        np.testing.assert_allclose(
+            c.values, np.abs(traj.q[:, i] - middle) / half, rtol=0, atol=1e-12
+        )
 
 
 @pytest.mark.parametrize("name", ["paper-two-inlets", "pipe-rack", "many-obstacles"])
@@ -130,8 +137,9 @@ def test_each_obstacle_curve_agrees_with_an_independent_distance(name: str) -> N
     for j, label in enumerate(sc.obstacles.labels):
         shape = twin(sc.obstacles[j])
         points = shape.point_distance(chain.reshape(-1, 2), period)[0]
-        links = shape.segment_distance(chain[:, :-1].reshape(-1, 2),
-                                       chain[:, 1:].reshape(-1, 2), period)[0]  # fmt: skip
+        links = shape.segment_distance(
+            chain[:, :-1].reshape(-1, 2), chain[:, 1:].reshape(-1, 2), period
+        )[0]
         curve = curves(page, "clearance")[label].values[rows]
         assert (curve <= points.reshape(chain.shape[:2]).min(axis=1) + 1e-9).all(), label
         straight = links.reshape(chain.shape[0], -1).min(axis=1)
@@ -179,6 +187,8 @@ def test_plot_limits_against_another_scene_says_so(
     assert "note" not in capsys.readouterr().err  # the scene it was planned from
     assert main([*same, "scenes/paper-inlets.toml"]) == 0  # the same arm: allowed, but said
     err = capsys.readouterr().err
-    assert err == (f"dvqp: note: {npz} was planned from another scene text than "
-                   "scenes/paper-inlets.toml: drawn with the latter's arm, obstacles and "
-                   "limits\n")  # fmt: skip
+    assert err == (
+        f"dvqp: note: {npz} was planned from another scene text than "
+        "scenes/paper-inlets.toml: drawn with the latter's arm, obstacles and "
+        "limits\n"
+    )

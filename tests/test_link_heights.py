@@ -54,8 +54,10 @@ def test_plan_reports_the_lowest_link_chord_and_the_holder(tmp_path: Path) -> No
     assert row["min_link_height"] == pytest.approx(0.05, abs=1e-4)  # held at min_height
     assert row["min_link_height"] == traj.link_height.min()
     text = format_summary(scene, traj, row, None)
-    want = (f"link heights    lowest {traj.link_height.min():+.4f} m (link4), "
-            f"holder {traj.holder_height.min():+.4f} m")  # fmt: skip
+    want = (
+        f"link heights    lowest {traj.link_height.min():+.4f} m (link4), "
+        f"holder {traj.holder_height.min():+.4f} m"
+    )
     assert [line for line in text.splitlines() if line.startswith("link heights")] == [want]
 
 

@@ -120,10 +120,11 @@ def test_dampers_over_different_obstacle_sets_keep_each_its_own_rows(
     d = Obstacle(p[5] + np.array([0.0, 0.05]), 0.03)  # near the probe
     dampers = [
         ObstacleDamper(ObstacleSet([a, b]), margin=0.01, influence=0.2, gain=0.3),
-        ObstacleDamper(ObstacleSet([b, d, c]), margin=0.02, influence=0.1, gain=0.8,
-                       deceleration=0.2),
+        ObstacleDamper(
+            ObstacleSet([b, d, c]), margin=0.02, influence=0.1, gain=0.8, deceleration=0.2
+        ),
         ObstacleDamper(ObstacleSet([d]), margin=0.0, influence=0.3, deceleration=np.inf),
-    ]  # fmt: skip
+    ]
     s = stepping.stepper(robot, q0, limits=dampers, backend="daqp")
     total = 0
     for q in [q0, *configurations(robot, q0, 4, seed=3, spread=0.05)]:
@@ -146,11 +147,13 @@ def mixed_shapes(state: KinematicState) -> ObstacleSet:
     clearance has no gradient)."""
     g = state.guarded[:, :2]
     box = np.array([[-0.03, -0.02], [0.035, -0.025], [0.03, 0.03], [-0.025, 0.02]])
-    return ObstacleSet([
-        Band(g[2, 1] + 0.03, g[2, 1] + 0.08),
-        Polygon(g[4] + box + np.array([0.0, 0.06])),
-        Inlet(g[0] + np.array([0.09, 0.1]), 0.06, PIPE_RADIUS),
-    ])  # fmt: skip
+    return ObstacleSet(
+        [
+            Band(g[2, 1] + 0.03, g[2, 1] + 0.08),
+            Polygon(g[4] + box + np.array([0.0, 0.06])),
+            Inlet(g[0] + np.array([0.09, 0.1]), 0.06, PIPE_RADIUS),
+        ]
+    )
 
 
 def test_every_shape_class_gives_rows_of_minus_its_clearance_gradient(

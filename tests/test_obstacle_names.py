@@ -55,8 +55,7 @@ def test_a_named_obstacle_labels_its_pairs_in_rows_reports_failures_and_the_cons
     why = run_error(scene, plan(scene, "pinv"))  # the baseline enters the lower inlet
     assert why is not None and "/inlet-lower clearance" in why
     resolver = make_resolver("daqp", scene.spec())
-    stepper = Stepper(scene.robot, scene.pipe_radius, resolver, qp.q[-1], scene.dt,
-                      scene.obstacles)  # fmt: skip
+    stepper = Stepper(scene.robot, scene.pipe_radius, resolver, qp.q[-1], scene.dt, scene.obstacles)
     stepper.start(qp.q[-1])
     assert Sample.of(stepper).closest == "link4/inlet-lower"
 
@@ -65,15 +64,27 @@ BAD_NAMES = [
     ('""', "obstacles[1].name: must be a non-empty name without surrounding spaces"),
     ('" lower"', "obstacles[1].name: must be a non-empty name without surrounding spaces"),
     ("42", "obstacles[1].name: expected a string, got a number"),
-    ('"in/let"', "obstacles[1].name: 'in/let': must be printable and have no '/' "
-                 "(labels read 'point3/<name>')"),
-    ('"in\\nlet"', "obstacles[1].name: 'in\\nlet': must be printable and have no '/' "
-                   "(labels read 'point3/<name>')"),
-    ('"height"', "obstacles[1].name: 'height' reads as another label (height, probe, holder, "
-                 "pointN, linkN, obstacles[N]): choose another"),
-    ('"obstacles[0]"', "obstacles[1].name: 'obstacles[0]' reads as another label (height, "
-                       "probe, holder, pointN, linkN, obstacles[N]): choose another"),
-]  # fmt: skip
+    (
+        '"in/let"',
+        "obstacles[1].name: 'in/let': must be printable and have no '/' "
+        "(labels read 'point3/<name>')",
+    ),
+    (
+        '"in\\nlet"',
+        "obstacles[1].name: 'in\\nlet': must be printable and have no '/' "
+        "(labels read 'point3/<name>')",
+    ),
+    (
+        '"height"',
+        "obstacles[1].name: 'height' reads as another label (height, probe, holder, "
+        "pointN, linkN, obstacles[N]): choose another",
+    ),
+    (
+        '"obstacles[0]"',
+        "obstacles[1].name: 'obstacles[0]' reads as another label (height, "
+        "probe, holder, pointN, linkN, obstacles[N]): choose another",
+    ),
+]
 
 
 @pytest.mark.parametrize(("name", "message"), BAD_NAMES, ids=[n for n, _ in BAD_NAMES])

@@ -30,14 +30,20 @@ DT = 0.005
 COMMAND = np.array([0.02, 0.01, 0.0, 0.1])
 
 
-def compiled(jac: np.ndarray, xdot: np.ndarray, g: np.ndarray, weights: np.ndarray,
-             metric: np.ndarray | None = None,
-             damping: float = 0.0) -> tuple[int, np.ndarray]:  # fmt: skip
+def compiled(
+    jac: np.ndarray,
+    xdot: np.ndarray,
+    g: np.ndarray,
+    weights: np.ndarray,
+    metric: np.ndarray | None = None,
+    damping: float = 0.0,
+) -> tuple[int, np.ndarray]:
     """``pinv_step`` on its own: its status and ``Q̇`` (the dense ``metric`` if given)."""
     out, info = np.full(jac.shape[1], np.nan), np.zeros(2)
     P = np.eye(jac.shape[1]) if metric is None else metric
-    status = pinv_step(np.ascontiguousarray(jac), xdot, -g, weights, P, metric is not None,
-                       damping, info, out)  # fmt: skip
+    status = pinv_step(
+        np.ascontiguousarray(jac), xdot, -g, weights, P, metric is not None, damping, info, out
+    )
     return int(status), out
 
 
@@ -68,8 +74,7 @@ def test_step_tracks_the_command_and_equals_the_qp_minimiser(seed: int, weighted
 
 
 @pytest.mark.parametrize("weighted", [False, True])
-def test_the_baseline_step_is_eq18_at_the_arms_configurations(robot: Robot,
-                                                              weighted: bool) -> None:  # fmt: skip
+def test_the_baseline_step_is_eq18_at_the_arms_configurations(robot: Robot, weighted: bool) -> None:
     rng = np.random.default_rng(2)
     w = rng.uniform(0.5, 2.0, 13) if weighted else np.ones(13)
     spec = spec_with(np.zeros(13), w)

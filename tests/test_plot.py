@@ -43,9 +43,13 @@ def planned(
 ) -> Trajectory:
     """A JOG scene of the paper's arm, run with the pseudoinverse baseline."""
     text = SCENE.format(
-        name=name, radius=PIPE_RADIUS, links=LINK_LENGTHS, q0=q0, duration=duration,
+        name=name,
+        radius=PIPE_RADIUS,
+        links=LINK_LENGTHS,
+        q0=q0,
+        duration=duration,
         velocity=velocity,
-    )  # fmt: skip
+    )
     path = folder / f"{name}.toml"
     path.write_text(text, encoding="utf-8")
     return plan(load_scene(path), "pinv")

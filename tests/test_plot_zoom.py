@@ -95,8 +95,11 @@ def test_what_passes_2pir_hides_the_stretches_it_covers_again() -> None:
     moved, _ = shifted(traj, [], 0.5 - arm.min())  # the arm from l = 0.5 m
     top = occupied(moved, []).max()
     end = PERIOD - 0.1 - 0.415  # a third circle from the arm's end to here
-    shapes = [Obstacle([0.0, 0.3], 0.1, 1.0), Obstacle([0.05, 0.3], 0.02, 1.0),
-              Obstacle([0.5 * (top - 0.02 + end), 0.3], 0.5 * (end - top + 0.02), 1.0)]  # fmt: skip
+    shapes = [
+        Obstacle([0.0, 0.3], 0.1, 1.0),
+        Obstacle([0.05, 0.3], 0.02, 1.0),
+        Obstacle([0.5 * (top - 0.02 + end), 0.3], 0.5 * (end - top + 0.02), 1.0),
+    ]
     lo, hi = arc_extent(moved, shapes, RADIUS)
     assert hi - lo == pytest.approx(1.16 * (end + 0.1) + 0.06, abs=1e-3)
     assert inside(occupied(moved, shapes), lo, hi)

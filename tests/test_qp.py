@@ -36,14 +36,22 @@ def near_obstacles(robot: Robot) -> ObstacleSet:
     """One circle 2 cm from point 3, one over link 4's middle, one far away."""
     p = KinematicState.compute(robot, Q0, PIPE_RADIUS).points[:, :2]
     mid = 0.5 * (p[3] + p[4])
-    return ObstacleSet([Obstacle(p[2] + np.array([0.0, 0.05]), 0.03),
-                        Obstacle(mid + np.array([0.0, 0.045]), 0.03),
-                        Obstacle(np.array([-0.5, -1.0]), 0.05)])  # fmt: skip
+    return ObstacleSet(
+        [
+            Obstacle(p[2] + np.array([0.0, 0.05]), 0.03),
+            Obstacle(mid + np.array([0.0, 0.045]), 0.03),
+            Obstacle(np.array([-0.5, -1.0]), 0.05),
+        ]
+    )
 
 
 def paper_limits(robot: Robot) -> tuple[Limit, ...]:
-    return (JointPositionLimit(robot), JointVelocityLimit(robot),
-            ObstacleDamper(near_obstacles(robot)), SurfaceHeight(min_height=0.075))  # fmt: skip
+    return (
+        JointPositionLimit(robot),
+        JointVelocityLimit(robot),
+        ObstacleDamper(near_obstacles(robot)),
+        SurfaceHeight(min_height=0.075),
+    )
 
 
 def qp(robot: Robot, spec: StepSpec) -> Stepper:

@@ -61,11 +61,11 @@ BACKENDS = [
 ]
 
 
-def stepper(robot: Robot, spec: StepSpec, backend: object = "daqp",
-            q0: np.ndarray | None = None) -> Stepper:  # fmt: skip
+def stepper(
+    robot: Robot, spec: StepSpec, backend: object = "daqp", q0: np.ndarray | None = None
+) -> Stepper:
     """The compiled step of ``spec`` on ``backend`` (``"pinv"``: the baseline), started."""
-    resolver = (PseudoinverseResolver(spec) if backend == "pinv"
-                else QPResolver(spec, backend))  # type: ignore[arg-type]  # fmt: skip
+    resolver = PseudoinverseResolver(spec) if backend == "pinv" else QPResolver(spec, backend)  # type: ignore[arg-type]
     start = np.array(Q0) if q0 is None else q0
     s = Stepper(robot, PIPE_RADIUS, resolver, start, DT)
     s.start(start)

@@ -17,8 +17,13 @@ import pytest
 from tests.runs import run
 
 DATA = Path(__file__).resolve().parent / "data" / "reference_runs.npz"
-NAMES = ("joint-limit", "many-obstacles", "narrow-passage", "paper-two-inlets",
-         "weld-circumference")  # fmt: skip
+NAMES = (
+    "joint-limit",
+    "many-obstacles",
+    "narrow-passage",
+    "paper-two-inlets",
+    "weld-circumference",
+)
 FIELDS = ("q", "qdot", "w", "min_clearance", "task_error")
 
 

@@ -81,8 +81,10 @@ def fast() -> Scene:
     """joint-limit following a path at 2 m/s, faster than its joints (1.5 rad/s) can: the run
     ends with the arm at speed and the tool behind its path."""
     s = scene("joint-limit")
-    path = ("[motion.path]\nwaypoints = [[0.2973, 0.35, 0.08, 0.0], [0.3973, 0.45, 0.08, 0.0]]\n"
-            "speed = 2.0\n")  # fmt: skip
+    path = (
+        "[motion.path]\nwaypoints = [[0.2973, 0.35, 0.08, 0.0], [0.3973, 0.45, 0.08, 0.0]]\n"
+        "speed = 2.0\n"
+    )
     return loads(s.text[: s.text.index("[[motion.jog]]")] + path)
 
 
@@ -99,9 +101,14 @@ def test_a_stop_that_needs_a_joint_at_its_velocity_limit_holds_it_there(backend:
     s, traj = fast(), fast_run(backend)
     k, qd_max, step = traj.brake_start, s.robot.qd_max, qdd_max(s) * s.dt
     assert_ends_at_rest(s, traj)
-    held = [i for i in range(k, traj.n_steps)
-            if np.any((np.abs(traj.qdot[i]) >= qd_max - 1e-9)
-                      & (np.abs(traj.qdot[i - 1]) + step > qd_max + 1e-9))]  # fmt: skip
+    held = [
+        i
+        for i in range(k, traj.n_steps)
+        if np.any(
+            (np.abs(traj.qdot[i]) >= qd_max - 1e-9)
+            & (np.abs(traj.qdot[i - 1]) + step > qd_max + 1e-9)
+        )
+    ]
     assert len(held) >= 5 and np.all(np.abs(traj.qdot) <= qd_max + 1e-9)
     assert set(traj.status[held]) == {"relaxed"}  # the tool gives way while the limit holds
 
@@ -140,9 +147,17 @@ def test_a_stop_longer_than_the_room_reserved_grows_the_record() -> None:
         spec, limits=tuple(lim for lim in spec.limits if not isinstance(lim, JointVelocityLimit))
     )
     resolver, c = dvqp.QPResolver(free, "daqp"), scene_commands(s)
-    traj = dvqp.simulate(s.robot, s.pipe_radius, resolver, s.q0, c.velocity, s.dt,
-                         obstacles=s.obstacles, reference=c.reference[:-1],
-                         feedback_gain=c.feedback_gain)  # fmt: skip
+    traj = dvqp.simulate(
+        s.robot,
+        s.pipe_radius,
+        resolver,
+        s.q0,
+        c.velocity,
+        s.dt,
+        obstacles=s.obstacles,
+        reference=c.reference[:-1],
+        feedback_gain=c.feedback_gain,
+    )
     k = traj.brake_start
     assert traj.n_steps - k > room(s.robot, resolver, s.dt) == math.ceil(MARGIN / s.dt) + 1
     assert traj.ok and not traj.qdot[-1].any()

@@ -80,13 +80,15 @@ def test_the_summary_gives_the_duration_before_and_after(
     retimed_runs: dict[str, Retimed],
 ) -> None:
     r = retimed_runs["paper-two-inlets"]
-    assert r.summary() == (f"{r.duration:.2f} s (planned 3.80 s), {r.t.shape[0]} samples at "
-                           f"500 Hz, limits kept")  # fmt: skip
+    assert r.summary() == (
+        f"{r.duration:.2f} s (planned 3.80 s), {r.t.shape[0]} samples at 500 Hz, limits kept"
+    )
     assert r.duration < 0.5 * 3.8  # the commands, not the joints, paced the planned run
 
 
-def load_joint_trajectory(path: Path) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray,
-                                                np.ndarray]:  # fmt: skip
+def load_joint_trajectory(
+    path: Path,
+) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """A ``trajectory_msgs/JointTrajectory`` as JSON, read field by field: joint names, and
     time from start (s), positions, velocities, accelerations per point."""
     doc = json.loads(path.read_text(encoding="utf-8"))
@@ -94,15 +96,23 @@ def load_joint_trajectory(path: Path) -> tuple[list[str], np.ndarray, np.ndarray
     assert doc["header"] == {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}
     names = doc["joint_names"]
     for point in doc["points"]:
-        assert set(point) == {"positions", "velocities", "accelerations", "effort",
-                              "time_from_start"}  # fmt: skip
+        assert set(point) == {
+            "positions",
+            "velocities",
+            "accelerations",
+            "effort",
+            "time_from_start",
+        }
         assert len(point["positions"]) == len(point["velocities"]) == len(names)
         assert isinstance(point["time_from_start"]["sec"], int)
         assert 0 <= point["time_from_start"]["nanosec"] < 10**9
-    duration = [p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"]
-                for p in doc["points"]]  # fmt: skip
-    fields = (np.array([p[key] for p in doc["points"]])
-              for key in ("positions", "velocities", "accelerations"))  # fmt: skip
+    duration = [
+        p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"] for p in doc["points"]
+    ]
+    fields = (
+        np.array([p[key] for p in doc["points"]])
+        for key in ("positions", "velocities", "accelerations")
+    )
     return names, np.array(duration), *fields  # type: ignore[return-value]
 
 

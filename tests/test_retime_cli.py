@@ -24,8 +24,11 @@ def test_plan_retime_prints_both_durations_and_writes_the_joint_trajectory(
     out = tmp_path / "paper.jt.json"
     assert main(["plan", PAPER, "--retime", "--rate", "250", "-o", str(out)]) == 0
     lines = capsys.readouterr().out.splitlines()
-    found = re.fullmatch(r"retimed         (\d+\.\d\d) s \(planned 3\.80 s\), (\d+) samples at "
-                         r"250 Hz, limits kept", lines[-2])  # fmt: skip
+    found = re.fullmatch(
+        r"retimed         (\d+\.\d\d) s \(planned 3\.80 s\), (\d+) samples at "
+        r"250 Hz, limits kept",
+        lines[-2],
+    )
     assert found, lines[-2]
     assert lines[-1] == f"saved           {out}"
     points = json.loads(out.read_text(encoding="utf-8"))["points"]
@@ -53,9 +56,11 @@ def test_plot_of_a_retimed_file_says_what_it_is_and_what_to_plot(
     capsys.readouterr()
     assert main(["plot", str(npz), "-o", str(tmp_path / "r.png")]) == 2
     err = capsys.readouterr().err
-    assert err == (f"dvqp: {npz}: a retimed motion (dvqp plan --retime): dvqp plot draws "
-                   "planned runs; save the run itself (dvqp plan SCENE -o RUN.npz) and plot "
-                   "that\n")  # fmt: skip
+    assert err == (
+        f"dvqp: {npz}: a retimed motion (dvqp plan --retime): dvqp plot draws "
+        "planned runs; save the run itself (dvqp plan SCENE -o RUN.npz) and plot "
+        "that\n"
+    )
     assert not (tmp_path / "r.png").exists()
 
 
@@ -65,12 +70,16 @@ def test_plot_of_a_retimed_file_says_what_it_is_and_what_to_plot(
         (["--retime", "--rate", "0"], "dvqp: --rate: must be > 0, got 0.0"),
         (["--retime", "--rate", "-3"], "dvqp: --rate: must be > 0, got -3.0"),
         (["--rate", "100"], "dvqp: --rate: is the rate of --retime: give --retime too"),
-        (["--retime", "-o", "{dir}/x.txt"],
-         "dvqp: output: {dir}/x.txt: unknown format '.txt' (use .npz, .csv, .json)"),
-        (["-o", "{dir}/x.json"],
-         "dvqp: output: {dir}/x.json: unknown format '.json' (use .npz, .csv)"),
+        (
+            ["--retime", "-o", "{dir}/x.txt"],
+            "dvqp: output: {dir}/x.txt: unknown format '.txt' (use .npz, .csv, .json)",
+        ),
+        (
+            ["-o", "{dir}/x.json"],
+            "dvqp: output: {dir}/x.json: unknown format '.json' (use .npz, .csv)",
+        ),
     ],
-)  # fmt: skip
+)
 def test_plan_retime_refuses_bad_input_before_the_run_with_exit_2(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], args: list[str], message: str
 ) -> None:

@@ -116,8 +116,7 @@ def test_continuous_joints_on_any_axis_become_unlimited_revolute_joints(tmp_path
             frame = raw_data.oMf[raw.getFrameId(name)]
             np.testing.assert_allclose(mine.origins[i], frame.translation, rtol=0, atol=1e-12)
             np.testing.assert_allclose(mine.axes[i], frame.rotation[:, 2], rtol=0, atol=1e-12)
-        np.testing.assert_allclose(mine.frame_jacobians, theirs.frame_jacobians, rtol=0,
-                                   atol=1e-12)  # fmt: skip
+        np.testing.assert_allclose(mine.frame_jacobians, theirs.frame_jacobians, rtol=0, atol=1e-12)
 
 
 def test_other_joints_are_refused_and_the_parser_stays_quiet(

@@ -44,7 +44,7 @@ def weld(**keys):  # type: ignore[no-untyped-def]
         "heading": "along",
         "height": 0.08,
     }
-    return SaddleWeld(**{**given, **keys})  # fmt: skip
+    return SaddleWeld(**{**given, **keys})
 
 
 @pytest.mark.parametrize("radius", [0.03, 0.05, 0.2])
@@ -58,11 +58,14 @@ def test_offset_curve_is_where_the_widened_branch_meets_the_pipe(radius: float) 
     assert np.all(got[:, 2] == 0.08)
 
 
-@pytest.mark.parametrize(("heading", "turn", "arc"), [
-    ("along", 0.0, (-0.5 * math.pi, 1.5 * math.pi)),
-    ("across", 0.5 * math.pi, (-0.5 * math.pi, 1.5 * math.pi)),
-    ("along", 0.0, (2.0, -4.0)),  # clockwise: along is still the direction of travel
-])  # fmt: skip
+@pytest.mark.parametrize(
+    ("heading", "turn", "arc"),
+    [
+        ("along", 0.0, (-0.5 * math.pi, 1.5 * math.pi)),
+        ("across", 0.5 * math.pi, (-0.5 * math.pi, 1.5 * math.pi)),
+        ("along", 0.0, (2.0, -4.0)),  # clockwise: along is still the direction of travel
+    ],
+)
 def test_heading_follows_the_tangent_continuously(heading: str, turn: float, arc: tuple) -> None:
     w = weld(heading=heading, arc=arc)
     theta = np.linspace(*arc, 20001)
@@ -111,27 +114,52 @@ def test_bad_weld_parameters_are_refused() -> None:
 TEXT = (SCENES / "saddle-weld.toml").read_text(encoding="utf-8")
 
 
-@pytest.mark.parametrize(("old", "new", "message"), [
-    ('branch = "nozzle"', 'branch = "nozle"',
-     "x.toml: motion.saddle.branch: no inlet obstacle named 'nozle' (named inlets: 'nozzle')"),
-    ('shape = "inlet"', 'shape = "circle"',
-     "x.toml: motion.saddle.branch: no inlet obstacle named 'nozzle' (named inlets: none)"),
-    ("offset = 0.02 ", "offset = 0.3 ",
-     "x.toml: motion.saddle.offset: the scanning radius r + d = 0.33 m must be smaller than "
-     "the pipe radius 0.254 m"),
-    ("arc = [-1.5708, 4.7124]", "arc = [1.0, 1.0]",
-     "x.toml: motion.saddle.arc: needs 0 < |θ_end − θ_start| <= 2π, got [1, 1]"),
-    ("arc = [-1.5708, 4.7124]", "arc = [1.0]",
-     "x.toml: motion.saddle.arc: expected an array of 2 numbers, got 1 values"),
-    ('heading = "along"', 'heading = "sideways"',
-     "x.toml: motion.saddle.heading: unknown heading 'sideways' (known: along, across)"),
-    ("h = 0.0817", "h = -0.01", "x.toml: motion.saddle.h: must be >= 0, got -0.01"),
-    ("h = 0.0817", "hh = 0.0817", "x.toml: motion.saddle.hh: unknown key (did you mean 'h'?)"),
-    ("speed = 0.02 ", "speed = 0.0 ", "x.toml: motion.saddle.speed: must be > 0, got 0.0"),
-    ("\n[motion.saddle]", "\n[[motion.jog]]\nduration = 1.0\nvelocity = [0.0, 0.0, 0.0, 0.0]\n"
-     "[motion.saddle]", "x.toml: motion: give exactly one of [[motion.jog]] segments, a "
-     "[motion.path] or a [motion.saddle]"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            'branch = "nozzle"',
+            'branch = "nozle"',
+            "x.toml: motion.saddle.branch: no inlet obstacle named 'nozle' "
+            "(named inlets: 'nozzle')",
+        ),
+        (
+            'shape = "inlet"',
+            'shape = "circle"',
+            "x.toml: motion.saddle.branch: no inlet obstacle named 'nozzle' (named inlets: none)",
+        ),
+        (
+            "offset = 0.02 ",
+            "offset = 0.3 ",
+            "x.toml: motion.saddle.offset: the scanning radius r + d = 0.33 m must be smaller than "
+            "the pipe radius 0.254 m",
+        ),
+        (
+            "arc = [-1.5708, 4.7124]",
+            "arc = [1.0, 1.0]",
+            "x.toml: motion.saddle.arc: needs 0 < |θ_end − θ_start| <= 2π, got [1, 1]",
+        ),
+        (
+            "arc = [-1.5708, 4.7124]",
+            "arc = [1.0]",
+            "x.toml: motion.saddle.arc: expected an array of 2 numbers, got 1 values",
+        ),
+        (
+            'heading = "along"',
+            'heading = "sideways"',
+            "x.toml: motion.saddle.heading: unknown heading 'sideways' (known: along, across)",
+        ),
+        ("h = 0.0817", "h = -0.01", "x.toml: motion.saddle.h: must be >= 0, got -0.01"),
+        ("h = 0.0817", "hh = 0.0817", "x.toml: motion.saddle.hh: unknown key (did you mean 'h'?)"),
+        ("speed = 0.02 ", "speed = 0.0 ", "x.toml: motion.saddle.speed: must be > 0, got 0.0"),
+        (
+            "\n[motion.saddle]",
+            "\n[[motion.jog]]\nduration = 1.0\nvelocity = [0.0, 0.0, 0.0, 0.0]\n[motion.saddle]",
+            "x.toml: motion: give exactly one of [[motion.jog]] segments, a "
+            "[motion.path] or a [motion.saddle]",
+        ),
+    ],
+)
 def test_scene_errors_name_the_file_and_the_field(old: str, new: str, message: str) -> None:
     assert old in TEXT
     with pytest.raises(SceneError) as err:

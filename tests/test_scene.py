@@ -78,8 +78,16 @@ def test_a_valid_scene_becomes_typed_objects() -> None:
     np.testing.assert_array_equal(scene.obstacles[0].center, [0.20, 0.45])
     assert scene.orbital_level == ORBITAL_LEVEL and scene.objective.gain == 1.0
     assert scene.objective.terms[0].level == ORBITAL_LEVEL
-    kinds = (JointPositionLimit, JointVelocityLimit, AccelerationLimit, ObstacleDamper,
-             SurfaceHeight, ProbeHeight, TiltLimit, SelfCollision)  # fmt: skip
+    kinds = (
+        JointPositionLimit,
+        JointVelocityLimit,
+        AccelerationLimit,
+        ObstacleDamper,
+        SurfaceHeight,
+        ProbeHeight,
+        TiltLimit,
+        SelfCollision,
+    )
     assert [type(limit) for limit in scene.limits] == list(kinds)
     acceleration, damper, height, probe, tilt, self_collision = scene.limits[2:]
     np.testing.assert_array_equal(acceleration.qdd_max, np.full(13, 10.0))
@@ -119,8 +127,13 @@ def test_the_bundled_paper_scene_puts_the_arm_where_the_issue_says() -> None:
     scene = load_scene(SCENES / "paper-two-inlets.toml")
     np.testing.assert_array_equal(scene.robot.q_max[1:], np.pi)
     state = KinematicState.compute(scene.robot, scene.q0, scene.pipe_radius)
-    expected = [(0.004, 0.100, 0.08), (0.012, 0.249, 0.08), (0.024, 0.399, 0.08),
-                (0.137, 0.372, 0.079), (0.252, 0.350, 0.079)]  # fmt: skip
+    expected = [
+        (0.004, 0.100, 0.08),
+        (0.012, 0.249, 0.08),
+        (0.024, 0.399, 0.08),
+        (0.137, 0.372, 0.079),
+        (0.252, 0.350, 0.079),
+    ]
     np.testing.assert_allclose(state.points, expected, atol=1.5e-3)
     np.testing.assert_allclose(state.tool, [0.297, 0.350, 0.082, 0.0], atol=1e-3)
     assert scene.weld == 0.35 and len(scene.obstacles) == 2
@@ -141,114 +154,250 @@ def test_every_bundled_scene_loads_and_has_a_readme_line() -> None:
 INVALID = [
     ("missing field", ("radius = 0.254\n", ""), "pipe.radius: required field is missing"),
     ("missing section", ("[pipe]\nradius = 0.254\n", ""), "pipe: required field is missing"),
-    ("wrong type", ("radius = 0.05\n", 'radius = "big"\n'),
-     'obstacles[1].radius: expected a number, got a string'),
-    ("boolean is no number", ("dt = 0.005", "dt = true"),
-     "motion.dt: expected a number, got a boolean"),
-    ("element type", ("-0.048, 0.068", '-0.048, "a"'),
-     "robot.q0[2]: expected a number, got a string"),
-    ("table expected", ("[pipe]\nradius = 0.254\n", "pipe = 0.254\n"),
-     "pipe: expected a table, got a number"),
-    ("wrong length", ("0.15, 0.06]", "0.06]"),
-     "robot.link_lengths: expected an array of 7 numbers, got 6 values"),
-    ("wrong length per joint", ("0.116, -0.278]", "0.116]"),
-     "robot.q0: expected an array of 13 numbers, got 12 values"),
-    ("wrong length per point", ("k_height = 1.0", "k_height = [1.0, 1.0]"),
-     "objective.k_height: expected a number or an array of 5 numbers, got 2 values"),
-    ("negative radius", ("radius = 0.05", "radius = -0.05"),
-     "obstacles[1].radius: must be > 0, got -0.05"),
+    (
+        "wrong type",
+        ("radius = 0.05\n", 'radius = "big"\n'),
+        "obstacles[1].radius: expected a number, got a string",
+    ),
+    (
+        "boolean is no number",
+        ("dt = 0.005", "dt = true"),
+        "motion.dt: expected a number, got a boolean",
+    ),
+    (
+        "element type",
+        ("-0.048, 0.068", '-0.048, "a"'),
+        "robot.q0[2]: expected a number, got a string",
+    ),
+    (
+        "table expected",
+        ("[pipe]\nradius = 0.254\n", "pipe = 0.254\n"),
+        "pipe: expected a table, got a number",
+    ),
+    (
+        "wrong length",
+        ("0.15, 0.06]", "0.06]"),
+        "robot.link_lengths: expected an array of 7 numbers, got 6 values",
+    ),
+    (
+        "wrong length per joint",
+        ("0.116, -0.278]", "0.116]"),
+        "robot.q0: expected an array of 13 numbers, got 12 values",
+    ),
+    (
+        "wrong length per point",
+        ("k_height = 1.0", "k_height = [1.0, 1.0]"),
+        "objective.k_height: expected a number or an array of 5 numbers, got 2 values",
+    ),
+    (
+        "negative radius",
+        ("radius = 0.05", "radius = -0.05"),
+        "obstacles[1].radius: must be > 0, got -0.05",
+    ),
     ("not finite", ("radius = 0.254", "radius = inf"), "pipe.radius: must be finite, got inf"),
     ("dt zero", ("dt = 0.005", "dt = 0"), "motion.dt: must be > 0, got 0.0"),
     ("dt negative", ("dt = 0.005", "dt = -0.01"), "motion.dt: must be > 0, got -0.01"),
-    ("unknown key", ("orbital_level = 0.08", "orbital_levle = 0.08"),
-     "objective.orbital_levle: unknown key (did you mean 'orbital_level'?)"),
+    (
+        "unknown key",
+        ("orbital_level = 0.08", "orbital_levle = 0.08"),
+        "objective.orbital_levle: unknown key (did you mean 'orbital_level'?)",
+    ),
     ("unknown section", ("[pipe]", "[pipes]"), "pipes: unknown key (did you mean 'pipe'?)"),
-    ("unknown key in array", ("weight = 10.0", "wieght = 10.0"),
-     "obstacles[0].wieght: unknown key (did you mean 'weight'?)"),
-    ("q0 outside the limits", ("q0 = [", "q_min = -1.0\nq_max = 1.0\nq0 = ["),
-     "robot.q0[0]: 1.5708 rad is outside [q_min, q_max] = [-1, 1] rad"),
-    ("limits crossed", ("q0 = [", "q_min = 2.0\nq_max = 1.0\nq0 = ["),
-     "robot.q_min: must be <= q_max for every joint"),
-    ("zero velocity limit", ("q0 = [", "qd_max = 0\nq0 = ["),
-     "robot.qd_max: must be > 0, got 0.0"),
-    ("zero weight", ("q0 = [", "weights = 0.0\nq0 = ["),
-     "robot.weights: must be >= 1e-06, got 0.0"),
+    (
+        "unknown key in array",
+        ("weight = 10.0", "wieght = 10.0"),
+        "obstacles[0].wieght: unknown key (did you mean 'weight'?)",
+    ),
+    (
+        "q0 outside the limits",
+        ("q0 = [", "q_min = -1.0\nq_max = 1.0\nq0 = ["),
+        "robot.q0[0]: 1.5708 rad is outside [q_min, q_max] = [-1, 1] rad",
+    ),
+    (
+        "limits crossed",
+        ("q0 = [", "q_min = 2.0\nq_max = 1.0\nq0 = ["),
+        "robot.q_min: must be <= q_max for every joint",
+    ),
+    ("zero velocity limit", ("q0 = [", "qd_max = 0\nq0 = ["), "robot.qd_max: must be > 0, got 0.0"),
+    (
+        "zero weight",
+        ("q0 = [", "weights = 0.0\nq0 = ["),
+        "robot.weights: must be >= 1e-06, got 0.0",
+    ),
     ("negative link", ("[0.334,", "[-0.334,"), "robot.link_lengths[0]: must be >= 0, got -0.334"),
     ("unknown model", ('"ndt13"', '"ndt12"'), "robot.model: unknown model 'ndt12' (known: ndt13)"),
-    ("model and urdf", ('model = "ndt13"', 'model = "ndt13"\nurdf = "a.urdf"'),
-     "robot: give exactly one of 'model' (built in) or 'urdf' (a file)"),
-    ("negative objective weight", ("k_height = 1.0", "k_height = -1.0"),
-     "objective.k_height: must be >= 0, got -1.0"),
-    ("damper gain", ("damper_gain = 0.5", "damper_gain = 2"),
-     "constraints.damper_gain: must be in (0, 1], got 2.0"),
-    ("influence below margin", ("influence = 0.06", "influence = 0.005"),
-     "constraints.influence: must be finite and > margin"),
-    ("jog duration", ("duration = 0.1", "duration = 0"),
-     "motion.jog[0].duration: must be > 0, got 0.0"),
-    ("jog velocity length", ("[0.05, 0.0, 0.0, 0.0]", "[0.05, 0.0]"),
-     "motion.jog[0].velocity: expected an array of 4 numbers, got 2 values"),
-    ("no motion", ("[[motion.jog]]\nduration = 0.1\nvelocity = [0.05, 0.0, 0.0, 0.0]\n", ""),
-     "motion: give exactly one of [[motion.jog]] segments, a [motion.path] or a [motion.saddle]"),
-    ("singular start", ("[0.334, 0.10, 0.15, 0.15, 0.15, 0.15, 0.06]", "[0, 0, 0, 0, 0, 0, 0]"),
-     "robot.q0: singular configuration: frame 'point1' lies on the pipe axis (rho = 0 m)"),
-    ("nan", ("orbital_level = 0.08", "orbital_level = nan"),
-     "objective.orbital_level: must be finite, got nan"),
-    ("obstacle swallows the tool", ("center = [0.20, 0.45]", "center = [0.2973, 0.40]"),
-     "obstacles[0]: covers the tool's start point [l, z] = [0.2973, 0.35] m "
-     "(10 mm inside the circle)"),
+    (
+        "model and urdf",
+        ('model = "ndt13"', 'model = "ndt13"\nurdf = "a.urdf"'),
+        "robot: give exactly one of 'model' (built in) or 'urdf' (a file)",
+    ),
+    (
+        "negative objective weight",
+        ("k_height = 1.0", "k_height = -1.0"),
+        "objective.k_height: must be >= 0, got -1.0",
+    ),
+    (
+        "damper gain",
+        ("damper_gain = 0.5", "damper_gain = 2"),
+        "constraints.damper_gain: must be in (0, 1], got 2.0",
+    ),
+    (
+        "influence below margin",
+        ("influence = 0.06", "influence = 0.005"),
+        "constraints.influence: must be finite and > margin",
+    ),
+    (
+        "jog duration",
+        ("duration = 0.1", "duration = 0"),
+        "motion.jog[0].duration: must be > 0, got 0.0",
+    ),
+    (
+        "jog velocity length",
+        ("[0.05, 0.0, 0.0, 0.0]", "[0.05, 0.0]"),
+        "motion.jog[0].velocity: expected an array of 4 numbers, got 2 values",
+    ),
+    (
+        "no motion",
+        ("[[motion.jog]]\nduration = 0.1\nvelocity = [0.05, 0.0, 0.0, 0.0]\n", ""),
+        "motion: give exactly one of [[motion.jog]] segments, a [motion.path] or a [motion.saddle]",
+    ),
+    (
+        "singular start",
+        ("[0.334, 0.10, 0.15, 0.15, 0.15, 0.15, 0.06]", "[0, 0, 0, 0, 0, 0, 0]"),
+        "robot.q0: singular configuration: frame 'point1' lies on the pipe axis (rho = 0 m)",
+    ),
+    (
+        "nan",
+        ("orbital_level = 0.08", "orbital_level = nan"),
+        "objective.orbital_level: must be finite, got nan",
+    ),
+    (
+        "obstacle swallows the tool",
+        ("center = [0.20, 0.45]", "center = [0.2973, 0.40]"),
+        "obstacles[0]: covers the tool's start point [l, z] = [0.2973, 0.35] m "
+        "(10 mm inside the circle)",
+    ),
     # sane bounds of physical quantities, the bound in the message
-    ("huge pipe", ("radius = 0.254", "radius = 1e300"),
-     "pipe.radius: must be <= 100 m, got 1e+300"),
-    ("tiny pipe", ("radius = 0.254", "radius = 1e-9"),
-     "pipe.radius: must be >= 0.001 m, got 1e-09"),
-    ("far weld", ("radius = 0.254", "radius = 0.254\nweld = -1e9"),
-     "pipe.weld: must be >= -1000 m, got -1000000000.0"),
+    (
+        "huge pipe",
+        ("radius = 0.254", "radius = 1e300"),
+        "pipe.radius: must be <= 100 m, got 1e+300",
+    ),
+    (
+        "tiny pipe",
+        ("radius = 0.254", "radius = 1e-9"),
+        "pipe.radius: must be >= 0.001 m, got 1e-09",
+    ),
+    (
+        "far weld",
+        ("radius = 0.254", "radius = 0.254\nweld = -1e9"),
+        "pipe.weld: must be >= -1000 m, got -1000000000.0",
+    ),
     ("long link", ("[0.334,", "[1e3,"), "robot.link_lengths[0]: must be <= 10 m, got 1000.0"),
-    ("far start angle", ("q0 = [1.5708", "q_min = -inf\nq_max = inf\nq0 = [1e300"),
-     "robot.q0[0]: must be <= 1000 rad, got 1e+300"),
-    ("huge finite limit", ("q0 = [", "q_max = 1e300\nq0 = ["),
-     "robot.q_max: must be <= 1000 rad, got 1e+300"),
-    ("fast joint", ("q0 = [", "qd_max = 1e9\nq0 = ["),
-     "robot.qd_max: must be <= 1000 rad/s, got 1000000000.0"),
-    ("heavy joint", ("q0 = [", "weights = 1e300\nq0 = ["),
-     "robot.weights: must be <= 1e+06, got 1e+300"),
-    ("far obstacle", ("center = [0.10, 0.20]", "center = [0.10, 1e300]"),
-     "obstacles[1].center[1]: must be <= 1000 m, got 1e+300"),
-    ("huge obstacle", ("radius = 0.05", "radius = 1e3"),
-     "obstacles[1].radius: must be <= 100 m, got 1000.0"),
-    ("heavy obstacle", ("weight = 10.0", "weight = 1e300"),
-     "obstacles[0].weight: must be <= 1e+06, got 1e+300"),
-    ("high orbit", ("orbital_level = 0.08", "orbital_level = 1e300"),
-     "objective.orbital_level: must be <= 10 m, got 1e+300"),
-    ("orbit inside", ("orbital_level = 0.08", "orbital_level = -0.1"),
-     "objective.orbital_level: must be >= 0, got -0.1"),
-    ("huge objective weight", ("k_height = 1.0", "k_height = [1, 1, 1e300, 1, 1]"),
-     "objective.k_height[2]: must be <= 1e+06, got 1e+300"),
-    ("huge gain", ("k_height = 1.0", "k_height = 1.0\ngain = 1e300"),
-     "objective.gain: must be <= 1e+06, got 1e+300"),
+    (
+        "far start angle",
+        ("q0 = [1.5708", "q_min = -inf\nq_max = inf\nq0 = [1e300"),
+        "robot.q0[0]: must be <= 1000 rad, got 1e+300",
+    ),
+    (
+        "huge finite limit",
+        ("q0 = [", "q_max = 1e300\nq0 = ["),
+        "robot.q_max: must be <= 1000 rad, got 1e+300",
+    ),
+    (
+        "fast joint",
+        ("q0 = [", "qd_max = 1e9\nq0 = ["),
+        "robot.qd_max: must be <= 1000 rad/s, got 1000000000.0",
+    ),
+    (
+        "heavy joint",
+        ("q0 = [", "weights = 1e300\nq0 = ["),
+        "robot.weights: must be <= 1e+06, got 1e+300",
+    ),
+    (
+        "far obstacle",
+        ("center = [0.10, 0.20]", "center = [0.10, 1e300]"),
+        "obstacles[1].center[1]: must be <= 1000 m, got 1e+300",
+    ),
+    (
+        "huge obstacle",
+        ("radius = 0.05", "radius = 1e3"),
+        "obstacles[1].radius: must be <= 100 m, got 1000.0",
+    ),
+    (
+        "heavy obstacle",
+        ("weight = 10.0", "weight = 1e300"),
+        "obstacles[0].weight: must be <= 1e+06, got 1e+300",
+    ),
+    (
+        "high orbit",
+        ("orbital_level = 0.08", "orbital_level = 1e300"),
+        "objective.orbital_level: must be <= 10 m, got 1e+300",
+    ),
+    (
+        "orbit inside",
+        ("orbital_level = 0.08", "orbital_level = -0.1"),
+        "objective.orbital_level: must be >= 0, got -0.1",
+    ),
+    (
+        "huge objective weight",
+        ("k_height = 1.0", "k_height = [1, 1, 1e300, 1, 1]"),
+        "objective.k_height[2]: must be <= 1e+06, got 1e+300",
+    ),
+    (
+        "huge gain",
+        ("k_height = 1.0", "k_height = 1.0\ngain = 1e300"),
+        "objective.gain: must be <= 1e+06, got 1e+300",
+    ),
     ("long dt", ("dt = 0.005", "dt = 5"), "motion.dt: must be <= 1 s, got 5.0"),
-    ("longest duration", ("duration = 0.1", "duration = 1.7976931348623157e308"),
-     "motion.jog[0].duration: must be <= 1e+06 s, got 1.7976931348623157e+308"),
-    ("fast jog", ("[0.05, 0.0, 0.0, 0.0]", "[0.05, 0.0, 0.0, 1e300]"),
-     "motion.jog[0].velocity[3]: must be <= 10 rad/s, got 1e+300"),
-    ("too many jog steps", ("duration = 0.1", "duration = 1e6"),
-     "motion: about 2e+08 steps of dt: too many (at most 1e+07)"),
-    ("any other number", ("margin = 0.01", "margin = 1e300"),
-     "constraints.margin: must be <= 1e+06, got 1e+300"),
+    (
+        "longest duration",
+        ("duration = 0.1", "duration = 1.7976931348623157e308"),
+        "motion.jog[0].duration: must be <= 1e+06 s, got 1.7976931348623157e+308",
+    ),
+    (
+        "fast jog",
+        ("[0.05, 0.0, 0.0, 0.0]", "[0.05, 0.0, 0.0, 1e300]"),
+        "motion.jog[0].velocity[3]: must be <= 10 rad/s, got 1e+300",
+    ),
+    (
+        "too many jog steps",
+        ("duration = 0.1", "duration = 1e6"),
+        "motion: about 2e+08 steps of dt: too many (at most 1e+07)",
+    ),
+    (
+        "any other number",
+        ("margin = 0.01", "margin = 1e300"),
+        "constraints.margin: must be <= 1e+06, got 1e+300",
+    ),
     # what the parser itself cannot take
-    ("deep arrays", ("radius = 0.254", "radius = 0.254\nweld = " + "[" * 1000 + "]" * 1000),
-     "invalid TOML: values nested too deeply"),
-    ("deep tables", ("radius = 0.254",
-     "radius = 0.254\nweld = " + "{a = " * 1000 + "1" + "}" * 1000),
-     "invalid TOML: values nested too deeply"),
-    ("nested but parsed", ("radius = 0.254", "radius = 0.254\nweld = " + "[" * 100 + "]" * 100),
-     "pipe.weld: expected a number, got an array"),
-    ("5000 digits", ("radius = 0.254", "radius = " + "1" * 5000),
-     "invalid TOML: Exceeds the limit (4300 digits) for integer string conversion: "
-     "value has 5000 digits"),
-    ("line break in a key", ("[pipe]", '[pipe]\n"a\\nb" = 1'),
-     "pipe.a\\nb: unknown key (allowed: radius, weld)"),
-]  # fmt: skip
+    (
+        "deep arrays",
+        ("radius = 0.254", "radius = 0.254\nweld = " + "[" * 1000 + "]" * 1000),
+        "invalid TOML: values nested too deeply",
+    ),
+    (
+        "deep tables",
+        ("radius = 0.254", "radius = 0.254\nweld = " + "{a = " * 1000 + "1" + "}" * 1000),
+        "invalid TOML: values nested too deeply",
+    ),
+    (
+        "nested but parsed",
+        ("radius = 0.254", "radius = 0.254\nweld = " + "[" * 100 + "]" * 100),
+        "pipe.weld: expected a number, got an array",
+    ),
+    (
+        "5000 digits",
+        ("radius = 0.254", "radius = " + "1" * 5000),
+        "invalid TOML: Exceeds the limit (4300 digits) for integer string conversion: "
+        "value has 5000 digits",
+    ),
+    (
+        "line break in a key",
+        ("[pipe]", '[pipe]\n"a\\nb" = 1'),
+        "pipe.a\\nb: unknown key (allowed: radius, weld)",
+    ),
+]
 
 
 @pytest.mark.parametrize(
@@ -264,21 +413,39 @@ def test_invalid_scenes_raise_one_line_naming_file_and_field(
 
 
 INVALID_PATHS = [
-    ("waypoint inside the pipe", ("[0.35, 0.35, 0.082, 0.0]", "[0.35, 0.35, -0.01, 0.0]"),
-     "motion.path.waypoints[1]: h = -0.01 m is inside the pipe (must be >= 0)"),
-    ("one waypoint", ("[[0.30, 0.35, 0.082, 0.0], ", "["),
-     "motion.path.waypoints: expected an array of at least 2 waypoints [l, z, h, α]"),
-    ("waypoint length", ("[0.35, 0.35, 0.082, 0.0]", "[0.35, 0.35]"),
-     "motion.path.waypoints[1]: expected an array of 4 numbers, got 2 values"),
-    ("zero-length path", ("[0.35, 0.35, 0.082, 0.0]", "[0.30, 0.35, 0.082, 0.0]"),
-     "motion.path.waypoints: the waypoints are all the same: nothing to follow"),
-    ("number out of range", ("speed = 0.05", "speed = 1" + "0" * 400),
-     "motion.path.speed: must be <= 10 m/s, got 1.000e+400"),
-    ("too many steps", ("speed = 0.05", "speed = 1e-300"),
-     "motion: about 1e+301 steps of dt: too many (at most 1e+07)"),
+    (
+        "waypoint inside the pipe",
+        ("[0.35, 0.35, 0.082, 0.0]", "[0.35, 0.35, -0.01, 0.0]"),
+        "motion.path.waypoints[1]: h = -0.01 m is inside the pipe (must be >= 0)",
+    ),
+    (
+        "one waypoint",
+        ("[[0.30, 0.35, 0.082, 0.0], ", "["),
+        "motion.path.waypoints: expected an array of at least 2 waypoints [l, z, h, α]",
+    ),
+    (
+        "waypoint length",
+        ("[0.35, 0.35, 0.082, 0.0]", "[0.35, 0.35]"),
+        "motion.path.waypoints[1]: expected an array of 4 numbers, got 2 values",
+    ),
+    (
+        "zero-length path",
+        ("[0.35, 0.35, 0.082, 0.0]", "[0.30, 0.35, 0.082, 0.0]"),
+        "motion.path.waypoints: the waypoints are all the same: nothing to follow",
+    ),
+    (
+        "number out of range",
+        ("speed = 0.05", "speed = 1" + "0" * 400),
+        "motion.path.speed: must be <= 10 m/s, got 1.000e+400",
+    ),
+    (
+        "too many steps",
+        ("speed = 0.05", "speed = 1e-300"),
+        "motion: about 1e+301 steps of dt: too many (at most 1e+07)",
+    ),
     ("missing speed", ("speed = 0.05", ""), "motion.path.speed: required field is missing"),
     ("zero speed", ("speed = 0.05", "speed = 0.0"), "motion.path.speed: must be > 0, got 0.0"),
-]  # fmt: skip
+]
 
 
 @pytest.mark.parametrize(
@@ -325,8 +492,14 @@ URDF = """<?xml version="1.0"?>
 
 def _urdf_arm() -> str:
     """A 6-joint arm on a carriage about the pipe axis; frames p2, p4, p6 and the tool."""
-    joints = [("z", "0 0 0"), ("x", "0.334 0 0.1"), ("y", "0 0 0.15"), ("x", "0 0 0.15"),
-              ("y", "0 0 0.15"), ("x", "0 0 0.1")]  # fmt: skip
+    joints = [
+        ("z", "0 0 0"),
+        ("x", "0.334 0 0.1"),
+        ("y", "0 0 0.15"),
+        ("x", "0 0 0.15"),
+        ("y", "0 0 0.15"),
+        ("x", "0 0 0.1"),
+    ]
     parts, parent = [], "base"
     for i, (axis, xyz) in enumerate(joints, start=1):
         vec = {"x": "1 0 0", "y": "0 1 0", "z": "0 0 1"}[axis]

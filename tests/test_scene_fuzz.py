@@ -117,9 +117,31 @@ def nested(depth: int, table: bool) -> Raw:
 
 
 NUMBERS = st.sampled_from(
-    [0, -0.0, 1e-300, 1e-9, 0.001, 0.5, -0.5, 3, 9.99, 10.0, 99.9, 999.0, 1e6, -1e6, 1e300,
-     -1e300, 1.7976931348623157e308, math.inf, -math.inf, math.nan, 10**400, -(10**30)]
-)  # fmt: skip
+    [
+        0,
+        -0.0,
+        1e-300,
+        1e-9,
+        0.001,
+        0.5,
+        -0.5,
+        3,
+        9.99,
+        10.0,
+        99.9,
+        999.0,
+        1e6,
+        -1e6,
+        1e300,
+        -1e300,
+        1.7976931348623157e308,
+        math.inf,
+        -math.inf,
+        math.nan,
+        10**400,
+        -(10**30),
+    ]
+)
 VALUES = st.one_of(
     NUMBERS,
     st.floats(allow_nan=True, allow_infinity=True),
@@ -134,9 +156,24 @@ VALUES = st.one_of(
 
 def mutate(doc: Doc, data: st.DataObject) -> str | bytes:
     """One mistake in ``doc``: the file text (or bytes) to run."""
-    kind = data.draw(st.sampled_from(["replace", "number", "number", "scale", "scale", "delete",
-                                      "unknown", "length", "deep", "bytes", "splice"]),
-                     label="mistake")  # fmt: skip
+    kind = data.draw(
+        st.sampled_from(
+            [
+                "replace",
+                "number",
+                "number",
+                "scale",
+                "scale",
+                "delete",
+                "unknown",
+                "length",
+                "deep",
+                "bytes",
+                "splice",
+            ]
+        ),
+        label="mistake",
+    )
     if kind == "bytes":
         return data.draw(st.binary(min_size=1, max_size=64), label="garbage")
     text = dumps(doc)

@@ -41,8 +41,10 @@ def test_a_table_without_shape_is_a_circle_as_before() -> None:
 
 def test_a_polygon_may_straddle_the_seam() -> None:
     edge = np.pi * 0.254
-    table = (f'[[obstacles]]\nshape = "polygon"\nvertices = [[{edge - 0.03}, 0.6], '
-             f"[{edge + 0.03}, 0.6], [{edge + 0.03}, 0.65], [{edge - 0.03}, 0.65]]\n")  # fmt: skip
+    table = (
+        f'[[obstacles]]\nshape = "polygon"\nvertices = [[{edge - 0.03}, 0.6], '
+        f"[{edge + 0.03}, 0.6], [{edge + 0.03}, 0.65], [{edge - 0.03}, 0.65]]\n"
+    )
     (pad,) = loads(with_obstacles(table), SRC).obstacles
     period = 2 * np.pi * 0.254
     inside_either_side = np.array([[edge - 0.01, 0.62], [-edge + 0.01, 0.62]])
@@ -51,20 +53,30 @@ def test_a_polygon_may_straddle_the_seam() -> None:
 
 
 BAD = [
-    ('shape = "cone"\ncenter = [0.2, 0.5]\nradius = 0.05',
-     "obstacles[0].shape: unknown shape 'cone' (known: circle, inlet, band, polygon)"),
-    ('shape = "polygon"\nvertices = [[0.4, 0.6], [0.5, 0.6]]',
-     "obstacles[0].vertices: expected an array of at least 3 vertices [l, z]"),
-    ('shape = "polygon"\nvertices = [[0.4, 0.6], [0.5, 0.7], [0.5, 0.6], [0.4, 0.7]]',
-     "obstacles[0].vertices: the polygon's edges cross (it must be simple)"),
-    ('shape = "inlet"\ncenter = [0.2, 0.6]\nradius = 0.3',
-     "obstacles[0].radius: 0.3 m must be smaller than the pipe radius 0.254 m"),
+    (
+        'shape = "cone"\ncenter = [0.2, 0.5]\nradius = 0.05',
+        "obstacles[0].shape: unknown shape 'cone' (known: circle, inlet, band, polygon)",
+    ),
+    (
+        'shape = "polygon"\nvertices = [[0.4, 0.6], [0.5, 0.6]]',
+        "obstacles[0].vertices: expected an array of at least 3 vertices [l, z]",
+    ),
+    (
+        'shape = "polygon"\nvertices = [[0.4, 0.6], [0.5, 0.7], [0.5, 0.6], [0.4, 0.7]]',
+        "obstacles[0].vertices: the polygon's edges cross (it must be simple)",
+    ),
+    (
+        'shape = "inlet"\ncenter = [0.2, 0.6]\nradius = 0.3',
+        "obstacles[0].radius: 0.3 m must be smaller than the pipe radius 0.254 m",
+    ),
     ('shape = "band"\nz = [0.6, 0.5]', "obstacles[0].z: needs z_min < z_max, got [0.6, 0.5]"),
     ('shape = "band"\nz = [0.6, 0.7]\nradius = 0.1', "obstacles[0].radius: unknown key"),
-    ('shape = "band"\nz = [0.30, 0.40]',
-     "obstacles[0]: covers the tool's start point [l, z] = [0.2973, 0.35] m "
-     "(50 mm inside the band)"),
-]  # fmt: skip
+    (
+        'shape = "band"\nz = [0.30, 0.40]',
+        "obstacles[0]: covers the tool's start point [l, z] = [0.2973, 0.35] m "
+        "(50 mm inside the band)",
+    ),
+]
 
 
 @pytest.mark.parametrize(("table", "message"), BAD, ids=[m.split(":")[1] for _, m in BAD])

@@ -59,12 +59,21 @@ def test_degenerate_segments_are_points() -> None:
 def test_pairs_are_the_non_adjacent_links() -> None:
     pairs = PairBuffers.allocate(5)
     assert list(zip(pairs.i.tolist(), pairs.j.tolist(), strict=True)) == [
-        (0, 2), (0, 3), (0, 4), (1, 3), (1, 4), (2, 4)
-    ]  # fmt: skip
+        (0, 2),
+        (0, 3),
+        (0, 4),
+        (1, 3),
+        (1, 4),
+        (2, 4),
+    ]
     assert SelfCollision().labels(5) == (
-        "link1/link3", "link1/link4", "link1/holder", "link2/link4", "link2/holder",
+        "link1/link3",
+        "link1/link4",
+        "link1/holder",
+        "link2/link4",
+        "link2/holder",
         "link3/holder",
-    )  # fmt: skip
+    )
     railed = PairBuffers.allocate(5, rail=True)  # the carriage link (5) against all but link1
     pairs = list(zip(railed.i.tolist(), railed.j.tolist(), strict=True))
     assert [p for p in pairs if 5 in p] == [(1, 5), (2, 5), (3, 5), (4, 5)] and len(pairs) == 10

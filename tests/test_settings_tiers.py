@@ -78,8 +78,16 @@ def test_compare_reports_accuracy_for_every_qp_backend_and_none_for_the_baseline
     pytest.importorskip("daqp")
     pytest.importorskip("osqp")
     out = tmp_path / "r.json"
-    argv = ["compare", write_scene(tmp_path), "--backends", "pinv,daqp,osqp",
-            "--settings", "high_accuracy", "--json", str(out)]  # fmt: skip
+    argv = [
+        "compare",
+        write_scene(tmp_path),
+        "--backends",
+        "pinv,daqp,osqp",
+        "--settings",
+        "high_accuracy",
+        "--json",
+        str(out),
+    ]
     assert main(argv) == 0
     printed = capsys.readouterr().out
     assert printed.startswith("settings: high_accuracy\n")
@@ -104,8 +112,20 @@ def test_compare_check_ignores_the_baselines_broken_limits(tmp_path: Path) -> No
 def test_bench_runs_under_a_tier_and_merges_every_calls_accuracy(tmp_path: Path) -> None:
     pytest.importorskip("daqp")
     out = tmp_path / "b.json"
-    argv = ["bench", "--count", "2", "--seed", "1", "--backends", "pinv,daqp",
-            "--settings", "high_accuracy", "--check", "--json", str(out)]  # fmt: skip
+    argv = [
+        "bench",
+        "--count",
+        "2",
+        "--seed",
+        "1",
+        "--backends",
+        "pinv,daqp",
+        "--settings",
+        "high_accuracy",
+        "--check",
+        "--json",
+        str(out),
+    ]
     assert main(argv) == 0
     doc = json.loads(out.read_text("utf-8"))
     runs = [r for r in doc["results"] if r["backend"] == "daqp"]

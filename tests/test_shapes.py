@@ -33,7 +33,7 @@ HALF = math.pi * R
 PAD = Polygon(np.array([[0.40, 0.31], [0.46, 0.30], [0.47, 0.40], [0.41, 0.41]]))
 L_SHAPE = Polygon(
     np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.03], [0.03, 0.03], [0.03, 0.1], [0.0, 0.1]])
-)  # fmt: skip  (non-convex)
+)  # (non-convex)
 SEAM = Polygon(np.array([[0.75, 0.2], [0.85, 0.2], [0.85, 0.3], [0.75, 0.3]]))  # past l = πR
 INLET = Inlet(np.array([0.17, 0.25]), 0.075, R)
 WIDE_INLET = Inlet(np.array([-0.3, 0.5]), 0.2, R)  # r/R = 0.79: strongly stretched in l
@@ -42,8 +42,17 @@ BAND = Band(0.46, 0.50)
 CIRCLE = Circle(np.array([0.2, 0.45]), 0.06)
 SEAM_CIRCLE = Circle(np.array([HALF - 0.01, -0.2]), 0.05)  # across the seam
 SHAPES = [PAD, L_SHAPE, SEAM, INLET, WIDE_INLET, SEAM_INLET, BAND, CIRCLE, SEAM_CIRCLE]
-IDS = ["pad", "l-shape", "seam-polygon", "inlet", "wide-inlet", "seam-inlet", "band", "circle",
-       "seam-circle"]  # fmt: skip
+IDS = [
+    "pad",
+    "l-shape",
+    "seam-polygon",
+    "inlet",
+    "wide-inlet",
+    "seam-inlet",
+    "band",
+    "circle",
+    "seam-circle",
+]
 
 
 def point_distance(shape: Shape, lz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -103,10 +112,12 @@ def around(shape: Shape, rng: np.random.Generator, count: int) -> np.ndarray:
     lo, hi = shape.z_range
     span = max(hi - lo, 0.05)
     l_mid = middle_l(shape)
-    pts = np.column_stack([
-        l_mid + rng.uniform(-1.5 * span, 1.5 * span, count),
-        rng.uniform(lo - 0.5 * span, hi + 0.5 * span, count),
-    ])  # fmt: skip
+    pts = np.column_stack(
+        [
+            l_mid + rng.uniform(-1.5 * span, 1.5 * span, count),
+            rng.uniform(lo - 0.5 * span, hi + 0.5 * span, count),
+        ]
+    )
     pts[:, 0] = wrap(pts[:, 0], PERIOD)
     return pts
 
@@ -141,8 +152,12 @@ def test_segment_distances_match_brute_force_and_their_closest_point(shape: Shap
     ts = np.linspace(0, 1, 4_001)[:, None]
     ends = short_way(a, b, PERIOD)  # the link goes the short way round
     numpy_twin = twin(shape)  # 4001 samples a link, measured by the NumPy oracle
-    sampled = np.array([numpy_twin.point_distance(a[i] + ts * (ends[i] - a[i]), PERIOD)[0]
-                        for i in range(a.shape[0])])  # fmt: skip
+    sampled = np.array(
+        [
+            numpy_twin.point_distance(a[i] + ts * (ends[i] - a[i]), PERIOD)[0]
+            for i in range(a.shape[0])
+        ]
+    )
     np.testing.assert_allclose(d, sampled.min(axis=1), atol=1e-4)
     assert (d <= sampled.min(axis=1) + 1e-12).all()  # never above a sample of the link
     at_t, n_at_t = point_distance(shape, a + t[:, None] * (ends - a))

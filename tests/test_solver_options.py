@@ -50,13 +50,16 @@ def test_the_scene_s_settings_reach_the_backend(tmp_path: Path) -> None:
     assert "iteration limit" not in plan(scene, "osqp", options={"max_iter": 20000}).refusals
 
 
-@pytest.mark.parametrize(("table", "message"), [
-    ("[solvers.osqp]\neps_abss = 1e-6\n", "solvers.osqp: osqp: unknown setting 'eps_abss'"),
-    ("[solvers.osqp]\neps_abs = [1e-6]\n", "solvers.osqp.eps_abs: expected a finite number"),
-    ("[solvers.osqp]\neps_abs = nan\n", "solvers.osqp.eps_abs: expected a finite number"),
-    ("[solvers.pinv]\ngain = 1\n", "solvers.pinv: the pseudoinverse has no settings"),
-    ("solvers = 3\n", "solvers: expected tables of settings"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    ("table", "message"),
+    [
+        ("[solvers.osqp]\neps_abss = 1e-6\n", "solvers.osqp: osqp: unknown setting 'eps_abss'"),
+        ("[solvers.osqp]\neps_abs = [1e-6]\n", "solvers.osqp.eps_abs: expected a finite number"),
+        ("[solvers.osqp]\neps_abs = nan\n", "solvers.osqp.eps_abs: expected a finite number"),
+        ("[solvers.pinv]\ngain = 1\n", "solvers.pinv: the pseudoinverse has no settings"),
+        ("solvers = 3\n", "solvers: expected tables of settings"),
+    ],
+)
 def test_bad_settings_in_a_scene_are_refused_at_load_naming_the_field(
     tmp_path: Path, table: str, message: str
 ) -> None:
@@ -74,12 +77,15 @@ def test_settings_of_a_backend_not_installed_are_kept_unchecked(tmp_path: Path) 
     assert scene.solver_options == {"gurobi": {"TimeLimit": 0.1}}
 
 
-@pytest.mark.parametrize(("option", "message"), [
-    ("osqp.eps_abs", "expected NAME.KEY=VALUE"),
-    ("eps_abs=1e-6", "expected NAME.KEY=VALUE"),
-    ("daqp.primal_tol=1e-6", "daqp is not run here (backends: osqp)"),
-    ("osqp.eps_abs=[1]", "expected a finite number, a boolean or text"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        ("osqp.eps_abs", "expected NAME.KEY=VALUE"),
+        ("eps_abs=1e-6", "expected NAME.KEY=VALUE"),
+        ("daqp.primal_tol=1e-6", "daqp is not run here (backends: osqp)"),
+        ("osqp.eps_abs=[1]", "expected a finite number, a boolean or text"),
+    ],
+)
 def test_a_bad_solver_option_is_one_line_and_exit_2_before_any_run(
     option: str, message: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -101,7 +107,21 @@ def test_solver_options_reach_plan_compare_and_bench(
     assert main(["compare", scene, "--backends", "osqp", "--solver-option", "osqp.eps_abss=1"]) == 2
     assert "unknown setting 'eps_abss'" in capsys.readouterr().err
     out = tmp_path / "bench.json"
-    assert main(["bench", "--count", "2", "--backends", "osqp", "--json", str(out),
-                 "--solver-option", "osqp.max_iter=1"]) == 0  # fmt: skip
+    assert (
+        main(
+            [
+                "bench",
+                "--count",
+                "2",
+                "--backends",
+                "osqp",
+                "--json",
+                str(out),
+                "--solver-option",
+                "osqp.max_iter=1",
+            ]
+        )
+        == 0
+    )
     summary = json.loads(out.read_text("utf-8"))["summary"]["osqp"]
     assert summary["capped_calls"] > 0 and "capped calls" in capsys.readouterr().out

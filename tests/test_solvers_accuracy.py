@@ -21,10 +21,16 @@ def _problem(seed: int) -> Problem:
     rng = np.random.default_rng(seed)
     n = 9
     M = rng.normal(size=(n, n))
-    return Problem(M @ M.T + np.eye(n), 3.0 * rng.normal(size=n), A=rng.normal(size=(2, n)),
-                   b=0.1 * rng.normal(size=2), G=rng.normal(size=(12, n)),
-                   h=0.3 * np.abs(rng.normal(size=12)), lb=-0.4 * np.ones(n),
-                   ub=0.4 * np.ones(n))  # fmt: skip
+    return Problem(
+        M @ M.T + np.eye(n),
+        3.0 * rng.normal(size=n),
+        A=rng.normal(size=(2, n)),
+        b=0.1 * rng.normal(size=2),
+        G=rng.normal(size=(12, n)),
+        h=0.3 * np.abs(rng.normal(size=12)),
+        lb=-0.4 * np.ones(n),
+        ub=0.4 * np.ones(n),
+    )
 
 
 @pytest.mark.parametrize("backend", ["daqp", "osqp", "clarabel", "quadprog", "proxqp"])
@@ -44,8 +50,9 @@ def test_duality_gap_equals_qpsolvers_own_on_each_backends_answer(backend: str, 
     theirs.x, theirs.y, theirs.z, theirs.z_box = answer.x, answer.y, answer.z, answer.z_box
     theirs.found = True
     assert answer.residuals.duality_gap == pytest.approx(theirs.duality_gap(), rel=1e-9, abs=1e-13)
-    assert answer.residuals.stationarity == pytest.approx(theirs.dual_residual(), rel=1e-9,
-                                                          abs=1e-13)  # fmt: skip
+    assert answer.residuals.stationarity == pytest.approx(
+        theirs.dual_residual(), rel=1e-9, abs=1e-13
+    )
     assert metrics(answer) == pytest.approx(
         (theirs.primal_residual(), theirs.dual_residual(), theirs.duality_gap()),
         rel=1e-9,
@@ -58,8 +65,16 @@ def test_an_infinite_row_is_left_out_of_the_gap_and_a_wrong_point_has_one() -> N
     answer = make_backend("daqp").solve(problem)
     h = problem.h.copy()
     h[::4] = np.inf  # rows never active: their multipliers are 0, their terms nothing
-    inactive = Problem(problem.P, problem.q, A=problem.A, b=problem.b, G=problem.G, h=h,
-                       lb=problem.lb, ub=problem.ub)  # fmt: skip
+    inactive = Problem(
+        problem.P,
+        problem.q,
+        A=problem.A,
+        b=problem.b,
+        G=problem.G,
+        h=h,
+        lb=problem.lb,
+        ub=problem.ub,
+    )
     again = make_backend("daqp").solve(inactive)
     assert again.found and math.isfinite(again.residuals.duality_gap)  # type: ignore[union-attr]
     moved = make_backend("daqp").solve(problem)
@@ -87,8 +102,9 @@ def test_shifted_geometric_mean_refuses_what_qpbenchmark_refuses() -> None:
 
 def test_tallies_merge_exactly_and_an_unanswered_call_counts_at_its_tolerance() -> None:
     answers = [make_backend("daqp").solve(_problem(seed)) for seed in range(6)]
-    infeasible = Problem(np.eye(2), np.zeros(2), G=np.array([[1.0, 0.0], [-1.0, 0.0]]),
-                         h=np.array([-1.0, -1.0]))  # fmt: skip
+    infeasible = Problem(
+        np.eye(2), np.zeros(2), G=np.array([[1.0, 0.0], [-1.0, 0.0]]), h=np.array([-1.0, -1.0])
+    )
     refused = make_backend("daqp").solve(infeasible)
     assert not refused.found
     whole, first, second = AccuracyTally(), AccuracyTally(), AccuracyTally()

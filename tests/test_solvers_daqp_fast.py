@@ -140,8 +140,9 @@ def test_fast_checks_agree_with_missing_blocks_and_multipliers(
     x = rng.uniform(-1.0, 1.0, n)
     sizes = {"y": problem.n_eq, "z": problem.n_in, "z_box": n}
     duals = {k: rng.standard_normal(s) if given_duals[k] else None for k, s in sizes.items()}
-    adopted = Solution.adopt(problem, x.copy(), backend="t", tolerance=TOL, status="ok",
-                             iterations=3, **duals)  # fmt: skip
+    adopted = Solution.adopt(
+        problem, x.copy(), backend="t", tolerance=TOL, status="ok", iterations=3, **duals
+    )
     assert_same_solution(adopted, general_check(problem, x, **duals))
     full = {k: rng.standard_normal(s) for k, s in sizes.items()}  # DAQP gives them all
     fast, handed = stacked_check(problem, x, **full)
@@ -203,11 +204,13 @@ def test_daqp_warm_solutions_are_those_of_the_general_check() -> None:
         solution = backend.solve(ws.problem)
         assert solution.found and not solution.retried, solution.message
         assert solution.x is not None and solution.x is not previous  # each solve's own x
-        want = general_check(ws.problem, solution.x, y=solution.y, z=solution.z,
-                             z_box=solution.z_box)  # fmt: skip
+        want = general_check(
+            ws.problem, solution.x, y=solution.y, z=solution.z, z_box=solution.z_box
+        )
         assert solution.residuals == want.residuals and want.found
-        np.testing.assert_allclose(solution.x, make_backend("daqp").solve(ws.fresh()).require(),
-                                   atol=2 * TOL)  # fmt: skip
+        np.testing.assert_allclose(
+            solution.x, make_backend("daqp").solve(ws.fresh()).require(), atol=2 * TOL
+        )
         previous = solution.x
     data = backend._data.copy()  # DAQP only reads the stacked buffer
     assert stack(*backend._stack) == 0
@@ -247,8 +250,9 @@ def test_daqp_copies_problems_that_do_not_fit_the_compiled_copy_with_numpy(field
         fortran[:] = getattr(ws, field)
         solution = backend.solve(problem)
         assert backend._stack is None and solution.found and not solution.retried
-        np.testing.assert_allclose(solution.x, make_backend("daqp").solve(ws.fresh()).require(),
-                                   atol=2 * TOL)  # fmt: skip
+        np.testing.assert_allclose(
+            solution.x, make_backend("daqp").solve(ws.fresh()).require(), atol=2 * TOL
+        )
     validated = make_backend("daqp")
     for _ in range(2):  # read-only arrays of validated problems take the compiled copy
         ws.move(0.01)

@@ -158,9 +158,15 @@ def test_checked_rejects_nan_multipliers_and_a_non_finite_x() -> None:
     z = case.z.copy()
     z[0] = np.nan
     nan_dual = Solution.checked(
-        case.problem, case.x, backend="t", tolerance=1e-6, status="ok",
-        y=case.y, z=z, z_box=case.z_box,
-    )  # fmt: skip
+        case.problem,
+        case.x,
+        backend="t",
+        tolerance=1e-6,
+        status="ok",
+        y=case.y,
+        z=z,
+        z_box=case.z_box,
+    )
     assert not nan_dual.found and "stationarity residual nan" in nan_dual.message
     x = case.x.copy()
     x[0] = np.inf

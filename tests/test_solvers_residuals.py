@@ -129,11 +129,19 @@ def test_residuals_of_a_shifted_optimum_equal_the_oracle() -> None:
 DATA = ("P", "q", "A", "b", "G", "h", "lb", "ub")
 #: Where a NaN goes (field, index) and the residual it must make NaN.
 NAN_CASES = [
-    ("h", 0, "inequality"), ("G", (0, 0), "inequality"), ("b", 0, "equality"),
-    ("A", (0, 0), "equality"), ("lb", 0, "bounds"), ("ub", 1, "bounds"),
-    ("P", (0, 0), "stationarity"), ("q", 0, "stationarity"), ("x", 0, "equality"),
-    ("y", 0, "stationarity"), ("z", 0, "complementarity"), ("z_box", 0, "stationarity"),
-]  # fmt: skip
+    ("h", 0, "inequality"),
+    ("G", (0, 0), "inequality"),
+    ("b", 0, "equality"),
+    ("A", (0, 0), "equality"),
+    ("lb", 0, "bounds"),
+    ("ub", 1, "bounds"),
+    ("P", (0, 0), "stationarity"),
+    ("q", 0, "stationarity"),
+    ("x", 0, "equality"),
+    ("y", 0, "stationarity"),
+    ("z", 0, "complementarity"),
+    ("z_box", 0, "stationarity"),
+]
 
 
 @pytest.mark.parametrize(("field", "index", "residual"), NAN_CASES)

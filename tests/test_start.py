@@ -26,14 +26,18 @@ def start_at(changes: dict[int, float], text: str = BASE) -> str:
 @pytest.mark.parametrize(
     ("changes", "message"),
     [
-        ({1: 0.3}, "robot.q0: body point 5 (frame 'point5') starts inside the pipe: "
-                   "h = -0.00987 m"),
-        ({2: 0.6}, "robot.q0: body point 4 (frame 'point4') starts inside the pipe: "
-                   "h = -0.01604 m"),
+        (
+            {1: 0.3},
+            "robot.q0: body point 5 (frame 'point5') starts inside the pipe: h = -0.00987 m",
+        ),
+        (
+            {2: 0.6},
+            "robot.q0: body point 4 (frame 'point4') starts inside the pipe: h = -0.01604 m",
+        ),
         ({5: -0.6}, "robot.q0: the tool (frame 'tool') starts inside the pipe: h = -0.005759 m"),
     ],
     ids=["body point", "first of several", "the tool alone"],
-)  # fmt: skip
+)
 def test_a_start_inside_the_pipe_is_refused_naming_the_part_and_its_height(
     changes: dict[int, float], message: str
 ) -> None:

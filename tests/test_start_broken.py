@@ -41,8 +41,9 @@ def heights(*qs: np.ndarray) -> tuple[np.ndarray, tuple[str, ...]]:
     ``qs``, m (rows,), measured independently of the step, and the rows' labels."""
     paper = scene("paper-two-inlets")
     radius = paper.pipe_radius
-    found = [measure(SurfaceHeight(BOUND), KinematicState.compute(paper.robot, q, radius))
-             for q in qs]  # fmt: skip
+    found = [
+        measure(SurfaceHeight(BOUND), KinematicState.compute(paper.robot, q, radius)) for q in qs
+    ]
     return np.min([m.value for m in found], axis=0), found[0].labels
 
 
@@ -106,8 +107,12 @@ def test_the_trajectory_file_carries_each_value_broken_at_the_start(tmp_path: Pa
     start, worst, labels = below(traj)
     broken = np.flatnonzero((start > 0) & (worst > TOLERANCE))
     assert [b.label for b in found] == [labels[i] for i in broken]
-    assert [b.label for b in found] == ["point4/height", "point5/height", "link3/height",
-                                        "link4/height"]  # fmt: skip
+    assert [b.label for b in found] == [
+        "point4/height",
+        "point5/height",
+        "link3/height",
+        "link4/height",
+    ]
     assert {(b.limit, b.quantity, b.unit, b.bound, b.tolerance) for b in found} == {
         ("min_height", "height", "m", BOUND, TOLERANCE)
     }
@@ -151,8 +156,10 @@ def test_the_baseline_that_makes_it_worse_is_broken_and_says_by_how_much() -> No
     start, worst = safe - found[0].value, safe - np.min([m.value for m in found], axis=0)
     broken = np.flatnonzero((start > 0) & (worst > TOLERANCE))
     i, worse = int(broken[np.argmax(worst[broken])]), (worst - start)[broken].max()
-    line = (f"margin: broken from the start by {worst[i] * 1e3:.3g} mm ({labels[i]} and "
-            f"{len(broken) - 1} more), {worse * 1e3:.3g} mm worse than at the start")  # fmt: skip
+    line = (
+        f"margin: broken from the start by {worst[i] * 1e3:.3g} mm ({labels[i]} and "
+        f"{len(broken) - 1} more), {worse * 1e3:.3g} mm worse than at the start"
+    )
     assert worse > 0.005
     text = format_summary(s, traj, summarize(s, traj), None)
     limits = text.split("\nlimits          ")[1].split("\nstep time")[0].split("\n")

@@ -37,8 +37,7 @@ def check_jacobians(robot: Robot, q: np.ndarray) -> None:
     scale = np.abs(state.tool_jacobian).max()
     np.testing.assert_allclose(state.tool_jacobian, fd("tool"), rtol=1e-6, atol=1e-6 * scale)
     scale = np.abs(state.guarded_jacobians).max()
-    np.testing.assert_allclose(state.guarded_jacobians, fd("guarded"), rtol=1e-6,
-                               atol=1e-6 * scale)  # fmt: skip
+    np.testing.assert_allclose(state.guarded_jacobians, fd("guarded"), rtol=1e-6, atol=1e-6 * scale)
     jv, jw = state.frame_jacobians[:, :3], state.frame_jacobians[:, 3:]
     np.testing.assert_allclose(jv, fd("origins", None), rtol=1e-6, atol=1e-7)
     # ż = ω × z = −S(z)·J_ω·Q̇

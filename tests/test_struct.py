@@ -77,8 +77,14 @@ def test_every_struct_and_array_is_freed_with_its_owner() -> None:
     )
     env = dict(os.environ, NUMBA_NRT_STATS="1")
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    run = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
-                         env=env, cwd=root, check=False)  # fmt: skip
+    run = subprocess.run(
+        [sys.executable, "-c", probe],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=root,
+        check=False,
+    )
     assert run.returncode == 0, run.stderr
     made, freed = map(int, run.stdout.split())
     assert made == freed == 100 * 4  # two arrays and two structs a round

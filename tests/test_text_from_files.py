@@ -58,21 +58,30 @@ def test_an_error_quoting_hostile_text_is_one_escaped_line(
 
 
 @settings(max_examples=60, deadline=None)
-@given(name=st.text(st.characters(exclude_categories=("Cs",)), max_size=30),
-       description=st.text(st.characters(exclude_categories=("Cs",)), max_size=30))  # fmt: skip
+@given(
+    name=st.text(st.characters(exclude_categories=("Cs",)), max_size=30),
+    description=st.text(st.characters(exclude_categories=("Cs",)), max_size=30),
+)
 def test_any_scene_name_or_description_loads_printable(name: str, description: str) -> None:
     text = (Path(__file__).parent.parent / "scenes" / "joint-limit.toml").read_text("utf-8")
     head = f"name = {toml_string(name)}\ndescription = {toml_string(description)}\n"
-    body = "\n".join(line for line in text.splitlines()
-                     if not line.startswith(("name =", "description =")))  # fmt: skip
+    body = "\n".join(
+        line for line in text.splitlines() if not line.startswith(("name =", "description ="))
+    )
     scene = loads(head + body)
     assert scene.name.isprintable() and scene.description.isprintable()
     assert scene.name == name or "\\" in scene.name  # unchanged unless something was escaped
 
 
-@pytest.mark.parametrize("command", [["plan", "{scene}", "-o", ""], ["plan", "{scene}", "-o", " "],
-                                     ["compare", "{scene}", "--json", ""],
-                                     ["bench", "--count", "1", "--csv", ""]])  # fmt: skip
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["plan", "{scene}", "-o", ""],
+        ["plan", "{scene}", "-o", " "],
+        ["compare", "{scene}", "--json", ""],
+        ["bench", "--count", "1", "--csv", ""],
+    ],
+)
 def test_an_empty_output_name_is_refused_before_any_run(
     command: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -24,8 +24,16 @@ RUSH = SCENES / "weld-rush.toml"
 
 def buffers(b: float) -> QPBuffers:
     """``min ½‖x‖²`` s.t. ``x₀ + x₁ = b``, ``|x| ≤ 1``: feasible for ``|b| ≤ 2``."""
-    return QPBuffers(P=np.eye(2), cost=np.zeros(2), A=np.array([[1.0, 1.0]]), b=np.array([b]),
-                     G=np.zeros((0, 2)), h=np.zeros(0), lb=-np.ones(2), ub=np.ones(2))  # fmt: skip
+    return QPBuffers(
+        P=np.eye(2),
+        cost=np.zeros(2),
+        A=np.array([[1.0, 1.0]]),
+        b=np.array([b]),
+        G=np.zeros((0, 2)),
+        h=np.zeros(0),
+        lb=-np.ones(2),
+        ub=np.ones(2),
+    )
 
 
 @pytest.mark.parametrize("backend", ["daqp", "osqp", "clarabel"])
@@ -82,8 +90,12 @@ def test_path_deviation_is_the_distance_to_the_polyline_by_dense_sampling() -> N
     reference = np.column_stack([np.cumsum(rng.normal(size=(12, 3)), axis=0), np.zeros(12)])
     tool = np.column_stack([rng.normal(size=(40, 3)) * 3.0, np.zeros(40)])
     t = np.linspace(0.0, 1.0, 4001)
-    dense = np.concatenate([a + t[:, None] * (b - a) for a, b in
-                            zip(reference[:-1, :3], reference[1:, :3], strict=True)])  # fmt: skip
+    dense = np.concatenate(
+        [
+            a + t[:, None] * (b - a)
+            for a, b in zip(reference[:-1, :3], reference[1:, :3], strict=True)
+        ]
+    )
     oracle = np.linalg.norm(tool[:, None, :3] - dense[None], axis=2).min(axis=1)
     found = path_deviation(reference, tool)
     assert np.all(found <= oracle + 1e-12)

@@ -23,12 +23,22 @@ def straddling(n_samples: int = 4) -> Trajectory:
     tool[:, 0] = (-edge + 0.03 + drift[:, 0] + edge) % (2 * edge) - edge
     n = n_samples - 1
     return Trajectory.from_samples(
-        dt=0.01, q=np.zeros((n_samples, 2)), qdot=np.zeros((n, 2)), tool=tool, points=points,
-        pipe_radius=R, w=np.zeros(n_samples), min_clearance=np.full(n_samples, np.inf),
-        solve_time=np.zeros(n), step_time=np.zeros(n), task_error=np.zeros(n),
-        iterations=np.zeros(n, dtype=np.int64), success=np.ones(n, dtype=bool),
-        status=["optimal"] * n, backend="test",
-    )  # fmt: skip
+        dt=0.01,
+        q=np.zeros((n_samples, 2)),
+        qdot=np.zeros((n, 2)),
+        tool=tool,
+        points=points,
+        pipe_radius=R,
+        w=np.zeros(n_samples),
+        min_clearance=np.full(n_samples, np.inf),
+        solve_time=np.zeros(n),
+        step_time=np.zeros(n),
+        task_error=np.zeros(n),
+        iterations=np.zeros(n, dtype=np.int64),
+        success=np.ones(n, dtype=bool),
+        status=["optimal"] * n,
+        backend="test",
+    )
 
 
 def test_l_is_continuous_along_the_body_and_in_time_across_the_seam() -> None:
@@ -107,9 +117,23 @@ def test_the_safety_diagnostics_round_trip_and_old_files_still_load(tmp_path: Pa
         np.testing.assert_array_equal(getattr(back, name), getattr(full, name))
     assert back.brake_start == 2 and back.braking_time == pytest.approx(0.01)  # the last step
     # a file written before 0.2: "dv" for the tool, no diagnostics
-    arrays = {name: getattr(traj, name) for name in ("t", "q", "qdot", "points", "w",
-              "min_clearance", "solve_time", "step_time", "task_error", "iterations",
-              "success", "status")}  # fmt: skip
+    arrays = {
+        name: getattr(traj, name)
+        for name in (
+            "t",
+            "q",
+            "qdot",
+            "points",
+            "w",
+            "min_clearance",
+            "solve_time",
+            "step_time",
+            "task_error",
+            "iterations",
+            "success",
+            "status",
+        )
+    }
     old = tmp_path / "old.npz"
     np.savez(old, dv=traj.tool, backend="pinv", pipe_radius=R, scene="", **arrays)
     loaded = Trajectory.load(old)

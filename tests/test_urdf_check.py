@@ -33,8 +33,10 @@ def chain(n: int, kind: str = "revolute") -> str:
             f'<child link="l{i}"/><origin xyz="{0.3 if i == 1 else 0} 0 0.01"/>'
             '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
         )
-    parts.append(f'<link name="probe"/><joint name="t" type="fixed"><parent link="l{n}"/>'
-                 '<child link="probe"/><origin xyz="0.05 0 0"/></joint></robot>')  # fmt: skip
+    parts.append(
+        f'<link name="probe"/><joint name="t" type="fixed"><parent link="l{n}"/>'
+        '<child link="probe"/><origin xyz="0.05 0 0"/></joint></robot>'
+    )
     return "\n".join(parts)
 
 
@@ -54,8 +56,14 @@ def capped_plan(folder: Path, urdf: str, n: int) -> tuple[subprocess.CompletedPr
 
     argv = ["plan", str(folder / "arm.toml"), "--backend", "pinv", "-o", str(folder / "o.npz")]
     start = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "dvqp", *argv], capture_output=True, text=True,
-                          preexec_fn=cap, cwd=ROOT, timeout=300)  # fmt: skip
+    done = subprocess.run(
+        [sys.executable, "-m", "dvqp", *argv],
+        capture_output=True,
+        text=True,
+        preexec_fn=cap,
+        cwd=ROOT,
+        timeout=300,
+    )
     return done, time.perf_counter() - start
 
 
@@ -88,73 +96,151 @@ def write(folder: Path, text: str | bytes) -> Path:
     return path
 
 
-BOMB = ('<?xml version="1.0"?>\n<!DOCTYPE robot [<!ENTITY e0 "aaaaaaaaaa">'
-        + "".join(f'<!ENTITY e{i + 1} "{f"&e{i};" * 10}">' for i in range(8))
-        + ']>\n<robot name="&e8;"><link name="base"/></robot>')  # fmt: skip
+BOMB = (
+    '<?xml version="1.0"?>\n<!DOCTYPE robot [<!ENTITY e0 "aaaaaaaaaa">'
+    + "".join(f'<!ENTITY e{i + 1} "{f"&e{i};" * 10}">' for i in range(8))
+    + ']>\n<robot name="&e8;"><link name="base"/></robot>'
+)
 """A billion laughs: the robot's name would expand to 10**9 characters."""
 EXTERNAL = '<!DOCTYPE robot [<!ENTITY x SYSTEM "file:///etc/passwd">]><robot name="&x;"/>'
 REFUSED = [
-    ("two parents", ARM.replace("</robot>", f"{CYCLE}</robot>"),
-     "joint 'cyc': link 'link2' already has parent joint 'joint2'"),
-    ("a cycle", ARM.replace('<parent link="base"/><child link="link1"/>',
-                            '<parent link="probe"/><child link="link1"/>'),
-     "the joints 'joint1', 'probe_fixed', 'joint13', 'joint12', 'joint11', 'joint10', ... form a "
-     "cycle: the links must form a tree"),
-    ("a self loop", ARM.replace('<parent link="link1"/><child link="link2"/>',
-                                '<parent link="link2"/><child link="link2"/>'),
-     "the joints 'joint2' form a cycle"),
-    ("a missing link", ARM.replace('<parent link="link4"/><child link="point1"/>',
-                                   '<parent link="link44"/><child link="point1"/>'),
-     "joint 'point1_fixed': parent link 'link44' is not a link of the file"),
-    ("a joint with two parent elements",
-     ARM.replace('<parent link="link1"/>', '<parent link="link1"/><parent link="base"/>'),
-     "joint 'joint2' has 2 <parent> elements, not one"),
-    ("a joint with no child", ARM.replace('<child link="link3"/>', ""),
-     "joint 'joint3' has 0 <child> elements, not one"),
-    ("two roots", ARM.replace('<link name="base"/>', '<link name="base"/><link name="island"/>'),
-     "2 links have no parent joint ('base', 'island'): the links must form one tree"),
+    (
+        "two parents",
+        ARM.replace("</robot>", f"{CYCLE}</robot>"),
+        "joint 'cyc': link 'link2' already has parent joint 'joint2'",
+    ),
+    (
+        "a cycle",
+        ARM.replace(
+            '<parent link="base"/><child link="link1"/>',
+            '<parent link="probe"/><child link="link1"/>',
+        ),
+        "the joints 'joint1', 'probe_fixed', 'joint13', 'joint12', 'joint11', 'joint10', "
+        "... form a cycle: the links must form a tree",
+    ),
+    (
+        "a self loop",
+        ARM.replace(
+            '<parent link="link1"/><child link="link2"/>',
+            '<parent link="link2"/><child link="link2"/>',
+        ),
+        "the joints 'joint2' form a cycle",
+    ),
+    (
+        "a missing link",
+        ARM.replace(
+            '<parent link="link4"/><child link="point1"/>',
+            '<parent link="link44"/><child link="point1"/>',
+        ),
+        "joint 'point1_fixed': parent link 'link44' is not a link of the file",
+    ),
+    (
+        "a joint with two parent elements",
+        ARM.replace('<parent link="link1"/>', '<parent link="link1"/><parent link="base"/>'),
+        "joint 'joint2' has 2 <parent> elements, not one",
+    ),
+    (
+        "a joint with no child",
+        ARM.replace('<child link="link3"/>', ""),
+        "joint 'joint3' has 0 <child> elements, not one",
+    ),
+    (
+        "two roots",
+        ARM.replace('<link name="base"/>', '<link name="base"/><link name="island"/>'),
+        "2 links have no parent joint ('base', 'island'): the links must form one tree",
+    ),
     ("an entity bomb", BOMB, "a DOCTYPE (DTD, entities) is not allowed in a URDF file"),
     ("an external entity", EXTERNAL, "a DOCTYPE (DTD, entities) is not allowed"),
-    ("NaN in an origin", ARM.replace('xyz="0 0 0.334" rpy="-1.5707963267948966 0 0"/><axis',
-                                     'xyz="0 nan 0.334" rpy="-1.5707963267948966 0 0"/><axis'),
-     "joint 'joint3': origin xyz = '0 nan 0.334': expected 3 finite numbers"),
-    ("an overflowing rpy", ARM.replace('rpy="1.5707963267948966 0 0"', 'rpy="1e999 0 0"', 1),
-     "joint 'joint2': origin rpy = '1e999 0 0': expected 3 finite numbers"),
-    ("two numbers for three", ARM.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 1"/>', 1),
-     "joint 'joint1': axis xyz = '0 1': expected 3 finite numbers"),
-    ("a zero axis", ARM.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>', 1),
-     "joint 'joint1': axis xyz '0 0 0' has no direction"),
-    ("a limit without velocity", ARM.replace(' effort="10" velocity="1.5"/>', ' effort="1"/>', 1),
-     "joint 'joint1': <limit> has no velocity"),
-    ("a revolute joint without limit", chain(2).replace(
-        '<limit lower="-1" upper="1" effort="1" velocity="1"/>', "", 1),
-     "joint 'j1' is revolute but has no <limit>"),
-    ("crossed limits", chain(2).replace('lower="-1" upper="1"', 'lower="1" upper="-1"', 1),
-     "joint 'j1': limit lower 1 > upper -1"),
-    ("a planar joint", ARM.replace('name="joint3" type="revolute"', 'name="joint3" type="planar"'),
-     "joint 'joint3' has type 'planar': dvqp takes only revolute, continuous, prismatic and "
-     "fixed joints"),
-    ("a control character in a name", ARM.replace('name="link3"', 'name="link&#127;3"'),
-     "link number 5: the name 'link\\x7f3' is not 200 printable characters or fewer"),
-    ("a line break in a name", ARM.replace('name="joint4"', 'name="joint&#10;4"'),
-     "joint number 5: the name 'joint\\n4' is not 200 printable"),
+    (
+        "NaN in an origin",
+        ARM.replace(
+            'xyz="0 0 0.334" rpy="-1.5707963267948966 0 0"/><axis',
+            'xyz="0 nan 0.334" rpy="-1.5707963267948966 0 0"/><axis',
+        ),
+        "joint 'joint3': origin xyz = '0 nan 0.334': expected 3 finite numbers",
+    ),
+    (
+        "an overflowing rpy",
+        ARM.replace('rpy="1.5707963267948966 0 0"', 'rpy="1e999 0 0"', 1),
+        "joint 'joint2': origin rpy = '1e999 0 0': expected 3 finite numbers",
+    ),
+    (
+        "two numbers for three",
+        ARM.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 1"/>', 1),
+        "joint 'joint1': axis xyz = '0 1': expected 3 finite numbers",
+    ),
+    (
+        "a zero axis",
+        ARM.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>', 1),
+        "joint 'joint1': axis xyz '0 0 0' has no direction",
+    ),
+    (
+        "a limit without velocity",
+        ARM.replace(' effort="10" velocity="1.5"/>', ' effort="1"/>', 1),
+        "joint 'joint1': <limit> has no velocity",
+    ),
+    (
+        "a revolute joint without limit",
+        chain(2).replace('<limit lower="-1" upper="1" effort="1" velocity="1"/>', "", 1),
+        "joint 'j1' is revolute but has no <limit>",
+    ),
+    (
+        "crossed limits",
+        chain(2).replace('lower="-1" upper="1"', 'lower="1" upper="-1"', 1),
+        "joint 'j1': limit lower 1 > upper -1",
+    ),
+    (
+        "a planar joint",
+        ARM.replace('name="joint3" type="revolute"', 'name="joint3" type="planar"'),
+        "joint 'joint3' has type 'planar': dvqp takes only revolute, continuous, prismatic and "
+        "fixed joints",
+    ),
+    (
+        "a control character in a name",
+        ARM.replace('name="link3"', 'name="link&#127;3"'),
+        "link number 5: the name 'link\\x7f3' is not 200 printable characters or fewer",
+    ),
+    (
+        "a line break in a name",
+        ARM.replace('name="joint4"', 'name="joint&#10;4"'),
+        "joint number 5: the name 'joint\\n4' is not 200 printable",
+    ),
     ("an empty name", ARM.replace('name="link3"', 'name=""', 1), "link number 5 has no name"),
-    ("two links of one name", ARM.replace('<link name="point1"/>', '<link name="link4"/>'),
-     "two links are named 'link4'"),
-    ("too many actuated joints", chain(65), "65 revolute, continuous and prismatic joints: dvqp "
-     "takes at most 64"),
-    ("no joint that moves", '<robot name="r"><link name="a"/></robot>',
-     "no revolute, continuous or prismatic joint: nothing moves"),
+    (
+        "two links of one name",
+        ARM.replace('<link name="point1"/>', '<link name="link4"/>'),
+        "two links are named 'link4'",
+    ),
+    (
+        "too many actuated joints",
+        chain(65),
+        "65 revolute, continuous and prismatic joints: dvqp takes at most 64",
+    ),
+    (
+        "no joint that moves",
+        '<robot name="r"><link name="a"/></robot>',
+        "no revolute, continuous or prismatic joint: nothing moves",
+    ),
     ("another root element", "<urdf><robot/></urdf>", "the root element is <urdf>, not <robot>"),
     ("not XML", "<robot", "not well-formed XML: unclosed token: line 1, column 0"),
-    ("deep nesting", ARM.replace('<link name="base"/>',
-                                 '<link name="base">' + "<a>" * 20000 + "</a>" * 20000 + "</link>"),
-     "elements nested more than 16 deep"),
-    ("not UTF-8", ARM.encode("utf-8").replace(b'name="base"', b'name="b\xe4se"'),
-     "not UTF-8 text (byte "),
-    ("a huge file", ARM.replace("</robot>", "<!--" + "x" * MAX_BYTES + "--></robot>"),
-     "larger than 1 MiB: not a robot description"),
-]  # fmt: skip
+    (
+        "deep nesting",
+        ARM.replace(
+            '<link name="base"/>', '<link name="base">' + "<a>" * 20000 + "</a>" * 20000 + "</link>"
+        ),
+        "elements nested more than 16 deep",
+    ),
+    (
+        "not UTF-8",
+        ARM.encode("utf-8").replace(b'name="base"', b'name="b\xe4se"'),
+        "not UTF-8 text (byte ",
+    ),
+    (
+        "a huge file",
+        ARM.replace("</robot>", "<!--" + "x" * MAX_BYTES + "--></robot>"),
+        "larger than 1 MiB: not a robot description",
+    ),
+]
 
 
 @pytest.mark.parametrize(("text", "reason"), [c[1:] for c in REFUSED], ids=[c[0] for c in REFUSED])
@@ -194,15 +280,31 @@ def test_a_scene_checks_its_per_joint_arrays_before_the_arm_is_built(
 
     monkeypatch.setattr(Robot, "from_urdf", build)
     cases = [
-        ("q0 = [0.0, 0.0, 0.0]", f"q0 = [{', '.join(['0.0'] * 13)}]", "q0", "an array of 3 "
-         "numbers, got 13 values"),
-        ("qdd_max = 10.0", "qdd_max = [1.0, 1.0]", "qdd_max", "a number or an array of 3 numbers, "
-         "got 2 values"),
-        ("[robot]", "[robot]\nweights = [1.0]", "weights", "a number or an array of 3 numbers, "
-         "got 1 values"),
-        ("[robot]", "[robot]\nq_max = [1.0, 1.0, 1.0, 1.0]", "q_max", "a number or an array of "
-         "3 numbers, got 4 values"),
-    ]  # fmt: skip
+        (
+            "q0 = [0.0, 0.0, 0.0]",
+            f"q0 = [{', '.join(['0.0'] * 13)}]",
+            "q0",
+            "an array of 3 numbers, got 13 values",
+        ),
+        (
+            "qdd_max = 10.0",
+            "qdd_max = [1.0, 1.0]",
+            "qdd_max",
+            "a number or an array of 3 numbers, got 2 values",
+        ),
+        (
+            "[robot]",
+            "[robot]\nweights = [1.0]",
+            "weights",
+            "a number or an array of 3 numbers, got 1 values",
+        ),
+        (
+            "[robot]",
+            "[robot]\nq_max = [1.0, 1.0, 1.0, 1.0]",
+            "q_max",
+            "a number or an array of 3 numbers, got 4 values",
+        ),
+    ]
     for old, new, key, reason in cases:
         (tmp_path / "arm.toml").write_text(base.replace(old, new), encoding="utf-8")
         with pytest.raises(SceneError) as info:

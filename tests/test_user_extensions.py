@@ -55,8 +55,11 @@ def floors() -> dict[str, type]:
     """The example's floor limits by name: ``ProbeFloor`` (NumPy) and, if given, its compiled
     twin ``CompiledProbeFloor``."""
     module = load("probe_floor")
-    kinds = {name: getattr(module, name) for name in ("ProbeFloor", "CompiledProbeFloor")
-             if hasattr(module, name)}  # fmt: skip
+    kinds = {
+        name: getattr(module, name)
+        for name in ("ProbeFloor", "CompiledProbeFloor")
+        if hasattr(module, name)
+    }
     assert "ProbeFloor" in kinds
     assert all(issubclass(kind, dvqp.VelocityDamper) for kind in kinds.values())
     return kinds
@@ -127,8 +130,10 @@ def test_a_compiled_user_limit_runs_as_its_numpy_twin() -> None:
     if "CompiledProbeFloor" not in kinds:
         pytest.skip("docs/examples/probe_floor.py has no compiled limit")
     scene = jog_scene("[0.0, 0.0, -0.02, 0.0]", duration=2.0)
-    plain, compiled = (dvqp.plan(scene, "daqp", limits=[kinds[name](floor=0.05)])
-                       for name in ("ProbeFloor", "CompiledProbeFloor"))  # fmt: skip
+    plain, compiled = (
+        dvqp.plan(scene, "daqp", limits=[kinds[name](floor=0.05)])
+        for name in ("ProbeFloor", "CompiledProbeFloor")
+    )
     np.testing.assert_allclose(compiled.q, plain.q, rtol=0, atol=1e-12)
     np.testing.assert_array_equal(compiled.status, plain.status)
 

@@ -24,8 +24,12 @@ from tests import runs
 from tests.test_console_browser import CHROMIUM, FLAGS, need
 
 ROOT = Path(__file__).resolve().parent.parent
-WEBGL = ["--use-gl=angle", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-         "--ignore-gpu-blocklist"]  # fmt: skip
+WEBGL = [
+    "--use-gl=angle",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--ignore-gpu-blocklist",
+]
 """WebGL without a GPU: ANGLE on SwiftShader (instead of the console's ``--disable-gpu``)."""
 
 pytestmark = pytest.mark.skipif(
@@ -65,9 +69,13 @@ def served(tmp_path: Path):  # type: ignore[no-untyped-def]
     need("viser", "pip install 'dvqp[view]'")
     traj = tmp_path / "pinv.npz"
     runs.run("paper-two-inlets", "pinv").save(traj)
-    proc = subprocess.Popen([sys.executable, "-m", "dvqp", "view", str(traj), "--port", "0"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            cwd=ROOT)  # fmt: skip
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "dvqp", "view", str(traj), "--port", "0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
     try:
         yield proc.stdout.readline().strip()  # type: ignore[union-attr]
         proc.send_signal(signal.SIGINT)
@@ -85,17 +93,18 @@ def test_view_in_chromium_shows_the_pipe_and_the_arm(served: str, tmp_path: Path
     errors: list[str] = []
     with sync_api.sync_playwright() as p:
         browser = p.chromium.launch_persistent_context(
-            str(tmp_path / "profile"), executable_path=CHROMIUM, headless=True,
+            str(tmp_path / "profile"),
+            executable_path=CHROMIUM,
+            headless=True,
             args=[f for f in FLAGS if f != "--disable-gpu"] + WEBGL,
             viewport={"width": 1280, "height": 800},
-        )  # fmt: skip
+        )
         page = browser.new_page()
         page.on("pageerror", lambda exc: errors.append(str(exc)))
         asked: list[str] = []
         page.on("request", lambda request: asked.append(request.url))
         page.goto(served)
-        last = shot(page, tmp_path / "view-last.png", {"pipe": 50_000, "arm": 2_000,
-                                                       "margin": 300})  # fmt: skip
+        last = shot(page, tmp_path / "view-last.png", {"pipe": 50_000, "arm": 2_000, "margin": 300})
         assert last["pipe"] > 50_000, last  # the pipe fills a good part of the page
         assert last["arm"] > 2_000, last  # the arm's links
         assert last["margin"] > 300, last  # the baseline's links at the lower inlet's margin

@@ -42,11 +42,13 @@ def saved(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.mark.parametrize(
     ("name", "message"),
-    [("missing.npz", "{f}: cannot read: No such file or directory"),
-     ("other.npz", "{f}: not a dvqp trajectory (not written by 'dvqp plan')"),
-     ("notes.txt", "{f}: not a dvqp trajectory (not an .npz file)"),
-     ("bad.toml", "{f}: pipe.radius: must be >= 0.001 m, got -1.0")],
-)  # fmt: skip
+    [
+        ("missing.npz", "{f}: cannot read: No such file or directory"),
+        ("other.npz", "{f}: not a dvqp trajectory (not written by 'dvqp plan')"),
+        ("notes.txt", "{f}: not a dvqp trajectory (not an .npz file)"),
+        ("bad.toml", "{f}: pipe.radius: must be >= 0.001 m, got -1.0"),
+    ],
+)
 def test_bad_input_is_one_line_and_exit_2(saved: Path, capsys, name, message) -> None:  # type: ignore[no-untyped-def]
     path = saved / name
     code = main(["view", str(path)])
@@ -68,8 +70,9 @@ def test_without_viser_it_says_how_to_install_it(monkeypatch, capsys) -> None:  
 
 def test_a_port_in_use_is_refused(capsys) -> None:  # type: ignore[no-untyped-def]
     pytest.importorskip("viser", reason="the view extra is not installed")
-    assert_a_taken_port_is_refused(lambda port: _run(parse(str(PAPER), "--port", str(port))),
-                                   capsys)  # fmt: skip
+    assert_a_taken_port_is_refused(
+        lambda port: _run(parse(str(PAPER), "--port", str(port))), capsys
+    )
 
 
 def test_the_view_serves_its_page_and_puts_the_arm_at_the_sliders_sample(saved: Path) -> None:

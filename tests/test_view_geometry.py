@@ -23,8 +23,13 @@ R = 0.254
 
 def dv_of(points: np.ndarray) -> np.ndarray:
     """[l, z, h] of 3-D points (theory §2), independent of the module under test."""
-    return np.column_stack([R * np.arctan2(points[:, 1], points[:, 0]), points[:, 2],
-                            np.hypot(points[:, 0], points[:, 1]) - R])  # fmt: skip
+    return np.column_stack(
+        [
+            R * np.arctan2(points[:, 1], points[:, 0]),
+            points[:, 2],
+            np.hypot(points[:, 0], points[:, 1]) - R,
+        ]
+    )
 
 
 def test_every_pipe_vertex_lies_on_the_pipe_surface() -> None:
@@ -75,8 +80,9 @@ def test_a_band_is_a_ring_round_the_pipe() -> None:
 
 
 def test_a_pad_is_its_outline_raised_with_a_top_covering_it() -> None:
-    corners = np.array([[0.0, 0.0], [0.12, 0.0], [0.12, 0.05], [0.04, 0.05], [0.04, 0.15],
-                        [0.0, 0.15]])  # an L: not convex  # fmt: skip
+    corners = np.array(
+        [[0.0, 0.0], [0.12, 0.0], [0.12, 0.05], [0.04, 0.05], [0.04, 0.15], [0.0, 0.15]]
+    )  # an L: not convex
     pad = Polygon(corners)
     mesh = scene3d.obstacle_mesh("pad", pad, R)
     lz_h = dv_of(mesh.vertices)
@@ -86,7 +92,8 @@ def test_a_pad_is_its_outline_raised_with_a_top_covering_it() -> None:
     assert np.allclose(lz_h[top, 2], scene3d.PATCH_HEIGHT, atol=1e-12)
     tri = lz_h[mesh.faces[2 * n :], :2]
     cross = (tri[:, 1, 0] - tri[:, 0, 0]) * (tri[:, 2, 1] - tri[:, 0, 1]) - (
-        tri[:, 1, 1] - tri[:, 0, 1]) * (tri[:, 2, 0] - tri[:, 0, 0])  # fmt: skip
+        tri[:, 1, 1] - tri[:, 0, 1]
+    ) * (tri[:, 2, 0] - tri[:, 0, 0])
     assert np.sum(np.abs(cross)) / 2 == pytest.approx(0.12 * 0.05 + 0.04 * 0.10, rel=1e-9)
     d, _ = distances([pad], tri.mean(axis=1), 2 * math.pi * R)
     assert d.max() < 0.0  # every top triangle inside the pad
@@ -99,8 +106,9 @@ def test_triangulation_of_a_simple_polygon_either_way_round(seed: int) -> None:
     rng = np.random.default_rng(seed)
     angle = np.sort(rng.uniform(0, 2 * np.pi, 14))
     poly = rng.uniform(0.3, 1.0, 14)[:, None] * np.column_stack([np.cos(angle), np.sin(angle)])
-    area = 0.5 * abs(np.sum(poly[:, 0] * np.roll(poly[:, 1], -1) - np.roll(poly[:, 0], -1)
-                            * poly[:, 1]))  # fmt: skip
+    area = 0.5 * abs(
+        np.sum(poly[:, 0] * np.roll(poly[:, 1], -1) - np.roll(poly[:, 0], -1) * poly[:, 1])
+    )
     for p in (poly, poly[::-1]):
         t = meshes.triangulate(p)
         assert t.shape == (12, 3)
@@ -131,10 +139,16 @@ def test_the_arm_chain_is_the_robots_frames_and_marks_the_links_at_their_margin(
         for i in range(view.chain.shape[1] - 1):
             a, b = view.chain[n, i], view.chain[n, i + 1]
             lz = dv_of(a + along * (b - a))[:, :2]
-            clearance = min(np.min(np.hypot((lz[:, 0] - c.center[0] + math.pi * R)
-                                            % (2 * math.pi * R) - math.pi * R,
-                                            lz[:, 1] - c.center[1]) - c.radius)
-                            for c in scene.obstacles)  # fmt: skip
+            clearance = min(
+                np.min(
+                    np.hypot(
+                        (lz[:, 0] - c.center[0] + math.pi * R) % (2 * math.pi * R) - math.pi * R,
+                        lz[:, 1] - c.center[1],
+                    )
+                    - c.radius
+                )
+                for c in scene.obstacles
+            )
             if abs(clearance - view.margin - scene3d.MARGIN_SLACK) > 1e-4:  # not on the edge
                 assert view.at_margin[n, i] == (clearance <= view.margin + scene3d.MARGIN_SLACK)
                 checked += view.at_margin[n, i]

@@ -47,9 +47,11 @@ def test_plot_3d_writes_a_png_showing_the_pipe_and_the_arm(saved: Path, capsys) 
 
 @pytest.mark.parametrize(
     ("extra", "message"),
-    [(["--gif"], "--3d takes neither --limits, --gif nor --full"),
-     (["--full"], "--3d takes neither --limits, --gif nor --full")],
-)  # fmt: skip
+    [
+        (["--gif"], "--3d takes neither --limits, --gif nor --full"),
+        (["--full"], "--3d takes neither --limits, --gif nor --full"),
+    ],
+)
 def test_plot_3d_refuses_other_figure_options(saved: Path, capsys, extra, message) -> None:  # type: ignore[no-untyped-def]
     png = saved / "refused.png"
     assert main(["plot", str(saved / "pinv.npz"), "-o", str(png), "--3d", *extra]) == 2
@@ -77,6 +79,8 @@ def test_plot_3d_refuses_a_scene_the_run_is_not_of(saved: Path, capsys) -> None:
     assert (
         main(["plot", str(saved / "pinv.npz"), "-o", str(png), "--3d", "--scene", str(wider)]) == 2
     )
-    assert capsys.readouterr().err == (f"dvqp: {saved / 'pinv.npz'}: not a run of {wider}: its "
-                                       "pipe radius is 0.254 m, the scene's 0.3 m\n")  # fmt: skip
+    assert capsys.readouterr().err == (
+        f"dvqp: {saved / 'pinv.npz'}: not a run of {wider}: its "
+        "pipe radius is 0.254 m, the scene's 0.3 m\n"
+    )
     assert not png.exists()

@@ -18,10 +18,25 @@ TYPES = ("revolute", "continuous", "prismatic", "fixed")
 REFUSED_EDITS = ("second parent", "cycle", "dangling", "number", "name", "type")
 """Edits after which the file must be refused before the parser sees it."""
 EDITS = (*REFUSED_EDITS, "splice", "drop")
-BAD_NUMBERS = ("nan", "NaN", "inf", "-inf", "1e999", "-1e400", "1_0", "0x10", "abc", "1,5",
-               "--1", "1e", ".", "")  # fmt: skip
-UNPRINTABLE = tuple(map(chr, (0x85, 0x7F, 0x9, 0xA, 0xD, 0x2028, 0x2029, 0xAD, 0x200B, 0xFEFF,
-                              0x9F, 0x1B)))  # fmt: skip
+BAD_NUMBERS = (
+    "nan",
+    "NaN",
+    "inf",
+    "-inf",
+    "1e999",
+    "-1e400",
+    "1_0",
+    "0x10",
+    "abc",
+    "1,5",
+    "--1",
+    "1e",
+    ".",
+    "",
+)
+UNPRINTABLE = tuple(
+    map(chr, (0x85, 0x7F, 0x9, 0xA, 0xD, 0x2028, 0x2029, 0xAD, 0x200B, 0xFEFF, 0x9F, 0x1B))
+)
 """Not printable; all but the last (which XML forbids) pass the XML parser."""
 AXES = ("1 0 0", "0 1 0", "0 0 1", "0 0 -1", "0.6 0.8 0", "0 0.7071 0.7071", "1 1 1")
 
@@ -75,8 +90,14 @@ def arms(draw: st.DrawFn) -> tuple[ET.Element, list[Joint]]:
         ET.SubElement(element, "origin", xyz=xyz, rpy=rpy)
         if joint.kind != "fixed":
             ET.SubElement(element, "axis", xyz=draw(st.sampled_from(AXES)))
-            ET.SubElement(element, "limit", lower=repr(joint.lower), upper=repr(joint.upper),
-                          effort="1", velocity=repr(draw(st.integers(1, 30)) / 10))  # fmt: skip
+            ET.SubElement(
+                element,
+                "limit",
+                lower=repr(joint.lower),
+                upper=repr(joint.upper),
+                effort="1",
+                velocity=repr(draw(st.integers(1, 30)) / 10),
+            )
         elements.append(element)
     for element in draw(st.permutations(elements), label="order"):
         root.append(element)
@@ -108,8 +129,12 @@ def edit(root: ET.Element, joints: list[Joint], kind: str, data: st.DataObject) 
     elif kind == "name":
         _bad_name(root, data)
     elif kind == "type":
-        element.set("type", data.draw(st.sampled_from(["planar", "floating", "bogus", "",
-                                                        "Revolute"]), label="type"))  # fmt: skip
+        element.set(
+            "type",
+            data.draw(
+                st.sampled_from(["planar", "floating", "bogus", "", "Revolute"]), label="type"
+            ),
+        )
     elif kind == "drop":
         every = [(p, c) for p in root.iter() for c in p]
         parent, child = data.draw(st.sampled_from(every), label="drop")
@@ -124,8 +149,12 @@ def edit(root: ET.Element, joints: list[Joint], kind: str, data: st.DataObject) 
 def _bad_number(element: ET.Element, data: st.DataObject) -> None:
     """One numeric attribute of ``element`` made bad: a bad token, a count off by one, a zero
     axis or an origin a kilometre and more away."""
-    places = [(e, key) for e in element for key in ("xyz", "rpy", "lower", "upper", "velocity")
-              if e.get(key) is not None]  # fmt: skip
+    places = [
+        (e, key)
+        for e in element
+        for key in ("xyz", "rpy", "lower", "upper", "velocity")
+        if e.get(key) is not None
+    ]
     target, key = data.draw(st.sampled_from(places), label="number")
     values = target.get(key, "").split()
     how = data.draw(st.sampled_from(["token", "count", "zero", "far"]), label="how")

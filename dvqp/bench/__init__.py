@@ -20,8 +20,25 @@ from dvqp.bench.summary import (
 )
 
 __all__ = [
-    "SHIFT_US", "BenchInterrupted", "BenchScene", "DaskUnavailableError", "Job", "PartialFile",
-    "Suite", "bench_json", "format_summary", "generate_scene", "generate_scenes",
-    "import_distributed", "make_suite", "outcome_differences", "qp_disagreement", "rows_to_csv",
-    "run_job", "run_suite", "save_scenes", "shifted_geometric_mean", "summarize_backends",
-]  # fmt: skip
+    "SHIFT_US",
+    "BenchInterrupted",
+    "BenchScene",
+    "DaskUnavailableError",
+    "Job",
+    "PartialFile",
+    "Suite",
+    "bench_json",
+    "format_summary",
+    "generate_scene",
+    "generate_scenes",
+    "import_distributed",
+    "make_suite",
+    "outcome_differences",
+    "qp_disagreement",
+    "rows_to_csv",
+    "run_job",
+    "run_suite",
+    "save_scenes",
+    "shifted_geometric_mean",
+    "summarize_backends",
+]

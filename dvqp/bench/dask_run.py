@@ -113,9 +113,13 @@ def dask_client(scheduler: str, workers: int = 1) -> Iterator[tuple[Any, Where]]
                 key = "distributed.worker.multiprocessing-method"  # a worker restarted too
                 stack.enter_context(dask.config.set({key: method, **LOCAL_WORKER_CONFIG}))
                 cluster = stack.enter_context(
-                    dd.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                    dashboard_address=None)
-                )  # fmt: skip
+                    dd.LocalCluster(
+                        n_workers=workers,
+                        threads_per_worker=1,
+                        processes=True,
+                        dashboard_address=None,
+                    )
+                )
                 client = stack.enter_context(dd.Client(cluster))
             else:
                 client = stack.enter_context(dd.Client(scheduler, timeout=CONNECT_TIMEOUT))
@@ -160,8 +164,10 @@ def _quiet_logs(stack: contextlib.ExitStack) -> None:
     known = logging.root.manager.loggerDict
     names = [n for n in known if n.split(".")[0] == "distributed"]
     off = ["asyncio", "tornado", *(n for n in known if n.startswith("tornado."))]
-    for name, level in [*((n, logging.CRITICAL) for n in ["distributed", *names]),
-                        *((n, logging.CRITICAL + 1) for n in off)]:  # fmt: skip
+    for name, level in [
+        *((n, logging.CRITICAL) for n in ["distributed", *names]),
+        *((n, logging.CRITICAL + 1) for n in off),
+    ]:
         logger = logging.getLogger(name)
         stack.push(_restorer(logger, logger.level))
         logger.setLevel(level)
@@ -214,8 +220,11 @@ def run_dask(
             client.cancel(late)
             for future in [*finished, *late]:
                 job = remaining.pop(future)
-                on_rows(_rows(dd, future, job) if future in finished else lost_rows(
-                    job, f"timed out after {timeout:g} s"))  # fmt: skip
+                on_rows(
+                    _rows(dd, future, job)
+                    if future in finished
+                    else lost_rows(job, f"timed out after {timeout:g} s")
+                )
                 done += len(job.backends)
                 if progress is not None:
                     progress(done, total, job.name)

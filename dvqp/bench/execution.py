@@ -206,8 +206,12 @@ def _pool_round(
     the pool fails every job it holds) and those not started yet; both empty when all finished.
     """
     todo, running, broken = list(reversed(jobs)), {}, []
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=pool_context(),
-                               initializer=_start_worker, initargs=(time.time(), warm))  # fmt: skip
+    pool = ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=pool_context(),
+        initializer=_start_worker,
+        initargs=(time.time(), warm),
+    )
     try:
         while (todo or running) and not broken:
             with sigint_deferred():  # the first submit forks the pool's processes

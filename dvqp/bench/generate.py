@@ -30,8 +30,21 @@ PIPE_RADIUS = 0.254
 """R of every generated scene, m (the bundled scenes' pipe)."""
 LINK_LENGTHS = (0.334, 0.10, 0.15, 0.15, 0.15, 0.15, 0.06)
 """The bundled NDT arm's link lengths, m."""
-Q0 = (1.5708, -0.048, 0.068, 0.026, 0.08, 0.032, 0.088, -0.078, -0.088, 0.003, -0.434, 0.116,
-      -0.278)  # fmt: skip
+Q0 = (
+    1.5708,
+    -0.048,
+    0.068,
+    0.026,
+    0.08,
+    0.032,
+    0.088,
+    -0.078,
+    -0.088,
+    0.003,
+    -0.434,
+    0.116,
+    -0.278,
+)
 """The bundled start configuration the generated ones vary around, rad."""
 ATTEMPTS = 100
 """Draws of one scene before giving up (never reached in practice)."""

@@ -71,8 +71,14 @@ def draw_path(rng: np.random.Generator, tool: NDArray[np.float64], dt: float) ->
         l, _, _, a = points[-1]
         dz = rng.uniform(-0.015, 0.015) if raster else 0.0
         turn = rng.uniform(-0.3, 0.3) if rng.random() < 1 / 3 else 0.0
-        points.append([l + direction * rng.uniform(0.04, 0.12), z0 + dz,
-                       h0 + rng.uniform(-0.005, 0.005), a + turn])  # fmt: skip
+        points.append(
+            [
+                l + direction * rng.uniform(0.04, 0.12),
+                z0 + dz,
+                h0 + rng.uniform(-0.005, 0.005),
+                a + turn,
+            ]
+        )
     waypoints = [[_r(x) for x in p] for p in points]
     length = float(ToolPath.segment_lengths(np.array([list(tool), *waypoints])).sum())
     speed = max(float(rng.uniform(0.05, 0.12)), length / (MAX_STEPS * dt))

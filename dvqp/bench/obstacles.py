@@ -110,8 +110,12 @@ def _round(rng: np.random.Generator, start: Start, kind: str) -> Table:
     """A circle or an inlet."""
     radius = rng.uniform(0.025, 0.07)
     l, z = _anchor(rng, start, radius)
-    return {"shape": kind, "center": [_mm(l), _mm(z)], "radius": _mm(radius),
-            "weight": _weight(rng)}  # fmt: skip
+    return {
+        "shape": kind,
+        "center": [_mm(l), _mm(z)],
+        "radius": _mm(radius),
+        "weight": _weight(rng),
+    }
 
 
 def _band(rng: np.random.Generator, start: Start) -> Table:

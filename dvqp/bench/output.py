@@ -20,17 +20,23 @@ from dvqp.comparison import rows_to_csv as csv_text
 from dvqp.table_text import aligned, cell
 
 COLUMNS = (  # (summary key, header, format of a defined value)
-    ("runs", "runs", "{}"), ("succeeded", "ok", "{}"), ("success_rate", "success", "{:.1%}"),
-    ("failed_steps", "failed steps", "{}"), ("relaxed_steps", "relaxed steps", "{}"),
+    ("runs", "runs", "{}"),
+    ("succeeded", "ok", "{}"),
+    ("success_rate", "success", "{:.1%}"),
+    ("failed_steps", "failed steps", "{}"),
+    ("relaxed_steps", "relaxed steps", "{}"),
     ("capped_calls", "capped calls", "{}"),
-    ("step_time_sgm_us", "step sgm us", "{:.0f}"), ("step_time_sgm_ratio", "x best", "{:.2f}"),
-    ("solve_time_sgm_us", "solve sgm us", "{:.0f}"), ("solve_time_sgm_ratio", "x best", "{:.2f}"),
+    ("step_time_sgm_us", "step sgm us", "{:.0f}"),
+    ("step_time_sgm_ratio", "x best", "{:.2f}"),
+    ("solve_time_sgm_us", "solve sgm us", "{:.0f}"),
+    ("solve_time_sgm_ratio", "x best", "{:.2f}"),
     ("worst_limit_excess", "worst excess", "{:.2g}"),
     ("worst_task_error", "worst task err", "{:.1e}"),
     ("max_distance_to_qp_median_m", "off QP median m", "{:.1e}"),
-    ("primal_residual", "r_prim", "{:.1e}"), ("dual_residual", "r_dual", "{:.1e}"),
+    ("primal_residual", "r_prim", "{:.1e}"),
+    ("dual_residual", "r_dual", "{:.1e}"),
     ("duality_gap", "gap", "{:.1e}"),
-)  # fmt: skip
+)
 """Columns of :func:`format_summary` after the backend's name."""
 
 TOOL = ("final_l", "final_z", "final_h", "final_alpha")
@@ -85,8 +91,10 @@ def format_summary(suite: Suite) -> str:
         ),
     ]
     if lost:
-        lines.append(f"lost            {len(lost)} scene{'s' * (len(lost) > 1)} (worker lost or "
-                     f"timed out: no figures): {', '.join(lost)}")  # fmt: skip
+        lines.append(
+            f"lost            {len(lost)} scene{'s' * (len(lost) > 1)} (worker lost or "
+            f"timed out: no figures): {', '.join(lost)}"
+        )
     return "\n".join(lines)
 
 
@@ -103,11 +111,18 @@ def _marked(suite: Suite) -> list[Row]:
 def bench_json(suite: Suite) -> str:
     """The ``--json`` document: results, summary, machine, versions, seed and count."""
     doc = {
-        "seed": suite.seed, "count": suite.count, "backends": list(suite.backends),
-        "interrupted": suite.interrupted, "execution": suite.where.as_dict(),
-        "shift_us": suite.shift_us, "results": _marked(suite), "summary": suite.summary,
-        "qp_disagreement": suite.disagreement, "machine": machine(), "versions": versions(),
-    }  # fmt: skip
+        "seed": suite.seed,
+        "count": suite.count,
+        "backends": list(suite.backends),
+        "interrupted": suite.interrupted,
+        "execution": suite.where.as_dict(),
+        "shift_us": suite.shift_us,
+        "results": _marked(suite),
+        "summary": suite.summary,
+        "qp_disagreement": suite.disagreement,
+        "machine": machine(),
+        "versions": versions(),
+    }
     clean = json.loads(json.dumps(doc), parse_constant=lambda _: None)  # NaN, ±inf: null
     return json.dumps(clean, indent=2, allow_nan=False) + "\n"
 
@@ -115,8 +130,10 @@ def bench_json(suite: Suite) -> str:
 def rows_to_csv(suite: Suite) -> str:
     """One CSV line per scene and backend (:data:`CSV_FIELDS`, ``final_tool`` spread over
     :data:`TOOL`), a header first."""
-    flat = [{**r, **dict(zip(TOOL, r.get("final_tool") or [None] * 4, strict=True))}
-            for r in _marked(suite)]  # fmt: skip
+    flat = [
+        {**r, **dict(zip(TOOL, r.get("final_tool") or [None] * 4, strict=True))}
+        for r in _marked(suite)
+    ]
     return csv_text(flat, CSV_FIELDS)
 
 

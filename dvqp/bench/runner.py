@@ -19,9 +19,15 @@ from dvqp.planning import plan
 from dvqp.scenes import Scene, loads
 
 EXTRA_FIELDS = (
-    "mode", "dt", "obstacles", "mean_step_us", "mean_solve_us", "median_solve_us", "total_step_s",
+    "mode",
+    "dt",
+    "obstacles",
+    "mean_step_us",
+    "mean_solve_us",
+    "median_solve_us",
+    "total_step_s",
     "capped_calls",
-)  # fmt: skip
+)
 """Keys a bench row adds to :data:`dvqp.comparison.FIELDS`, after ``index`` (its first key)."""
 
 WORKER_LOST = "worker lost"

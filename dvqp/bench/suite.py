@@ -61,8 +61,10 @@ def run_suite(
     DaskUnavailableError, DvqpError
         Dask is missing, or the scheduler cannot be reached.
     """
-    jobs = [Job(s.index, s.name, s.text, tuple(backends), dict(options or {}), tier)
-            for s in longest_first(scenes)]  # fmt: skip
+    jobs = [
+        Job(s.index, s.name, s.text, tuple(backends), dict(options or {}), tier)
+        for s in longest_first(scenes)
+    ]
     rows: list[Row] = []
 
     def finished(scene_rows: list[Row]) -> None:
@@ -132,7 +134,13 @@ def make_suite(
     order = {b: i for i, b in enumerate(backends)}
     ordered = sorted(rows, key=lambda r: (r["index"], order.get(r["backend"], len(order))))
     return Suite(
-        seed=seed, count=count, backends=tuple(backends), where=where, rows=ordered,
+        seed=seed,
+        count=count,
+        backends=tuple(backends),
+        where=where,
+        rows=ordered,
         summary=summarize_backends(ordered, backends, shift),
-        disagreement=qp_disagreement(ordered), shift_us=shift, interrupted=interrupted,
-    )  # fmt: skip
+        disagreement=qp_disagreement(ordered),
+        shift_us=shift,
+        interrupted=interrupted,
+    )

@@ -94,9 +94,15 @@ def _accuracy(runs: Sequence[Row]) -> dict[str, Any]:
     tally = AccuracyTally()
     for r in runs:
         if r.get("qp_solves"):
-            tally.merge(AccuracyTally.from_dict({"solves": r["qp_solves"],
-                                                 "unanswered": r["unanswered_solves"],
-                                                 **{m: r[m] for m in METRICS}}))  # fmt: skip
+            tally.merge(
+                AccuracyTally.from_dict(
+                    {
+                        "solves": r["qp_solves"],
+                        "unanswered": r["unanswered_solves"],
+                        **{m: r[m] for m in METRICS},
+                    }
+                )
+            )
     means = tally.means()
     return {
         "qp_solves": tally.solves if means else None,

@@ -74,16 +74,26 @@ def register(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument("--json", help="write results, summary, machine and versions as JSON")
     p.add_argument("--csv", help="write one row per scene and backend as CSV")
     p.add_argument("--save-scenes", metavar="DIR", help="write the scene files into DIR")
-    p.add_argument("--workers", default="1",
-                   help="local processes, or LocalCluster workers (default: 1)")  # fmt: skip
-    p.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask scheduler "
-                   "(tcp://host:8786), or 'local' for a LocalCluster")  # fmt: skip
-    p.add_argument("--scene-timeout", metavar="SECONDS", default=str(SCENE_TIMEOUT),
-                   help="on Dask, give a scene up after running this long "
-                   f"(default: {SCENE_TIMEOUT:g})")  # fmt: skip
+    p.add_argument(
+        "--workers", default="1", help="local processes, or LocalCluster workers (default: 1)"
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run on a Dask scheduler (tcp://host:8786), or 'local' for a LocalCluster",
+    )
+    p.add_argument(
+        "--scene-timeout",
+        metavar="SECONDS",
+        default=str(SCENE_TIMEOUT),
+        help=f"on Dask, give a scene up after running this long (default: {SCENE_TIMEOUT:g})",
+    )
     solver_option.add_argument(p)
-    p.add_argument("--check", action="store_true",
-                   help="exit 1 unless every QP backend's run is ok (safe to send)")  # fmt: skip
+    p.add_argument(
+        "--check",
+        action="store_true",
+        help="exit 1 unless every QP backend's run is ok (safe to send)",
+    )
     p.set_defaults(run=run)
     return p
 
@@ -108,12 +118,18 @@ def run(args: argparse.Namespace) -> int:
     try:
         with contextlib.closing(ProgressBar(sys.stderr)) as bar:
             suite = run_suite(
-                scenes, options.backends, seed=options.seed, workers=options.workers,
-                scheduler=options.scheduler, progress=bar.show, ready=ready,
+                scenes,
+                options.backends,
+                seed=options.seed,
+                workers=options.workers,
+                scheduler=options.scheduler,
+                progress=bar.show,
+                ready=ready,
                 on_scene=lambda rows: [p.add(rows) for p in partial],
-                scene_timeout=options.scene_timeout, options=options.solver_options,
+                scene_timeout=options.scene_timeout,
+                options=options.solver_options,
                 tier=options.tier,
-            )  # fmt: skip
+            )
     except BenchInterrupted as exc:
         _report(exc.suite, options, partial)  # what finished is still written
         raise
@@ -131,8 +147,10 @@ def _report(suite: Suite, options: Options, partial: list[PartialFile]) -> None:
     file that held the results while the suite ran."""
     print(format_summary(suite))
     if options.scenes_dir is not None:
-        print(f"scene files     {options.scenes_dir}/bench-s{options.seed}-*.toml "
-              f"({options.count}; 'dvqp plan FILE' runs one)")  # fmt: skip
+        print(
+            f"scene files     {options.scenes_dir}/bench-s{options.seed}-*.toml "
+            f"({options.count}; 'dvqp plan FILE' runs one)"
+        )
     if options.json is not None:
         write_text(options.json, bench_json(suite))
     if options.csv is not None:
@@ -162,8 +180,20 @@ def check_options(args: argparse.Namespace) -> Options:
         except DaskUnavailableError as exc:
             raise DvqpError(f"--scheduler {exc}") from exc
     settings = solver_options(args.solver_option, backends)
-    return Options(count, seed, backends, workers, args.scheduler, timeout, json_out, csv_out,
-                   scenes_dir, settings, args.settings, args.check)  # fmt: skip
+    return Options(
+        count,
+        seed,
+        backends,
+        workers,
+        args.scheduler,
+        timeout,
+        json_out,
+        csv_out,
+        scenes_dir,
+        settings,
+        args.settings,
+        args.check,
+    )
 
 
 def _integer(option: str, text: str, minimum: int) -> int:

@@ -73,14 +73,21 @@ def make_view(
     finite = np.all(np.isfinite(traj.points)) and np.all(np.isfinite(traj.tool))
     if traj.t.shape[0] < 1 or not finite:
         raise ParameterError("trajectory", "needs at least one sample and finite points")
-    for name, value in (("orbital_level", orbital_level), ("weld_z", weld_z),
-                        ("min_height", min_height)):  # fmt: skip
+    for name, value in (
+        ("orbital_level", orbital_level),
+        ("weld_z", weld_z),
+        ("min_height", min_height),
+    ):
         if value is not None and not (isinstance(value, Real) and math.isfinite(value)):
             raise ParameterError(name, f"must be a finite number, got {value!r}")
     h = None if orbital_level is None else float(orbital_level)
     weld = None if weld_z is None else float(weld_z)
-    z = [traj.points[..., 1].ravel(), traj.tool[:, 1], traj.rail[:, 1],  # rail: () if none
-         *(np.array(o.z_range) for o in obstacles)]  # fmt: skip
+    z = [
+        traj.points[..., 1].ravel(),
+        traj.tool[:, 1],
+        traj.rail[:, 1],  # rail: () if none
+        *(np.array(o.z_range) for o in obstacles),
+    ]
     zs = np.concatenate([*z, [] if weld is None else [weld]])
     pad, edge = 0.08 * float(np.ptp(zs)) + 0.03, 1.12 * np.pi * radius  # l: beyond the seams
     arc = None if full else arc_extent(traj, obstacles, radius)

@@ -20,12 +20,18 @@ from dvqp.scenes import load_scene
 
 def register(subparsers: Any) -> None:
     """Add ``export-qps`` to ``subparsers`` (of ``dvqp``'s parser)."""
-    e = subparsers.add_parser("export-qps", help="write every QP of a run as a qpsolvers "
-                              "problem file, with dvqp's answer")  # fmt: skip
+    e = subparsers.add_parser(
+        "export-qps", help="write every QP of a run as a qpsolvers problem file, with dvqp's answer"
+    )
     e.add_argument("scene", help="scene file (.toml)")
     e.add_argument("--backend", default="daqp", help="a QP backend (default: daqp)")
-    e.add_argument("-o", "--output", required=True, metavar="DIR",
-                   help="folder to write: new or empty (or --force)")  # fmt: skip
+    e.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        metavar="DIR",
+        help="folder to write: new or empty (or --force)",
+    )
     e.add_argument("--force", action="store_true", help="replace an earlier export in DIR")
     solver_option.add_argument(e)
     e.set_defaults(run=run)
@@ -38,19 +44,26 @@ def run(args: argparse.Namespace) -> int:
     check_size([scene], 1)
     with contextlib.closing(ProgressBar(sys.stderr)) as bar:
         exported = export_qps(
-            scene, args.backend, args.output, options=options, tier=args.settings,
+            scene,
+            args.backend,
+            args.output,
+            options=options,
+            tier=args.settings,
             force=args.force,
             progress=lambda k, n: bar.show(k, n, "steps"),
-            notice=lambda text: bar.note(text) if text.startswith("compiled")
-            else bar.show(0, 1, text),
-        )  # fmt: skip
+            notice=lambda text: (
+                bar.note(text) if text.startswith("compiled") else bar.show(0, 1, text)
+            ),
+        )
     index = exported.index
     kinds = Counter(entry["kind"] for entry in index["problems"])
     counted = ", ".join(
         f"{kinds[kind]} {kind}" for kind in ("strict", "scaled", "relaxed") if kinds[kind]
     )
-    print(f"wrote {len(index['problems'])} QPs ({counted or 'none'}) of {index['steps']} steps "
-          f"to {args.output} ({INDEX}, answers/)")  # fmt: skip
+    print(
+        f"wrote {len(index['problems'])} QPs ({counted or 'none'}) of {index['steps']} steps "
+        f"to {args.output} ({INDEX}, answers/)"
+    )
     if index["error"]:
         print(f"dvqp: {index['error']}", file=sys.stderr)
         return 1

@@ -105,8 +105,9 @@ def limit_series(scene: Scene, traj: Trajectory) -> LimitPage:
     if traj.q.ndim != 2 or traj.q.shape[1] != n or traj.t.shape[0] < 2:
         raise ParameterError("trajectory", f"needs at least 2 samples of the scene's {n} joints")
     if traj.pipe_radius != radius:
-        raise ParameterError("trajectory", f"its pipe radius is {traj.pipe_radius:.6g} m, the "
-                             f"scene's {radius:.6g} m")  # fmt: skip
+        raise ParameterError(
+            "trajectory", f"its pipe radius is {traj.pipe_radius:.6g} m, the scene's {radius:.6g} m"
+        )
     dt = float(traj.t[1] - traj.t[0])
     stepper = Stepper(scene.robot, radius, PseudoinverseResolver(scene.spec()), traj.q[0], dt)
     stepper.arrays.shapes.far[:] = np.inf  # every row exact: no box bound far from a shape
@@ -136,9 +137,17 @@ def _groups(block: Block, scene: Scene) -> list[tuple[str, str, slice | list[int
     if type(limit) is ObstacleDamper:  # points then links, obstacle-major (its labels)
         names, points, links = limit.obstacles.labels, k + 1 + rail, k + rail
         at = len(names) * points
-        return [("clearance", name, [*range(j * points, (j + 1) * points),
-                                     *range(at + j * links, at + (j + 1) * links)])
-                for j, name in enumerate(names)]  # fmt: skip
+        return [
+            (
+                "clearance",
+                name,
+                [
+                    *range(j * points, (j + 1) * points),
+                    *range(at + j * links, at + (j + 1) * links),
+                ],
+            )
+            for j, name in enumerate(names)
+        ]
     if type(limit) is SurfaceHeight:
         return [("height", "body points", slice(0, k)), ("height", "link chords", slice(k, count))]
     if type(limit) is ProbeHeight:
@@ -151,8 +160,9 @@ def _groups(block: Block, scene: Scene) -> list[tuple[str, str, slice | list[int
     return [(getattr(limit, "quantity", name), name, slice(0, count))]
 
 
-def _damper(t: Array, values: Array, safe: Array, tolerance: Array, block: Block,
-            scene: Scene) -> list[Curve]:  # fmt: skip
+def _damper(
+    t: Array, values: Array, safe: Array, tolerance: Array, block: Block, scene: Scene
+) -> list[Curve]:
     """A damper's curves: the least of each group's verified values."""
     unit = getattr(block.limit, "unit", "m")
     rows = np.arange(block.start, block.stop)
@@ -160,8 +170,17 @@ def _damper(t: Array, values: Array, safe: Array, tolerance: Array, block: Block
     for panel, label, group in _groups(block, scene):
         at = rows[group]
         if at.shape[0]:
-            curves.append(Curve(panel, label, t, values[:, at].min(axis=1), float(safe[at[0]]),
-                                float(tolerance[at[0]]), unit))  # fmt: skip
+            curves.append(
+                Curve(
+                    panel,
+                    label,
+                    t,
+                    values[:, at].min(axis=1),
+                    float(safe[at[0]]),
+                    float(tolerance[at[0]]),
+                    unit,
+                )
+            )
     return curves
 
 
@@ -171,9 +190,20 @@ def _positions(t: Array, room: Array, scene: Scene) -> list[Curve]:
     robot, n = scene.robot, scene.robot.n
     half = 0.5 * (robot.q_max - robot.q_min)
     least = np.minimum(room[:, :n], room[:, n:])
-    return [Curve("joint position", f"joint{i + 1}", t, 1.0 - least[:, i] / half[i], 1.0,
-                  JointPositionLimit.tolerance / half[i], "", upper=True)
-            for i in range(n) if np.isfinite(half[i])]  # fmt: skip
+    return [
+        Curve(
+            "joint position",
+            f"joint{i + 1}",
+            t,
+            1.0 - least[:, i] / half[i],
+            1.0,
+            JointPositionLimit.tolerance / half[i],
+            "",
+            upper=True,
+        )
+        for i in range(n)
+        if np.isfinite(half[i])
+    ]
 
 
 def _rates(traj: Trajectory, stepper: Stepper, dt: float) -> list[Curve]:
@@ -184,9 +214,20 @@ def _rates(traj: Trajectory, stepper: Stepper, dt: float) -> list[Curve]:
     if bounds.accelerate and traj.qddot.shape == traj.qdot.shape:
         rates.append(("joint acceleration", traj.qddot, bounds.qdd_max, BOUND_TOLERANCE / dt))
     for panel, rate, limit, tol in rates:
-        curves += [Curve(panel, f"joint{i + 1}", t, np.abs(rate[:, i]) / limit[i], 1.0,
-                         tol / limit[i], "", upper=True)
-                   for i in range(rate.shape[1]) if np.isfinite(limit[i])]  # fmt: skip
+        curves += [
+            Curve(
+                panel,
+                f"joint{i + 1}",
+                t,
+                np.abs(rate[:, i]) / limit[i],
+                1.0,
+                tol / limit[i],
+                "",
+                upper=True,
+            )
+            for i in range(rate.shape[1])
+            if np.isfinite(limit[i])
+        ]
     return curves
 
 
@@ -194,6 +235,10 @@ def _marks(traj: Trajectory) -> dict[str, Array]:
     """The start times (s) of the slowed, relaxed, braking, split and failed steps."""
     t, status = traj.t[:-1], traj.status.astype(str)
     split = traj.substeps > 1 if traj.substeps.shape == t.shape else np.zeros(t.shape, bool)
-    return {"slowed": t[status == "slowed"], "relaxed": t[status == "relaxed"],
-            "braking": t[status == "braking"],
-            "split": t[split], "failed": t[~traj.success]}  # fmt: skip
+    return {
+        "slowed": t[status == "slowed"],
+        "relaxed": t[status == "relaxed"],
+        "braking": t[status == "braking"],
+        "split": t[split],
+        "failed": t[~traj.success],
+    }

@@ -115,8 +115,13 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--csv", help="write the figures as CSV")
     c.add_argument("--plot", help="write a figure of the comparison (.png/.svg/.pdf)")
     c.add_argument("--jobs", type=_positive_int, default=1, help="worker processes (scenes)")
-    c.add_argument("--check", "--strict", dest="check", action="store_true",
-                   help="exit 1 unless every QP backend's run is ok (safe to send)")  # fmt: skip
+    c.add_argument(
+        "--check",
+        "--strict",
+        dest="check",
+        action="store_true",
+        help="exit 1 unless every QP backend's run is ok (safe to send)",
+    )
     _timing_argument(c)
     solver_option.add_argument(c)
     c.set_defaults(run=_compare)
@@ -132,9 +137,13 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _timing_argument(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--timing", choices=TIMINGS, help="a path's timing: fixed (the paper's: "
-                        "the task relaxed where limits bind) or scaled (slow down along the "
-                        "path there); default: the scene's, else fixed")  # fmt: skip
+    parser.add_argument(
+        "--timing",
+        choices=TIMINGS,
+        help="a path's timing: fixed (the paper's: "
+        "the task relaxed where limits bind) or scaled (slow down along the "
+        "path there); default: the scene's, else fixed",
+    )
 
 
 def _positive_int(text: str) -> int:
@@ -166,9 +175,15 @@ def _plan(args: argparse.Namespace) -> int:
     check_size([scene], 1)
     try:  # a progress bar on stderr, erased when done
         with contextlib.closing(ProgressBar(sys.stderr)) as bar:
-            traj = plan(scene, args.backend, progress=lambda k, n: bar.show(k, n, "steps"),
-                        notice=lambda text: _notice(bar, text), options=options,
-                        tier=args.settings, timing=args.timing)  # fmt: skip
+            traj = plan(
+                scene,
+                args.backend,
+                progress=lambda k, n: bar.show(k, n, "steps"),
+                notice=lambda text: _notice(bar, text),
+                options=options,
+                tier=args.settings,
+                timing=args.timing,
+            )
     except SingularConfigurationError as exc:
         print(f"dvqp: {one_line(scene.source)}: {args.backend}: {exc}", file=sys.stderr)
         return 1
@@ -192,8 +207,15 @@ def _compare(args: argparse.Namespace) -> int:
     csv_out = output_path(args.csv, (".csv",)) if args.csv is not None else None
     plot_out = output_path(args.plot, FIGURE_FORMATS) if args.plot is not None else None
     with contextlib.closing(ProgressBar(sys.stderr)) as bar:
-        rows = cmp.compare(args.scenes, backends, args.jobs, progress=bar.show, options=options,
-                           tier=args.settings, timing=args.timing)  # fmt: skip
+        rows = cmp.compare(
+            args.scenes,
+            backends,
+            args.jobs,
+            progress=bar.show,
+            options=options,
+            tier=args.settings,
+            timing=args.timing,
+        )
     if args.settings != "default":
         print(f"settings: {args.settings}")
     print(format_table(rows))
@@ -201,9 +223,14 @@ def _compare(args: argparse.Namespace) -> int:
         if row["error"]:
             print(f"  {row['scene']} / {row['backend']}: {row['error']}")
     if json_out is not None:  # no NaN in it: an undefined figure is null
-        doc = {"backends": backends, "scenes": list(args.scenes), "settings": args.settings,
-               "results": rows,
-               "machine": cmp.machine(), "versions": versions()}  # fmt: skip
+        doc = {
+            "backends": backends,
+            "scenes": list(args.scenes),
+            "settings": args.settings,
+            "results": rows,
+            "machine": cmp.machine(),
+            "versions": versions(),
+        }
         write_text(json_out, json.dumps(doc, indent=2, allow_nan=False) + "\n")
     if csv_out is not None:
         write_text(csv_out, rows_to_csv(rows))

@@ -173,8 +173,13 @@ def _draw_heights(ax: Axes, view: View) -> None:
     if view.h_star is not None:
         ax.axhline(view.h_star, color="0.3", ls="--", lw=1.2, label=f"h* = {view.h_star:.3g} m")
     if view.min_height is not None:
-        ax.axhline(view.min_height, color="tab:red", ls=":", lw=1.4,
-                   label=f"min_height = {view.min_height:.3g} m")  # fmt: skip
+        ax.axhline(
+            view.min_height,
+            color="tab:red",
+            ls=":",
+            lw=1.4,
+            label=f"min_height = {view.min_height:.3g} m",
+        )
     ax.set(xlabel="t (s)", ylabel="h (m)", title="heights above the pipe surface")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small", ncol=2)

@@ -28,8 +28,7 @@ def plot_3d(view: Scene3D, target: Path, dpi: int = 130) -> Path:
     ax = fig.add_subplot(projection="3d", computed_zorder=False)
     azim = _facing(view)
     triangles, colors = _shaded(view)
-    ax.add_collection3d(Poly3DCollection(triangles, facecolors=colors, edgecolors="none",
-                                         zorder=1))  # fmt: skip
+    ax.add_collection3d(Poly3DCollection(triangles, facecolors=colors, edgecolors="none", zorder=1))
     toward = np.array([math.cos(azim), math.sin(azim)])
     for line in view.lines:
         pts = line.points.copy()
@@ -70,8 +69,14 @@ def _arm(ax, view: Scene3D, n: int, alpha: float) -> None:  # type: ignore[no-un
     chain = view.chain[n]
     for i in range(len(chain) - 1):
         color = COLORS["margin"] if view.at_margin[n, i] else COLORS["arm"]
-        ax.plot(*chain[i : i + 2].T, color=_rgb(color), lw=5.0, alpha=alpha, zorder=4,
-                solid_capstyle="round")  # fmt: skip
+        ax.plot(
+            *chain[i : i + 2].T,
+            color=_rgb(color),
+            lw=5.0,
+            alpha=alpha,
+            zorder=4,
+            solid_capstyle="round",
+        )
     ax.scatter(*chain.T, color="k", s=10, alpha=alpha, zorder=5, depthshade=False)
 
 

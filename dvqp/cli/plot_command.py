@@ -28,17 +28,29 @@ def register(subparsers: Any) -> None:
     g.add_argument("trajectory", help="trajectory file (.npz) written by 'dvqp plan'")
     g.add_argument("-o", "--output", required=True, help="figure (.png/.svg/.pdf, or .gif)")
     g.add_argument("--gif", action="store_true", help="write an animation (.gif)")
-    g.add_argument("--full", action="store_true",
-                   help="the developed view's whole circumference (default: where the arm and "
-                        "the obstacles are)")  # fmt: skip
-    g.add_argument("--limits", action="store_true",
-                   help="write the limits page: each limit's quantity over time against its "
-                        "bound")  # fmt: skip
-    g.add_argument("--3d", dest="three_d", action="store_true",
-                   help="write a still of the 3-D view: the pipe, its obstacles as the objects "
-                        "they stand for, the arm at the first and last sample")  # fmt: skip
-    g.add_argument("--scene", help="with --limits or --3d: the scene file to read the arm "
-                   "and limits from (default: the one stored in the trajectory)")  # fmt: skip
+    g.add_argument(
+        "--full",
+        action="store_true",
+        help="the developed view's whole circumference (default: where the arm and "
+        "the obstacles are)",
+    )
+    g.add_argument(
+        "--limits",
+        action="store_true",
+        help="write the limits page: each limit's quantity over time against its bound",
+    )
+    g.add_argument(
+        "--3d",
+        dest="three_d",
+        action="store_true",
+        help="write a still of the 3-D view: the pipe, its obstacles as the objects "
+        "they stand for, the arm at the first and last sample",
+    )
+    g.add_argument(
+        "--scene",
+        help="with --limits or --3d: the scene file to read the arm "
+        "and limits from (default: the one stored in the trajectory)",
+    )
     g.set_defaults(run=run)
 
 
@@ -52,8 +64,12 @@ def run(args: argparse.Namespace) -> int:
     drawn_with: dict[str, Any] = {"full": args.full}
     if traj.scene_text:  # draw the stored scene's obstacles, levels and weld
         env = environment(traj.scene_text, f"{args.trajectory} (stored scene)")
-        drawn_with |= {"obstacles": env.obstacles, "orbital_level": env.orbital_level,
-                      "weld_z": env.weld, "min_height": env.min_height}  # fmt: skip
+        drawn_with |= {
+            "obstacles": env.obstacles,
+            "orbital_level": env.orbital_level,
+            "weld_z": env.weld,
+            "min_height": env.min_height,
+        }
     from dvqp.cli import plot
 
     draw = plot.animate_trajectory if args.gif else plot.plot_trajectory
@@ -64,8 +80,9 @@ def run(args: argparse.Namespace) -> int:
 def _plot_limits(args: argparse.Namespace, traj: Trajectory) -> int:
     """The limits page of a trajectory, from its stored scene (or ``--scene``)."""
     if not args.limits or args.gif or args.full:
-        raise DvqpError("--scene goes with --limits or --3d; --limits takes neither --gif nor "
-                        "--full")  # fmt: skip
+        raise DvqpError(
+            "--scene goes with --limits or --3d; --limits takes neither --gif nor --full"
+        )
     target = output_path(args.output, FIGURE_FORMATS)
     scene = scene_of(args.trajectory, traj, args.scene)
     from dvqp.cli.limit_series import limit_series
@@ -99,9 +116,11 @@ def _note_other_scene(args: argparse.Namespace, traj: Trajectory, scene: Scene) 
     """Say on stderr that ``--scene`` is not the scene text stored in the trajectory (allowed:
     to see a run against other limits, say)."""
     if args.scene is not None and traj.scene_text and traj.scene_text != scene.text:
-        print(f"dvqp: note: {one_line(args.trajectory)} was planned from another scene text "
-              f"than {one_line(args.scene)}: drawn with the latter's arm, obstacles and limits",
-              file=sys.stderr)  # fmt: skip
+        print(
+            f"dvqp: note: {one_line(args.trajectory)} was planned from another scene text "
+            f"than {one_line(args.scene)}: drawn with the latter's arm, obstacles and limits",
+            file=sys.stderr,
+        )
 
 
 def scene_of(path: str, traj: Trajectory, scene_file: str | None) -> Scene:
@@ -118,11 +137,15 @@ def trajectory_3d(path: str, traj: Trajectory, scene: Scene, samples: int = 2000
     """The 3-D view of a run of ``scene`` (read from ``path``) at no more than ``samples``
     evenly spaced samples, the last one included; a DvqpError if it is not a run of it."""
     if traj.q.shape[1] != scene.robot.n:
-        raise DvqpError(f"{path}: not a run of {scene.source}: {traj.q.shape[1]} joints, "
-                        f"the scene's arm has {scene.robot.n}")  # fmt: skip
+        raise DvqpError(
+            f"{path}: not a run of {scene.source}: {traj.q.shape[1]} joints, "
+            f"the scene's arm has {scene.robot.n}"
+        )
     if traj.pipe_radius and abs(traj.pipe_radius - scene.pipe_radius) > 1e-12:
-        raise DvqpError(f"{path}: not a run of {scene.source}: its pipe radius is "
-                        f"{traj.pipe_radius:g} m, the scene's {scene.pipe_radius:g} m")  # fmt: skip
+        raise DvqpError(
+            f"{path}: not a run of {scene.source}: its pipe radius is "
+            f"{traj.pipe_radius:g} m, the scene's {scene.pipe_radius:g} m"
+        )
     pick = np.unique(np.linspace(0, len(traj.t) - 1, min(samples, len(traj.t))).round())
     pick = pick.astype(np.int64)
     title = f"{scene.name} / {traj.backend or 'unknown resolver'}"
@@ -143,9 +166,11 @@ def load_trajectory(path: str) -> Trajectory:
         traj = Trajectory.load(path)
     except DvqpError as exc:  # dvqp reads arrays only, never pickled objects
         if _retimed(path):
-            raise DvqpError(f"{path}: a retimed motion (dvqp plan --retime): dvqp plot draws "
-                            "planned runs; save the run itself (dvqp plan SCENE -o RUN.npz) "
-                            "and plot that") from exc  # fmt: skip
+            raise DvqpError(
+                f"{path}: a retimed motion (dvqp plan --retime): dvqp plot draws "
+                "planned runs; save the run itself (dvqp plan SCENE -o RUN.npz) "
+                "and plot that"
+            ) from exc
         raise DvqpError(f"{path}: not a dvqp trajectory (not written by 'dvqp plan')") from exc
     if not _drawable(traj):
         raise DvqpError(f"{path}: not a dvqp trajectory (arrays of unexpected shapes)")
@@ -170,8 +195,14 @@ def _drawable(traj: Trajectory) -> bool:
         return False
     n1 = t.shape[0]
     return (
-        n1 >= 1 and q.shape[0] == n1 and qdot.shape == (n1 - 1, q.shape[1])
-        and tool.shape == (n1, 4) and points.ndim == 3 and points.shape[0] == n1
-        and points.shape[2] == 3 and traj.w.shape == (n1,) and traj.min_clearance.shape == (n1,)
+        n1 >= 1
+        and q.shape[0] == n1
+        and qdot.shape == (n1 - 1, q.shape[1])
+        and tool.shape == (n1, 4)
+        and points.ndim == 3
+        and points.shape[0] == n1
+        and points.shape[2] == 3
+        and traj.w.shape == (n1,)
+        and traj.min_clearance.shape == (n1,)
         and low.shape == holder.shape in ((n1,), (0,))
-    )  # fmt: skip
+    )

@@ -20,19 +20,28 @@ from dvqp.cli.limit_series import MARKS, Curve, LimitPage
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-MARK_COLOURS = {"slowed": "tab:olive", "relaxed": "tab:orange", "braking": "tab:blue",
-                "split": "tab:purple", "failed": "tab:red"}  # fmt: skip
+MARK_COLOURS = {
+    "slowed": "tab:olive",
+    "relaxed": "tab:orange",
+    "braking": "tab:blue",
+    "split": "tab:purple",
+    "failed": "tab:red",
+}
 """The band colour of each kind of marked step."""
 
 NAMED = 8
 """Curves a panel names in its legend, those that come closest to their bound; the others are
 drawn thin and grey."""
 
-TITLES = {"clearance": "clearance per obstacle (m)", "self distance": "self distance (m)",
-          "height": "heights above the pipe (m)", "tilt": "probe tilt from radial (rad)",
-          "joint position": "joint position, fraction of its half range from the middle",
-          "joint speed": "joint speed |q̇|, fraction of q̇_max",
-          "joint acceleration": "joint acceleration |q̈|, fraction of q̈_max"}  # fmt: skip
+TITLES = {
+    "clearance": "clearance per obstacle (m)",
+    "self distance": "self distance (m)",
+    "height": "heights above the pipe (m)",
+    "tilt": "probe tilt from radial (rad)",
+    "joint position": "joint position, fraction of its half range from the middle",
+    "joint speed": "joint speed |q̇|, fraction of q̇_max",
+    "joint acceleration": "joint acceleration |q̈|, fraction of q̈_max",
+}
 
 
 def plot_limits(page: LimitPage, path: str | Path, title: str = "") -> Path:
@@ -59,8 +68,12 @@ def plot_limits(page: LimitPage, path: str | Path, title: str = "") -> Path:
             ax.set_xlabel("t (s)")
     for ax in axes[len(panels) :]:
         ax.set_axis_off()
-    fig.legend(handles=_mark_handles(page), loc="outside lower center", ncol=len(MARKS) + 1,
-               fontsize="small")  # fmt: skip
+    fig.legend(
+        handles=_mark_handles(page),
+        loc="outside lower center",
+        ncol=len(MARKS) + 1,
+        fontsize="small",
+    )
     fig.suptitle(title or "limits over time: each quantity against its bound")
     return save_figure(fig, target, dpi=110)
 
@@ -73,8 +86,15 @@ def _draw_panel(ax: Axes, panel: str, curves: list[Curve], page: LimitPage) -> N
         if rank < NAMED:
             ax.plot(c.t, c.values, lw=1.3, label=c.label, drawstyle=step, zorder=3)
         else:
-            ax.plot(c.t, c.values, color="0.6", lw=0.7, drawstyle=step, zorder=2,
-                    label="others" if rank == NAMED else None)  # fmt: skip
+            ax.plot(
+                c.t,
+                c.values,
+                color="0.6",
+                lw=0.7,
+                drawstyle=step,
+                zorder=2,
+                label="others" if rank == NAMED else None,
+            )
     bounds = dict.fromkeys((c.bound, c.upper) for c in curves)
     bottom, top = ax.get_ylim()  # the bounds in view too, with room on their forbidden side
     low, high = min(b for b, _ in bounds), max(b for b, _ in bounds)
@@ -98,8 +118,9 @@ def _draw_marks(ax: Axes, page: LimitPage) -> None:
         starts = page.marks[kind]
         cut = np.flatnonzero(np.diff(starts) > 1.5 * page.dt) + 1
         for run in np.split(starts, cut) if starts.shape[0] else ():
-            ax.axvspan(run[0], run[-1] + page.dt, color=MARK_COLOURS[kind], alpha=0.25, lw=0,
-                       zorder=1)  # fmt: skip
+            ax.axvspan(
+                run[0], run[-1] + page.dt, color=MARK_COLOURS[kind], alpha=0.25, lw=0, zorder=1
+            )
 
 
 def _mark_handles(page: LimitPage) -> list:

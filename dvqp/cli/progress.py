@@ -136,9 +136,11 @@ def check_size(scenes: Sequence[Scene], runs: int) -> None:
         estimate = RunEstimate.of(scene)
         if memory and estimate.nbytes > MEMORY_SHARE * memory:
             raise SceneError(
-                scene.source, "motion", f"{estimate.describe()}, more than this machine's "
+                scene.source,
+                "motion",
+                f"{estimate.describe()}, more than this machine's "
                 f"{memory / 1e9:.2g} GB allow: use a larger dt or a shorter motion",
-            )  # fmt: skip
+            )
         if estimate.seconds * runs > LONG_RUN_SECONDS:
             note = f"{one_line(scene.source)}: {estimate.describe(runs)}"
             print(f"dvqp: note: {note}", file=sys.stderr)

@@ -21,22 +21,36 @@ if TYPE_CHECKING:
     from dvqp import Scene, Trajectory
 
 TABLE = (  # (row key, header, format)
-    ("scene", "scene", "{}"), ("backend", "backend", "{}"), ("success", "ok", "{}"),
-    ("steps", "steps", "{}"), ("median_step_us", "med us", "{:.0f}"),
-    ("p95_step_us", "p95 us", "{:.0f}"), ("median_solver_us", "solver us", "{:.1f}"),
-    ("median_rest_us", "rest us", "{:.1f}"), ("median_iterations", "iters", "{:.0f}"),
+    ("scene", "scene", "{}"),
+    ("backend", "backend", "{}"),
+    ("success", "ok", "{}"),
+    ("steps", "steps", "{}"),
+    ("median_step_us", "med us", "{:.0f}"),
+    ("p95_step_us", "p95 us", "{:.0f}"),
+    ("median_solver_us", "solver us", "{:.1f}"),
+    ("median_rest_us", "rest us", "{:.1f}"),
+    ("median_iterations", "iters", "{:.0f}"),
     ("ratio_to_pinv", "x pinv", "{:.2f}"),
-    ("max_task_error", "task err", "{:.1e}"), ("min_clearance", "clearance m", "{:+.4f}"),
-    ("closest", "closest", "{}"), ("min_self_distance", "self m", "{:.3f}"),
-    ("max_joint_acceleration", "qdd", "{:.3g}"), ("max_limit_excess", "excess", "{:.2g}"),
+    ("max_task_error", "task err", "{:.1e}"),
+    ("min_clearance", "clearance m", "{:+.4f}"),
+    ("closest", "closest", "{}"),
+    ("min_self_distance", "self m", "{:.3f}"),
+    ("max_joint_acceleration", "qdd", "{:.3g}"),
+    ("max_limit_excess", "excess", "{:.2g}"),
     ("max_joint_limit_violation", "q viol rad", "{:.3g}"),
-    ("max_velocity_limit_violation", "qd viol rad/s", "{:.3g}"), ("slowed", "slowed", "{}"),
-    ("relaxed", "relaxed", "{}"), ("max_deviation", "path dev m", "{:.2g}"),
-    ("refused_calls", "refused", "{}"), ("primal_residual", "r_prim", "{:.1e}"),
-    ("dual_residual", "r_dual", "{:.1e}"), ("duality_gap", "gap", "{:.1e}"),
-    ("substepped", "split", "{}"), ("failures", "fails", "{}"),
-    ("final_joint_speed", "end qd", "{:.3g}"), ("braking_time", "brake s", "{:.3f}"),
-)  # fmt: skip
+    ("max_velocity_limit_violation", "qd viol rad/s", "{:.3g}"),
+    ("slowed", "slowed", "{}"),
+    ("relaxed", "relaxed", "{}"),
+    ("max_deviation", "path dev m", "{:.2g}"),
+    ("refused_calls", "refused", "{}"),
+    ("primal_residual", "r_prim", "{:.1e}"),
+    ("dual_residual", "r_dual", "{:.1e}"),
+    ("duality_gap", "gap", "{:.1e}"),
+    ("substepped", "split", "{}"),
+    ("failures", "fails", "{}"),
+    ("final_joint_speed", "end qd", "{:.3g}"),
+    ("braking_time", "brake s", "{:.3f}"),
+)
 """Columns of :func:`format_table`: (row key, header, format of a defined value)."""
 
 
@@ -100,9 +114,11 @@ def _path(row: Row) -> str:
     """``path            followed in 3.750 s (nominal 3.390 s), 171 steps slowed; worst
     deviation 0.55 mm``."""
     slowed = f", {row['slowed']} steps slowed" if row["slowed"] else ""
-    return (f"path            followed in {row['path_duration']:.3f} s (nominal "
-            f"{row['nominal_duration']:.3f} s){slowed}; worst deviation from it "
-            f"{row['max_deviation'] * 1e3:.3g} mm")  # fmt: skip
+    return (
+        f"path            followed in {row['path_duration']:.3f} s (nominal "
+        f"{row['nominal_duration']:.3f} s){slowed}; worst deviation from it "
+        f"{row['max_deviation'] * 1e3:.3g} mm"
+    )
 
 
 def _heights(row: Row, traj: Trajectory) -> str:
@@ -138,14 +154,19 @@ def _steps(row: Row) -> str:
 def _limits(row: Row, traj: Trajectory) -> str:
     """That every limit was kept (and the deepest excess within tolerance), or the worst one
     broken, and each limit the start broke (one line each)."""
-    worst = (f"{row['worst_limit']} past its bound by {row['max_limit_excess']:.2g}"
-             if row["worst_limit"] else "a limit given to plan, not named here")  # fmt: skip
+    worst = (
+        f"{row['worst_limit']} past its bound by {row['max_limit_excess']:.2g}"
+        if row["worst_limit"]
+        else "a limit given to plan, not named here"
+    )
     lines = start_broken_lines(traj.start_broken)
     if not traj.limits_kept.all():
         lines.insert(0, f"BROKEN: {worst}")
     elif not lines:
-        lines = ["every limit kept" + (f" to its tolerance (deepest: {worst})"
-                                       if row["worst_limit"] else "")]  # fmt: skip
+        lines = [
+            "every limit kept"
+            + (f" to its tolerance (deepest: {worst})" if row["worst_limit"] else "")
+        ]
     return "\n                ".join(lines)
 
 

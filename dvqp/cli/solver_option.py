@@ -24,13 +24,22 @@ FLAG = "--solver-option"
 def add_argument(parser: argparse.ArgumentParser) -> None:
     """The repeatable ``--solver-option`` and the ``--settings`` tier of ``plan``, ``compare``
     and ``bench``."""
-    parser.add_argument(FLAG, action="append", default=[], metavar="NAME.KEY=VALUE",
-                        help="a setting of a QP backend, e.g. osqp.eps_abs=1e-6 (repeatable; "
-                        "over the scene's [solvers.NAME])")  # fmt: skip
-    parser.add_argument("--settings", choices=TIERS, default=TIERS[0],
-                        help="accuracy tier of every QP backend, as qpbenchmark's: its solver "
-                        "settings and the tolerance answers are checked to (default: default; "
-                        "see docs/cli.md)")  # fmt: skip
+    parser.add_argument(
+        FLAG,
+        action="append",
+        default=[],
+        metavar="NAME.KEY=VALUE",
+        help="a setting of a QP backend, e.g. osqp.eps_abs=1e-6 (repeatable; "
+        "over the scene's [solvers.NAME])",
+    )
+    parser.add_argument(
+        "--settings",
+        choices=TIERS,
+        default=TIERS[0],
+        help="accuracy tier of every QP backend, as qpbenchmark's: its solver "
+        "settings and the tolerance answers are checked to (default: default; "
+        "see docs/cli.md)",
+    )
 
 
 def solver_options(values: Sequence[str], backends: Sequence[str]) -> dict[str, dict[str, Any]]:
@@ -52,8 +61,9 @@ def solver_options(values: Sequence[str], backends: Sequence[str]) -> dict[str, 
         if not (sep and dot and name and key):
             raise ParameterError(FLAG, f"{text!r}: expected NAME.KEY=VALUE, e.g. osqp.eps_abs=1e-6")
         if name not in backends:
-            raise ParameterError(FLAG, f"{text!r}: {name} is not run here "
-                                 f"(backends: {', '.join(backends)})")  # fmt: skip
+            raise ParameterError(
+                FLAG, f"{text!r}: {name} is not run here (backends: {', '.join(backends)})"
+            )
         try:
             value = tomllib.loads(f"v = {raw.strip()}")["v"]
         except tomllib.TOMLDecodeError:

@@ -23,10 +23,15 @@ from dvqp.view.scene3d import Scene3D, scene_3d
 def register(subparsers: Any) -> None:
     """Add the ``view`` subcommand to ``subparsers`` (its ``run`` is :func:`run`)."""
     v = subparsers.add_parser("view", help="the arm on the pipe in 3-D, in the browser")
-    v.add_argument("file", help="a trajectory (.npz) written by 'dvqp plan', or a scene file "
-                                "(.toml): its start pose")  # fmt: skip
-    v.add_argument("--scene", help="with a trajectory: the scene file to read the arm from "
-                                   "(default: the one stored in the trajectory)")  # fmt: skip
+    v.add_argument(
+        "file",
+        help="a trajectory (.npz) written by 'dvqp plan', or a scene file (.toml): its start pose",
+    )
+    v.add_argument(
+        "--scene",
+        help="with a trajectory: the scene file to read the arm from "
+        "(default: the one stored in the trajectory)",
+    )
     v.add_argument("--host", default="127.0.0.1", help="address to listen on (default: 127.0.0.1)")
     v.add_argument("--port", type=_port, default=8080, help="TCP port (default: 8080; 0: any)")
     v.set_defaults(run=run)

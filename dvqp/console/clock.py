@@ -45,10 +45,14 @@ class RateStats:
         """Rate, steps, wall time, dropped time and step-time percentiles (ms)."""
         times = np.array(self.step_times) * 1e3 if self.step_times else np.zeros(1)
         return {
-            "realtime": self.realtime(dt), "steps": self.steps, "wall_s": self.wall,
-            "dropped_s": self.dropped, "step_ms_median": float(np.median(times)),
-            "step_ms_p95": float(np.percentile(times, 95)), "step_ms_max": float(times.max()),
-        }  # fmt: skip
+            "realtime": self.realtime(dt),
+            "steps": self.steps,
+            "wall_s": self.wall,
+            "dropped_s": self.dropped,
+            "step_ms_median": float(np.median(times)),
+            "step_ms_p95": float(np.percentile(times, 95)),
+            "step_ms_max": float(times.max()),
+        }
 
 
 class RealTimeClock:

@@ -64,9 +64,21 @@ class Sample:
             name = point_label(part, k) if part < m else link_label(part - m, k)
             where = f"{name}/{stepper.obstacles.labels[obstacle]}"
         excess = stepper.excess_now
-        return cls(a.state.q.copy(), a.state.tool.copy(), a.state.guarded[:k].copy(),
-                   float(a.objective.value[0]), clearance, probe, where, tilt, apart,
-                   max(float(excess[0]), 0.0), bool(excess[1] <= 1.0), low, holder)  # fmt: skip
+        return cls(
+            a.state.q.copy(),
+            a.state.tool.copy(),
+            a.state.guarded[:k].copy(),
+            float(a.objective.value[0]),
+            clearance,
+            probe,
+            where,
+            tilt,
+            apart,
+            max(float(excess[0]), 0.0),
+            bool(excess[1] <= 1.0),
+            low,
+            holder,
+        )
 
 
 class Recording:

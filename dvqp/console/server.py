@@ -29,8 +29,12 @@ else:
 MISSING = "the console needs aiohttp: pip install 'dvqp[console]'"
 """The one-line error of ``dvqp console`` without the extra."""
 STATIC = Path(__file__).with_name("static")
-FILES = {"console.js": "text/javascript", "draw.js": "text/javascript",
-         "panels.js": "text/javascript", "console.css": "text/css"}  # fmt: skip
+FILES = {
+    "console.js": "text/javascript",
+    "draw.js": "text/javascript",
+    "panels.js": "text/javascript",
+    "console.css": "text/css",
+}
 STATE_HZ = 50.0
 """State messages per second to each client."""
 MAX_FRAME_BYTES = 1 << 20
@@ -113,9 +117,10 @@ async def _trajectory(request: Any) -> Any:
     name = re.sub(r"[^A-Za-z0-9._-]", "_", session.scene.name) or "scene"
     disposition = f'attachment; filename="{name}-console.npz"'
     return web.Response(
-        body=body, content_type="application/octet-stream",
+        body=body,
+        content_type="application/octet-stream",
         headers={"Content-Disposition": disposition},
-    )  # fmt: skip
+    )
 
 
 def _npz_bytes(session: ConsoleSession) -> bytes:

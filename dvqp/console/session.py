@@ -68,8 +68,9 @@ class ConsoleSession:
         self.scene, self.backend = scene, check_name(backend)
         self.resolver = make_resolver(backend, scene.spec(), scene.solver_options.get(backend))
         self.verify = self.resolver.holds_limits
-        self.stepper = Stepper(scene.robot, scene.pipe_radius, self.resolver, scene.q0, scene.dt,
-                               scene.obstacles)  # fmt: skip
+        self.stepper = Stepper(
+            scene.robot, scene.pipe_radius, self.resolver, scene.q0, scene.dt, scene.obstacles
+        )
         self.stepper.start(scene.q0)
         self._first = Sample.of(self.stepper)
         self._lock = threading.Lock()
@@ -184,16 +185,24 @@ class ConsoleSession:
             clamped, substeps = self._clamped, self._substeps
             recorded = len(self._recording)
         return {
-            "type": "state", "t": round(t, 6), "tool": protocol.rounded(sample.tool),
-            "points": protocol.rounded(sample.points), "status": step.status,
+            "type": "state",
+            "t": round(t, 6),
+            "tool": protocol.rounded(sample.tool),
+            "points": protocol.rounded(sample.points),
+            "status": step.status,
             "min_clearance": protocol.finite(sample.min_clearance),
-            "task_error": protocol.finite(step.task_error, 9), "closest": sample.closest,
+            "task_error": protocol.finite(step.task_error, 9),
+            "closest": sample.closest,
             "probe_clearance": protocol.finite(sample.probe_clearance),
-            "tilt": protocol.finite(sample.tilt), "limits_kept": sample.limits_kept,
-            "substeps": substeps, "command": protocol.rounded(command),
+            "tilt": protocol.finite(sample.tilt),
+            "limits_kept": sample.limits_kept,
+            "substeps": substeps,
+            "command": protocol.rounded(command),
             "velocity": protocol.rounded(velocity),
-            "clamped": clamped, "seq": seq, "recorded_steps": recorded,
-        }  # fmt: skip
+            "clamped": clamped,
+            "seq": seq,
+            "recorded_steps": recorded,
+        }
 
     def trajectory(self) -> Trajectory:
         """What was driven since the last reset (at most the last

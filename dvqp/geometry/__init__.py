@@ -11,6 +11,12 @@ from dvqp.geometry.proximity import (
 )
 
 __all__ = [
-    "Obstacle", "ObstacleSet", "Proximity", "distances", "link_bends", "min_clearance",
-    "proximity", "segment_distances",
-]  # fmt: skip
+    "Obstacle",
+    "ObstacleSet",
+    "Proximity",
+    "distances",
+    "link_bends",
+    "min_clearance",
+    "proximity",
+    "segment_distances",
+]

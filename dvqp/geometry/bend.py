@@ -65,8 +65,9 @@ def link_bends(state: KinematicState) -> NDArray[np.float64]:
     """``δ`` (m) of each guarded link of ``state`` (L,), in :func:`link_ends` order: the
     farthest its real DV image strays from its straight DV segment."""
     o, ends = np.asarray(state.origins), link_ends(state.k, state.rail)
-    return np.array([state.radius * abs(link_bend(o[a, 0], o[a, 1], o[b, 0], o[b, 1])[0])
-                     for a, b in ends])  # fmt: skip
+    return np.array(
+        [state.radius * abs(link_bend(o[a, 0], o[a, 1], o[b, 0], o[b, 1])[0]) for a, b in ends]
+    )
 
 
 @njit(inline="always")

@@ -54,10 +54,15 @@ def _piece(shapes, j, a, b, radius, piece):  # type: ignore[no-untyped-def]
     x0, y0, _ = link_point(a, b, piece[T0])
     x1, y1, _ = link_point(a, b, piece[T1])
     d, s, nl, nz = shape_segment(
-        shapes, j, piece[END0], piece[END0 + 1], piece[END1], piece[END1 + 1],
+        shapes,
+        j,
+        piece[END0],
+        piece[END0 + 1],
+        piece[END1],
+        piece[END1 + 1],
         (piece[END0 + 2], piece[END0 + 3], piece[END0 + 4]),
         (piece[END1 + 2], piece[END1 + 3], piece[END1 + 4]),
-    )  # fmt: skip
+    )
     return d, radius * abs(link_bend(x0, y0, x1, y1)[0]), s, nl, nz
 
 
@@ -76,7 +81,8 @@ def link_clearance(shapes, j, i, a, b, la, radius, near) -> None:  # type: ignor
     while count > 0:
         for p in range(count):
             out[p, 0], out[p, 1], out[p, 2], out[p, 3], out[p, 4] = _piece(
-                shapes, j, a, b, radius, live[p])  # fmt: skip
+                shapes, j, a, b, radius, live[p]
+            )
             upper = min(upper, out[p, 0] + out[p, 1])
         for p in range(count):  # the final pieces
             if 2.0 * out[p, 1] <= PRECISION and out[p, 0] - out[p, 1] < best:

@@ -112,9 +112,19 @@ class ShapeArrays:
                 at += local.shape[0]
         packed = np.concatenate(vertices) if vertices else np.zeros((0, 2))
         vl, vz = np.ascontiguousarray(packed[:, 0]), np.ascontiguousarray(packed[:, 1])
-        return cls(float(period), code, data, start, stop, vl, vz,
-                   np.array([s.size for s in shapes], float), np.full(count, math.inf), box,
-                   np.full(count, math.inf))  # fmt: skip
+        return cls(
+            float(period),
+            code,
+            data,
+            start,
+            stop,
+            vl,
+            vz,
+            np.array([s.size for s in shapes], float),
+            np.full(count, math.inf),
+            box,
+            np.full(count, math.inf),
+        )
 
 
 @njit
@@ -128,8 +138,14 @@ def shape_point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
         return d, 0.0, nz
     a, b = shapes.start[j], shapes.stop[j]
     if code == INLET:
-        return inlet_point(wrap_period(pl - data[0], period), pz - data[1], data[2], data[3],
-                           shapes.vl[a:b], shapes.vz[a:b])  # fmt: skip
+        return inlet_point(
+            wrap_period(pl - data[0], period),
+            pz - data[1],
+            data[2],
+            data[3],
+            shapes.vl[a:b],
+            shapes.vz[a:b],
+        )
     return polygon_point(wrap_period(pl - data[0], period), pz, shapes.vl[a:b], shapes.vz[a:b])
 
 
@@ -150,8 +166,18 @@ def shape_segment(shapes, j, al, az, bl, bz, a_end, b_end):  # type: ignore[no-u
     if code == INLET:
         if lb != wrap_period(bl - data[0], period):  # b measured at another period's copy
             b_end = UNKNOWN
-        return inlet_segment(la, az - data[1], lb, bz - data[1], data[2], data[3],
-                             shapes.vl[a:b], shapes.vz[a:b], a_end, b_end)  # fmt: skip
+        return inlet_segment(
+            la,
+            az - data[1],
+            lb,
+            bz - data[1],
+            data[2],
+            data[3],
+            shapes.vl[a:b],
+            shapes.vz[a:b],
+            a_end,
+            b_end,
+        )
     return polygon_segment(la, az, lb, bz, shapes.vl[a:b], shapes.vz[a:b])
 
 
@@ -188,8 +214,9 @@ def link_row(shapes, j, chain, i, near, exact) -> None:  # type: ignore[no-untyp
     if not exact and (shapes.code[j] == POLYGON or shapes.code[j] == INLET):
         d, nl, nz = box_bound(shapes, j, al, az, bl, bz)
     if d <= shapes.far[j]:
-        d, t, nl, nz = shape_segment(shapes, j, al, az, bl, bz, _end(shapes, near, j, a),
-                                     _end(shapes, near, j, b))  # fmt: skip
+        d, t, nl, nz = shape_segment(
+            shapes, j, al, az, bl, bz, _end(shapes, near, j, a), _end(shapes, near, j, b)
+        )
     near.link_distance[j, i], near.link_t[j, i] = d, t
     near.link_normal[j, i, 0], near.link_normal[j, i, 1] = nl, nz
 
@@ -234,8 +261,9 @@ def _circle_rows(shapes, j, chain, near) -> None:  # type: ignore[no-untyped-def
     ends, distance, normal, at = near.ends, near.link_distance, near.link_normal, near.link_t
     for i in range(ends.shape[0]):
         a, b = ends[i, 0], ends[i, 1]
-        d, t, nl, nz = circle_segment(cl, cz, r, chain[a, 0], chain[a, 1], chain[b, 0],
-                                      chain[b, 1], period)  # fmt: skip
+        d, t, nl, nz = circle_segment(
+            cl, cz, r, chain[a, 0], chain[a, 1], chain[b, 0], chain[b, 1], period
+        )
         distance[j, i], at[j, i], normal[j, i, 0], normal[j, i, 1] = d, t, nl, nz
 
 
@@ -272,8 +300,13 @@ def penalties(size, near) -> None:  # type: ignore[no-untyped-def]
                 near.link_penalty_gradient[j, i, c] = 2.0 * (d + rho) * near.link_normal[j, i, c]
 
 
-def user_rows(shapes: Sequence[Shape], code: NDArray[np.int64], chain: Array, period: float,
-              near: ProximityBuffers) -> None:  # fmt: skip
+def user_rows(
+    shapes: Sequence[Shape],
+    code: NDArray[np.int64],
+    chain: Array,
+    period: float,
+    near: ProximityBuffers,
+) -> None:
     """Rows of the shapes of your own (code :data:`OTHER`): their NumPy ``point_distance`` of
     the points ``chain`` (m) and ``segment_distance`` of the links ``near.ends``, into
     ``near``."""

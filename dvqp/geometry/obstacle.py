@@ -42,8 +42,9 @@ class ObstacleSet:
         scene errors name it).
     """
 
-    def __init__(self, obstacles: Sequence[Shape] = (),
-                 names: Sequence[str | None] | None = None) -> None:  # fmt: skip
+    def __init__(
+        self, obstacles: Sequence[Shape] = (), names: Sequence[str | None] | None = None
+    ) -> None:
         self.obstacles = tuple(obstacles)
         for i, o in enumerate(self.obstacles):
             if not isinstance(o, Shape):

@@ -81,14 +81,28 @@ class Proximity:
     @classmethod
     def of(cls, near: ProximityBuffers, k: int) -> Proximity:
         """Views of proximity buffers of k body points."""
-        points = ShapeDistances(near.point_distance, near.point_normal, near.point_penalty,
-                                near.point_penalty_gradient,
-                                np.zeros_like(near.point_distance))  # fmt: skip
-        links = ShapeDistances(near.link_distance, near.link_normal, near.link_penalty,
-                               near.link_penalty_gradient, near.link_t)  # fmt: skip
+        points = ShapeDistances(
+            near.point_distance,
+            near.point_normal,
+            near.point_penalty,
+            near.point_penalty_gradient,
+            np.zeros_like(near.point_distance),
+        )
+        links = ShapeDistances(
+            near.link_distance,
+            near.link_normal,
+            near.link_penalty,
+            near.link_penalty_gradient,
+            near.link_t,
+        )
         none = np.zeros_like(near.real_distance)
-        real = ShapeDistances(near.real_distance, near.real_normal, none,
-                              np.zeros_like(near.real_normal), near.real_at)  # fmt: skip
+        real = ShapeDistances(
+            near.real_distance,
+            near.real_normal,
+            none,
+            np.zeros_like(near.real_normal),
+            near.real_at,
+        )
         return cls(points, links, real, int(k))
 
     @property
@@ -145,8 +159,13 @@ def link_label(i: int, k: int) -> str:
     return f"link{i + 1}" if i < k - 1 else ("holder", "carriage")[i - k + 1]
 
 
-def measure(shapes: Sequence[Shape], chain: Array, period: float, ends: NDArray[np.int64],
-            real: tuple[Array, float, int] | None = None) -> ProximityBuffers:  # fmt: skip
+def measure(
+    shapes: Sequence[Shape],
+    chain: Array,
+    period: float,
+    ends: NDArray[np.int64],
+    real: tuple[Array, float, int] | None = None,
+) -> ProximityBuffers:
     """Every distance of the points ``chain`` (m) and of the links ``ends`` (L, 2) between them
     to ``shapes``, penalties included, in new buffers (J, m) and (J, L); with ``real`` (the
     points' 3-D origins (m, 3), the pipe's radius, m, and the probe's index), also the links'

@@ -149,8 +149,9 @@ def _broad(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-de
         for i in range(ends.shape[0]):
             d = links[j, i] - bends[i]
             reported = probe if ends[i, 1] == tool else arm
-            if links[j, i] > far and (d <= far or d < shapes.refine[j] + 2.0 * bends[i]
-                                      or d < reported):  # fmt: skip
+            if links[j, i] > far and (
+                d <= far or d < shapes.refine[j] + 2.0 * bends[i] or d < reported
+            ):
                 near.skipped[j] = False
                 link_row(shapes, j, chain, i, near, True)
                 _one_piece(near, j, i)

@@ -27,8 +27,11 @@ from solvers.jit import njit
 Array = NDArray[np.float64]
 
 REVOLUTE, PRISMATIC = 0, 1
-_ALIGNED = {f"JointModel{kind}{axis}": (code, tuple(float(a == axis) for a in "XYZ"))
-            for kind, code in (("R", REVOLUTE), ("P", PRISMATIC)) for axis in "XYZ"}  # fmt: skip
+_ALIGNED = {
+    f"JointModel{kind}{axis}": (code, tuple(float(a == axis) for a in "XYZ"))
+    for kind, code in (("R", REVOLUTE), ("P", PRISMATIC))
+    for axis in "XYZ"
+}
 _UNALIGNED = {"JointModelRevoluteUnaligned": REVOLUTE, "JointModelPrismaticUnaligned": PRISMATIC}
 
 
@@ -91,13 +94,18 @@ class ModelArrays:
                 support[f, j] = True
                 j = model.parents[j]
         return cls(
-            parents=np.array(model.parents, dtype=np.int64), kinds=kinds,
+            parents=np.array(model.parents, dtype=np.int64),
+            kinds=kinds,
             index=np.array([max(model.joints[j].idx_q, 0) for j in range(count)], np.int64),
-            placements=np.array([p.homogeneous for p in model.jointPlacements]), axes=axes,
+            placements=np.array([p.homogeneous for p in model.jointPlacements]),
+            axes=axes,
             frame_joint=np.array([f.parentJoint for f in frames], dtype=np.int64),
-            frame_placement=np.array([f.placement.homogeneous for f in frames]), support=support,
-            work=np.zeros((count + 2, 4, 4)), world=np.zeros((count, 3)), tool=int(tool),
-        )  # fmt: skip
+            frame_placement=np.array([f.placement.homogeneous for f in frames]),
+            support=support,
+            work=np.zeros((count + 2, 4, 4)),
+            world=np.zeros((count, 3)),
+            tool=int(tool),
+        )
 
 
 def _motion_of(joint: pin.JointModel, name: str) -> tuple[int, Array]:
@@ -110,8 +118,11 @@ def _motion_of(joint: pin.JointModel, name: str) -> tuple[int, Array]:
         axis = np.array(joint.extract().axis, dtype=np.float64)
         return _UNALIGNED[short], axis / np.linalg.norm(axis)
     kind = short.removeprefix("JointModel")
-    raise ParameterError("model", f"joint {name!r} is a {kind} joint: only revolute and "
-                         "prismatic joints about a fixed axis are supported")  # fmt: skip
+    raise ParameterError(
+        "model",
+        f"joint {name!r} is a {kind} joint: only revolute and "
+        "prismatic joints about a fixed axis are supported",
+    )
 
 
 @njit(inline="always")
@@ -200,8 +211,13 @@ def kinematics(model, radius, state) -> int:  # type: ignore[no-untyped-def]
         for r in range(3):
             state.origins[f, r], state.axes[f, r] = pose[r, 3], pose[r, 2]
         _frame_jacobian(model, f, state.origins[f], state.frame_jacobians[f])
-        if not _developed(radius, state.origins[f], state.frame_jacobians[f],
-                          state.guarded[f], state.guarded_jacobians[f]):  # fmt: skip
+        if not _developed(
+            radius,
+            state.origins[f],
+            state.frame_jacobians[f],
+            state.guarded[f],
+            state.guarded_jacobians[f],
+        ):
             return f
     t = model.tool
     for c in range(state.q.shape[0]):
@@ -209,8 +225,9 @@ def kinematics(model, radius, state) -> int:  # type: ignore[no-untyped-def]
             state.tool_jacobian[r, c] = state.guarded_jacobians[t, r, c]
     for r in range(3):
         state.tool[r] = state.guarded[t, r]
-    state.tool[3] = _heading(state.origins[t], state.axes[t], state.frame_jacobians[t],
-                             state.tool_jacobian[3])  # fmt: skip
+    state.tool[3] = _heading(
+        state.origins[t], state.axes[t], state.frame_jacobians[t], state.tool_jacobian[3]
+    )
     return -1
 
 

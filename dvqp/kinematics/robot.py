@@ -162,8 +162,9 @@ class Robot:
             if not 1 <= int(j) <= n:
                 raise ParameterError("point_joints", f"joint {j} is not in 1..{n}")
         if rail_joint is not None and not 1 <= int(rail_joint) < min(point_joints):
-            raise ParameterError("rail_joint", f"joint {rail_joint} is not before the first "
-                                 "body point's")  # fmt: skip
+            raise ParameterError(
+                "rail_joint", f"joint {rail_joint} is not before the first body point's"
+            )
         lo = _validate.limit("q_min", q_min, n)
         hi = _validate.limit("q_max", q_max, n)
         model = pin.Model()
@@ -175,8 +176,16 @@ class Robot:
             if row.theta_offset != 0.0:
                 rz = pin.SE3(pin.rpy.rpyToMatrix(0.0, 0.0, row.theta_offset), np.zeros(3))
                 placement = placement * rz
-            parent = model.addJoint(parent, pin.JointModelRZ(), placement, f"joint{i + 1}", inf,
-                                    inf, lo[i : i + 1], hi[i : i + 1])  # fmt: skip
+            parent = model.addJoint(
+                parent,
+                pin.JointModelRZ(),
+                placement,
+                f"joint{i + 1}",
+                inf,
+                inf,
+                lo[i : i + 1],
+                hi[i : i + 1],
+            )
             model.addJointFrame(parent, -1)
             placement = pin.SE3(fixed_part(row))
             for k, j in enumerate(point_joints):
@@ -188,8 +197,9 @@ class Robot:
         model.addFrame(pin.Frame("tool", parent, tool_placement, pin.OP_FRAME))
         points = [f"point{k + 1}" for k in range(len(point_joints))]
         rail = None if rail_joint is None else "rail"
-        return cls(model, points, "tool", rail_frame=rail, q_min=lo, q_max=hi, qd_max=qd_max,
-                   name=name)  # fmt: skip
+        return cls(
+            model, points, "tool", rail_frame=rail, q_min=lo, q_max=hi, qd_max=qd_max, name=name
+        )
 
     @classmethod
     def ndt13(
@@ -217,8 +227,16 @@ class Robot:
         default_lo[0] = -np.inf
         lo = default_lo if q_min is None else q_min
         hi = -default_lo if q_max is None else q_max
-        return cls.from_dh(table, tool, NDT13_POINT_JOINTS, rail_joint=NDT13_RAIL_JOINT,
-                           q_min=lo, q_max=hi, qd_max=qd_max, name="ndt13")  # fmt: skip
+        return cls.from_dh(
+            table,
+            tool,
+            NDT13_POINT_JOINTS,
+            rail_joint=NDT13_RAIL_JOINT,
+            q_min=lo,
+            q_max=hi,
+            qd_max=qd_max,
+            name="ndt13",
+        )
 
     @classmethod
     def from_urdf(
@@ -255,5 +273,13 @@ class Robot:
         if qd_max is None:
             vel = np.asarray(model.velocityLimit, dtype=float)
             qd_max = np.where(np.isfinite(vel) & (vel > 0), vel, DEFAULT_QD_MAX)
-        return cls(model, points, tool, rail_frame=rail, q_min=q_min, q_max=q_max, qd_max=qd_max,
-                   name=model.name)  # fmt: skip
+        return cls(
+            model,
+            points,
+            tool,
+            rail_frame=rail,
+            q_min=q_min,
+            q_max=q_max,
+            qd_max=qd_max,
+            name=model.name,
+        )

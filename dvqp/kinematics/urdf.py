@@ -26,13 +26,19 @@ def urdf_model(path: str | Path) -> pin.Model:
         raise RobotFileError(str(path), f"cannot load URDF: {exc}{detail}") from exc
     model = _bounded_revolute(model)
     if model.nq != checked.actuated:  # the checks and the parser must agree on the joints
-        raise RobotFileError(str(path), f"the URDF parser read {model.nq} joint coordinates, "
-                             f"the file has {checked.actuated} joints that move")  # fmt: skip
+        raise RobotFileError(
+            str(path),
+            f"the URDF parser read {model.nq} joint coordinates, "
+            f"the file has {checked.actuated} joints that move",
+        )
     return model
 
 
-UNBOUNDED_REVOLUTE = {"JointModelRUBX": pin.JointModelRX, "JointModelRUBY": pin.JointModelRY,
-                      "JointModelRUBZ": pin.JointModelRZ}  # fmt: skip
+UNBOUNDED_REVOLUTE = {
+    "JointModelRUBX": pin.JointModelRX,
+    "JointModelRUBY": pin.JointModelRY,
+    "JointModelRUBZ": pin.JointModelRZ,
+}
 """Pinocchio's joints for a URDF ``continuous`` joint about x, y, z (nq = 2: cos, sin) and their
 nq = 1 twins (any other axis: ``JointModelRevoluteUnboundedUnaligned``, see :func:`_twin`)."""
 
@@ -53,9 +59,16 @@ def _bounded_revolute(model: pin.Model) -> pin.Model:
         if twin is not None:
             lo, hi = np.array([-np.inf]), np.array([np.inf])
         v = slice(joint.idx_v, joint.idx_v + joint.nv)
-        out.addJoint(model.parents[i], joint.extract() if twin is None else twin,
-                     model.jointPlacements[i], model.names[i], model.effortLimit[v],
-                     model.velocityLimit[v], lo, hi)  # fmt: skip
+        out.addJoint(
+            model.parents[i],
+            joint.extract() if twin is None else twin,
+            model.jointPlacements[i],
+            model.names[i],
+            model.effortLimit[v],
+            model.velocityLimit[v],
+            lo,
+            hi,
+        )
         out.appendBodyToJoint(i, model.inertias[i], pin.SE3.Identity())
     for frame in list(model.frames)[1:]:
         out.addFrame(pin.Frame(frame), False)

@@ -37,10 +37,12 @@ ACTUATED = ("revolute", "continuous", "prismatic")
 JOINT_TYPES = (*ACTUATED, "fixed")
 """The joint types dvqp accepts (``floating`` and ``planar`` are refused)."""
 NUMBERS = {
-    "origin": {"xyz": 3, "rpy": 3}, "axis": {"xyz": 3},
-    "limit": {"lower": 1, "upper": 1, "effort": 1, "velocity": 1}, "mass": {"value": 1},
+    "origin": {"xyz": 3, "rpy": 3},
+    "axis": {"xyz": 3},
+    "limit": {"lower": 1, "upper": 1, "effort": 1, "velocity": 1},
+    "mass": {"value": 1},
     "inertia": {k: 1 for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")},
-}  # fmt: skip
+}
 """Numeric attributes checked in every link and joint: element -> attribute -> count."""
 REQUIRED = {"limit": ("effort", "velocity"), "mass": ("value",), "inertia": (*NUMBERS["inertia"],)}
 """Of these, the attributes the URDF parser requires."""
@@ -121,8 +123,10 @@ def _check(root: Element) -> int:
     if len(links) > MAX_LINKS:
         raise _Refused(f"{len(links)} links: dvqp takes at most {MAX_LINKS}")
     if actuated > MAX_ACTUATED:
-        raise _Refused(f"{actuated} revolute, continuous and prismatic joints: dvqp takes at "
-                       f"most {MAX_ACTUATED}")  # fmt: skip
+        raise _Refused(
+            f"{actuated} revolute, continuous and prismatic joints: dvqp takes at "
+            f"most {MAX_ACTUATED}"
+        )
     if actuated == 0:
         raise _Refused("no revolute, continuous or prismatic joint: nothing moves")
     names = [_name(link.get("name"), f"link number {i + 1}") for i, link in enumerate(links)]
@@ -143,8 +147,7 @@ def _name(name: str | None, what: str) -> str:
         raise _Refused(f"{what} has no name")
     if len(name) > MAX_NAME or not name.isprintable():
         shown = repr(name[:MAX_NAME]) + ("..." if len(name) > MAX_NAME else "")
-        raise _Refused(f"{what}: the name {shown} is not {MAX_NAME} printable characters or "
-                       "fewer")  # fmt: skip
+        raise _Refused(f"{what}: the name {shown} is not {MAX_NAME} printable characters or fewer")
     return name
 
 
@@ -162,8 +165,10 @@ def _joint(joint: Element, name: str, links: set[str]) -> tuple[str, str]:
     """A joint's type and limits checked; its ``(parent link, child link)``."""
     kind = joint.get("type")
     if kind not in JOINT_TYPES:
-        raise _Refused(f"joint {name!r} has type {kind!r}: dvqp takes only revolute, continuous, "
-                       "prismatic and fixed joints")  # fmt: skip
+        raise _Refused(
+            f"joint {name!r} has type {kind!r}: dvqp takes only revolute, continuous, "
+            "prismatic and fixed joints"
+        )
     ends = []
     for end in ("parent", "child"):
         found = joint.findall(end)
@@ -190,8 +195,10 @@ def _tree(links: list[str], joints: list[tuple[str, str, str]]) -> None:
     up: dict[str, tuple[str, str]] = {}  # child link -> (joint, parent link)
     for name, parent, child in joints:
         if child in up:
-            raise _Refused(f"joint {name!r}: link {child!r} already has parent joint "
-                           f"{up[child][0]!r} (a link has at most one parent)")  # fmt: skip
+            raise _Refused(
+                f"joint {name!r}: link {child!r} already has parent joint "
+                f"{up[child][0]!r} (a link has at most one parent)"
+            )
         up[child] = (name, parent)
     done: set[str] = set()
     for start in links:
@@ -201,16 +208,19 @@ def _tree(links: list[str], joints: list[tuple[str, str, str]]) -> None:
             if link in chain:
                 loop = chain[chain.index(link) :]
                 named = ", ".join(repr(up[c][0]) for c in loop[:6])
-                raise _Refused(f"the joints {named}{', ...' if len(loop) > 6 else ''} form a "
-                               "cycle: the links must form a tree")  # fmt: skip
+                raise _Refused(
+                    f"the joints {named}{', ...' if len(loop) > 6 else ''} form a "
+                    "cycle: the links must form a tree"
+                )
             chain.append(link)
             link = up[link][1]
         done.update(chain)
     roots = [link for link in links if link not in up]
     if len(roots) != 1:
         named = ", ".join(map(repr, roots[:4])) + (", ..." if len(roots) > 4 else "")
-        raise _Refused(f"{len(roots)} links have no parent joint ({named}): the links must form "
-                       "one tree")  # fmt: skip
+        raise _Refused(
+            f"{len(roots)} links have no parent joint ({named}): the links must form one tree"
+        )
 
 
 def _numbers(owner: Element, what: str) -> None:
@@ -226,8 +236,10 @@ def _numbers(owner: Element, what: str) -> None:
                     raise _Refused(f"{what}: axis xyz {element.get(key)!r} has no direction")
                 far = [v for v in found if abs(v) > MAX_OFFSET]
                 if (tag, key) == ("origin", "xyz") and far:
-                    raise _Refused(f"{what}: origin xyz {element.get(key)!r}: a coordinate "
-                                   f"beyond {MAX_OFFSET:g} m")  # fmt: skip
+                    raise _Refused(
+                        f"{what}: origin xyz {element.get(key)!r}: a coordinate "
+                        f"beyond {MAX_OFFSET:g} m"
+                    )
 
 
 def _floats(element: Element, key: str, count: int, what: str) -> list[float]:
@@ -239,6 +251,8 @@ def _floats(element: Element, key: str, count: int, what: str) -> list[float]:
     values = [float(p) for p in parts if _NUMBER.fullmatch(p)]
     if len(parts) != count or len(values) != count or not all(map(math.isfinite, values)):
         shown = repr(text[:40]) + ("..." if len(text) > 40 else "")
-        raise _Refused(f"{what}: {element.tag} {key} = {shown}: expected {count} finite "
-                       f"number{'s' if count > 1 else ''}")  # fmt: skip
+        raise _Refused(
+            f"{what}: {element.tag} {key} = {shown}: expected {count} finite "
+            f"number{'s' if count > 1 else ''}"
+        )
     return values

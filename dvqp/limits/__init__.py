@@ -16,9 +16,26 @@ from dvqp.limits.self_collision import SelfCollision, self_distance
 from dvqp.limits.tilt import TiltLimit
 
 __all__ = [
-    "DEFAULT_DECELERATION", "DEFAULT_QDD_MAX", "NO_EXCESS", "AccelerationLimit", "Bounds",
-    "Constraint", "Distances", "Excess", "JointPositionLimit", "JointVelocityLimit", "Limit",
-    "ObstacleDamper", "ProbeHeight", "SelfCollision", "StartBroken", "SurfaceHeight",
-    "TiltLimit", "VelocityDamper", "damper_value", "lowest_link", "self_distance",
+    "DEFAULT_DECELERATION",
+    "DEFAULT_QDD_MAX",
+    "NO_EXCESS",
+    "AccelerationLimit",
+    "Bounds",
+    "Constraint",
+    "Distances",
+    "Excess",
+    "JointPositionLimit",
+    "JointVelocityLimit",
+    "Limit",
+    "ObstacleDamper",
+    "ProbeHeight",
+    "SelfCollision",
+    "StartBroken",
+    "SurfaceHeight",
+    "TiltLimit",
+    "VelocityDamper",
+    "damper_value",
+    "lowest_link",
+    "self_distance",
     "start_broken_lines",
-]  # fmt: skip
+]

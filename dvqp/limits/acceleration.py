@@ -78,8 +78,16 @@ def _braking(a: float, dt: float, room: float) -> float:
 
 
 @njit
-def acceleration_bounds(q: Array, q_min: Array, q_max: Array, qdd_max: Array, previous: Array,
-                        dt: float, lb: Array, ub: Array) -> None:  # fmt: skip
+def acceleration_bounds(
+    q: Array,
+    q_min: Array,
+    q_max: Array,
+    qdd_max: Array,
+    previous: Array,
+    dt: float,
+    lb: Array,
+    ub: Array,
+) -> None:
     """The box ``|Q̇ − Q̇_prev| ≤ q̈_max dt`` capped by the braking bounds, intersected into
     ``lb``, ``ub`` in place. A joint that cannot brake in time any more keeps its position
     limit, not this bound (``lb = min(low, high)``)."""

@@ -141,8 +141,9 @@ class DamperArrays:
 
 
 @njit
-def damper_value(distance: float, safe: float, gain: float, dt: float, depth: float,
-                 deceleration: float) -> float:  # fmt: skip
+def damper_value(
+    distance: float, safe: float, gain: float, dt: float, depth: float, deceleration: float
+) -> float:
     """The right-hand side of a damper row (see the module docstring), m/s."""
     room = distance - safe
     rhs = 0.0 if room < -depth else gain / dt * room
@@ -163,8 +164,9 @@ def damper_rows(params, dampers, dt: float, G: Array, h: Array) -> None:  # type
         if dampers.usable[r] and d < params.reach[r]:
             for c in range(G.shape[1]):
                 G[r, c] = -dampers.gradient[r, c]
-            h[r] = damper_value(d, params.safe[r], params.gain[r], dt, params.depth[r],
-                                params.deceleration[r])  # fmt: skip
+            h[r] = damper_value(
+                d, params.safe[r], params.gain[r], dt, params.depth[r], params.deceleration[r]
+            )
         elif h[r] != np.inf:  # (a row at +inf is a zero row already)
             for c in range(G.shape[1]):
                 G[r, c] = 0.0

@@ -64,8 +64,10 @@ class Excess:
             return f"{self.label} ({self.quantity})"
         by = amount(self.value, self.unit)
         below = "<" if self.quantity not in ("joint position", "joint velocity") else "past"
-        return (f"{self.label} {self.quantity} {self.actual:.4g} {self.unit} {below} "
-                f"{self.bound:.4g} {self.unit} (by {by})")  # fmt: skip
+        return (
+            f"{self.label} {self.quantity} {self.actual:.4g} {self.unit} {below} "
+            f"{self.bound:.4g} {self.unit} (by {by})"
+        )
 
 
 NO_EXCESS = Excess(value=-math.inf, tolerance=1.0)
@@ -108,8 +110,15 @@ class StartBroken:
     @property
     def excess(self) -> Excess:
         """How far past the bound at worst over the run (the true figure, not the start's)."""
-        return Excess(self.bound - self.lowest, self.tolerance, self.label, self.quantity,
-                      self.unit, self.lowest, self.bound)  # fmt: skip
+        return Excess(
+            self.bound - self.lowest,
+            self.tolerance,
+            self.label,
+            self.quantity,
+            self.unit,
+            self.lowest,
+            self.bound,
+        )
 
     @property
     def worse(self) -> float:
@@ -128,10 +137,15 @@ def start_broken_lines(found: Sequence[StartBroken]) -> list[str]:
         top = max(group, key=lambda b: b.excess.ratio)
         more = f" and {len(group) - 1} more" if len(group) > 1 else ""
         worst = max(group, key=lambda b: b.worse / b.tolerance)
-        then = ("never worse" if worst.worse <= worst.tolerance
-                else f"{amount(worst.worse, worst.unit)} worse than at the start")  # fmt: skip
-        lines.append(f"{limit}: broken from the start by {amount(top.excess.value, top.unit)} "
-                     f"({top.label}{more}), {then}")  # fmt: skip
+        then = (
+            "never worse"
+            if worst.worse <= worst.tolerance
+            else f"{amount(worst.worse, worst.unit)} worse than at the start"
+        )
+        lines.append(
+            f"{limit}: broken from the start by {amount(top.excess.value, top.unit)} "
+            f"({top.label}{more}), {then}"
+        )
     return lines
 
 

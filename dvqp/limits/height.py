@@ -45,13 +45,17 @@ class SurfaceHeight(VelocityDamper):
     name = "height"
     quantity = "height"
     SCENE_KEYS: ClassVar[dict[str, str]] = {
-        "damper_deceleration": "deceleration", "min_height": "min_height", "damper_gain": "gain"
-    }  # fmt: skip
+        "damper_deceleration": "deceleration",
+        "min_height": "min_height",
+        "damper_gain": "gain",
+    }
 
     def __init__(
-        self, min_height: float = 0.0, gain: float = 0.5,
+        self,
+        min_height: float = 0.0,
+        gain: float = 0.5,
         deceleration: float = DEFAULT_DECELERATION,
-    ) -> None:  # fmt: skip
+    ) -> None:
         super().__init__(gain, deceleration)
         self.min_height = _finite("min_height", min_height)
 
@@ -87,8 +91,9 @@ class ProbeHeight(VelocityDamper):
     name = "probe_height"
     quantity = "height"
     SCENE_KEYS: ClassVar[dict[str, str]] = {
-        "damper_deceleration": "deceleration", "damper_gain": "gain"
-    }  # fmt: skip
+        "damper_deceleration": "deceleration",
+        "damper_gain": "gain",
+    }
 
     def __init__(
         self, floor: float = 0.0, gain: float = 0.5, deceleration: float = DEFAULT_DECELERATION
@@ -180,6 +185,7 @@ def lowest_link(state: KinematicState) -> tuple[float, str]:
     (:func:`lowest_chords`) and that link's name (``"link2"``, ``"carriage"``; inf and ``""``
     without links)."""
     ends = link_ends(state.k, state.rail)
-    low, which, _ = lowest_chords(np.array(state.guarded), np.array(state.origins), ends,
-                                  state.k, state.radius)  # fmt: skip
+    low, which, _ = lowest_chords(
+        np.array(state.guarded), np.array(state.origins), ends, state.k, state.radius
+    )
     return float(low), link_label(int(which), state.k) if which >= 0 else ""

@@ -35,8 +35,7 @@ class JointPositionLimit(Limit):
 
 
 @njit
-def position_bounds(q: Array, q_min: Array, q_max: Array, dt: float, lb: Array,
-                    ub: Array) -> None:  # fmt: skip
+def position_bounds(q: Array, q_min: Array, q_max: Array, dt: float, lb: Array, ub: Array) -> None:
     """``min((q_min − q)/dt, 0) ≤ Q̇ ≤ max((q_max − q)/dt, 0)``, intersected into ``lb``,
     ``ub`` in place."""
     for i in range(q.shape[0]):
@@ -69,8 +68,9 @@ class JointVelocityLimit(Limit):
 
 
 @njit
-def velocity_bounds(qd_max: NDArray[np.float64], lb: NDArray[np.float64],
-                    ub: NDArray[np.float64]) -> None:  # fmt: skip
+def velocity_bounds(
+    qd_max: NDArray[np.float64], lb: NDArray[np.float64], ub: NDArray[np.float64]
+) -> None:
     """``−q̇_max ≤ Q̇ ≤ q̇_max``, intersected into ``lb``, ``ub`` in place."""
     for i in range(qd_max.shape[0]):
         lb[i] = max(lb[i], -qd_max[i])

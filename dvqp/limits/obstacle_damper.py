@@ -42,14 +42,20 @@ class ObstacleDamper(VelocityDamper):
     name = "obstacles"
     quantity = "clearance"
     SCENE_KEYS: ClassVar[dict[str, str]] = {
-        "damper_deceleration": "deceleration", "margin": "margin", "influence": "influence",
+        "damper_deceleration": "deceleration",
+        "margin": "margin",
+        "influence": "influence",
         "damper_gain": "gain",
-    }  # fmt: skip
+    }
 
     def __init__(
-        self, obstacles: ObstacleSet, margin: float = 0.01, influence: float = 0.06,
-        gain: float = 0.5, deceleration: float = DEFAULT_DECELERATION,
-    ) -> None:  # fmt: skip
+        self,
+        obstacles: ObstacleSet,
+        margin: float = 0.01,
+        influence: float = 0.06,
+        gain: float = 0.5,
+        deceleration: float = DEFAULT_DECELERATION,
+    ) -> None:
         super().__init__(gain, deceleration)
         self.obstacles = ObstacleSet.of(obstacles)
         self.margin = _validate.positive("margin", margin, strict=False)
@@ -79,8 +85,19 @@ class ObstacleDamper(VelocityDamper):
 
 
 @njit
-def obstacle_distances(near, jacobians, origins, frame_jacobians, radius, reach, members,
-                       start, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]  # fmt: skip
+def obstacle_distances(
+    near,
+    jacobians,
+    origins,
+    frame_jacobians,
+    radius,
+    reach,
+    members,
+    start,
+    distance,
+    gradient,
+    usable,
+) -> None:  # type: ignore[no-untyped-def]
     """Clearances of every (point, obstacle) pair then every (link, obstacle) pair of the
     obstacles ``members`` (rows of ``near``, a packed ProximityBuffers), obstacle-major, from
     row ``start``: ``d``, ``∂d/∂Q = n · ∂p/∂Q`` and whether the normal is defined. A link's

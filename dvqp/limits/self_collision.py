@@ -47,13 +47,18 @@ class SelfCollision(VelocityDamper):
     name = "self"
     quantity = "self distance"
     SCENE_KEYS: ClassVar[dict[str, str]] = {
-        "damper_deceleration": "deceleration", "self_margin": "margin", "damper_gain": "gain"
-    }  # fmt: skip
+        "damper_deceleration": "deceleration",
+        "self_margin": "margin",
+        "damper_gain": "gain",
+    }
 
     def __init__(
-        self, margin: float = 0.02, influence: float = 0.05, gain: float = 0.5,
+        self,
+        margin: float = 0.02,
+        influence: float = 0.05,
+        gain: float = 0.5,
         deceleration: float = DEFAULT_DECELERATION,
-    ) -> None:  # fmt: skip
+    ) -> None:
         super().__init__(gain, deceleration)
         self.margin = _validate.positive("margin", margin, strict=False)
         self.influence = _validate.positive("influence", influence)
@@ -72,8 +77,9 @@ class SelfCollision(VelocityDamper):
         """The pairs' names, e.g. ``"link1/link3"``, ``"link2/holder"``, ``"link2/carriage"``
         (k body points, the carriage link if ``rail``)."""
         pairs = PairBuffers.allocate(k, rail)
-        return tuple(f"{link_label(a, k)}/{link_label(b, k)}"
-                     for a, b in zip(pairs.i, pairs.j, strict=True))  # fmt: skip
+        return tuple(
+            f"{link_label(a, k)}/{link_label(b, k)}" for a, b in zip(pairs.i, pairs.j, strict=True)
+        )
 
 
 @njit

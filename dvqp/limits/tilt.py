@@ -43,8 +43,10 @@ class TiltLimit(VelocityDamper):
     tolerance = 1e-3
     """rad: how far below ``min(θ_min, θ at the start)`` an integrated step may end."""
     SCENE_KEYS: ClassVar[dict[str, str]] = {
-        "damper_deceleration": "deceleration", "min_tilt": "min_tilt", "damper_gain": "gain"
-    }  # fmt: skip
+        "damper_deceleration": "deceleration",
+        "min_tilt": "min_tilt",
+        "damper_gain": "gain",
+    }
 
     def __init__(
         self, min_tilt: float = 0.2, gain: float = 0.5, deceleration: float = DEFAULT_DECELERATION

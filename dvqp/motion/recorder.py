@@ -14,8 +14,16 @@ from dvqp.limits.excess import StartBroken
 from dvqp.motion.trajectory import Trajectory
 from dvqp.step import Advance
 
-PER_SAMPLE = ("w", "min_clearance", "probe_clearance", "tilt", "self_distance", "limit_excess",
-              "link_height", "holder_height")  # fmt: skip
+PER_SAMPLE = (
+    "w",
+    "min_clearance",
+    "probe_clearance",
+    "tilt",
+    "self_distance",
+    "limit_excess",
+    "link_height",
+    "holder_height",
+)
 PER_STEP = ("solve_time", "solver_time", "step_time", "task_error")
 
 
@@ -65,11 +73,17 @@ class TrajectoryRecorder:
             self.arrays[name] = np.concatenate([a, room])
         self.status = np.concatenate([self.status, np.full(steps, "", dtype=object)])
 
-    def trajectory(self, dt: float, pipe_radius: float, backend: str, steps: int | None = None,
-                   brake_start: int = -1,
-                   start_broken: tuple[StartBroken, ...] = (),
-                   refusals: dict[str, int] | None = None,
-                   accuracy: dict[str, float] | None = None) -> Trajectory:  # fmt: skip
+    def trajectory(
+        self,
+        dt: float,
+        pipe_radius: float,
+        backend: str,
+        steps: int | None = None,
+        brake_start: int = -1,
+        start_broken: tuple[StartBroken, ...] = (),
+        refusals: dict[str, int] | None = None,
+        accuracy: dict[str, float] | None = None,
+    ) -> Trajectory:
         """The first ``steps`` (default all) recorded steps and their samples (l and α
         unwrapped), with ``qddot``: the change of joint velocity at the start of each step over
         dt (the run starts at rest), rad/s²; ``brake_start`` the first braking step (−1: none);
@@ -82,7 +96,14 @@ class TrajectoryRecorder:
         qdot = kept["qdot"]
         before = np.vstack([np.zeros((1, qdot.shape[1])), qdot[:-1]])
         return Trajectory.from_samples(
-            dt=dt, pipe_radius=pipe_radius, backend=backend, status=self.status[:steps],
-            qddot=(qdot - before) / dt, brake_start=brake_start, start_broken=start_broken,
-            refusals=dict(refusals or {}), accuracy=dict(accuracy or {}), **kept,
-        )  # fmt: skip
+            dt=dt,
+            pipe_radius=pipe_radius,
+            backend=backend,
+            status=self.status[:steps],
+            qddot=(qdot - before) / dt,
+            brake_start=brake_start,
+            start_broken=start_broken,
+            refusals=dict(refusals or {}),
+            accuracy=dict(accuracy or {}),
+            **kept,
+        )

@@ -65,23 +65,29 @@ class SaddleWeld:
     height: float
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "center", _validate.readonly(
-            _validate.vector("center", self.center, 2)))  # fmt: skip
+        object.__setattr__(
+            self, "center", _validate.readonly(_validate.vector("center", self.center, 2))
+        )
         _validate.positive("radius", self.radius)
         _validate.positive("offset", self.offset, strict=False)
         _validate.positive("height", self.height, strict=False)
         if not self.radius + self.offset < self.pipe_radius:
-            raise ParameterError("offset", f"the scanning radius r + d = "
-                                 f"{self.radius + self.offset:g} m must be smaller than the "
-                                 f"pipe radius {self.pipe_radius:g} m")  # fmt: skip
+            raise ParameterError(
+                "offset",
+                f"the scanning radius r + d = "
+                f"{self.radius + self.offset:g} m must be smaller than the "
+                f"pipe radius {self.pipe_radius:g} m",
+            )
         start, end = (float(a) for a in self.arc)
         if not 0.0 < abs(end - start) <= 2.0 * math.pi + TURN_SLACK:
-            raise ParameterError("arc", f"needs 0 < |θ_end − θ_start| <= 2π, got "
-                                 f"[{start:g}, {end:g}]")  # fmt: skip
+            raise ParameterError(
+                "arc", f"needs 0 < |θ_end − θ_start| <= 2π, got [{start:g}, {end:g}]"
+            )
         object.__setattr__(self, "arc", (start, end))
         if self.heading not in HEADINGS:
-            raise ParameterError("heading", f"unknown heading {self.heading!r} (known: "
-                                 f"{', '.join(HEADINGS)})")  # fmt: skip
+            raise ParameterError(
+                "heading", f"unknown heading {self.heading!r} (known: {', '.join(HEADINGS)})"
+            )
 
     def points(self, theta: Array) -> Array:
         """``[l, z, h, α]`` of the probe at the curve parameters ``theta`` (rad, shape (m,)),
@@ -126,6 +132,7 @@ def chord_deviation(weld: SaddleWeld, theta: Array) -> float:
     mid = weld.points(0.5 * (theta[1:] + theta[:-1]))[:, :2]
     a, b = ends[:-1], ends[1:]
     ab = b - a
-    t = np.clip(np.sum((mid - a) * ab, axis=1) / np.maximum(np.sum(ab * ab, axis=1), 1e-300),
-                0.0, 1.0)  # fmt: skip
+    t = np.clip(
+        np.sum((mid - a) * ab, axis=1) / np.maximum(np.sum(ab * ab, axis=1), 1e-300), 0.0, 1.0
+    )
     return float(np.max(np.linalg.norm(a + t[:, None] * ab - mid, axis=1)))

@@ -55,8 +55,15 @@ class Schedule:
         ``reference[k+1] − reference[k]``, as a path's are).
     """
 
-    def __init__(self, commands: Array, reference: Array | None, gain: float, dt: float,
-                 radius: float, scaled: bool = False) -> None:  # fmt: skip
+    def __init__(
+        self,
+        commands: Array,
+        reference: Array | None,
+        gain: float,
+        dt: float,
+        radius: float,
+        scaled: bool = False,
+    ) -> None:
         if scaled and reference is None:
             raise ParameterError("timing", "time scaling follows a path: it needs its reference")
         self.commands, self.reference = commands, reference

@@ -172,14 +172,21 @@ def simulate(
     refused = {} if solver is None else dict(solver.refusals)
     accuracy = {} if solver is None else solver.accuracy.to_dict()
     braked = n if stop else -1
-    traj = record.trajectory(dt, radius, resolver.name, n + steps, braked,
-                             stepper.start_broken(), refused, accuracy)  # fmt: skip
+    traj = record.trajectory(
+        dt, radius, resolver.name, n + steps, braked, stepper.start_broken(), refused, accuracy
+    )
     held = np.full(steps, path_time[-1])
     return dataclasses.replace(traj, path_time=np.concatenate([path_time, held]))
 
 
-def _follow(stepper: Stepper, record: TrajectoryRecorder, schedule: Schedule, check: bool,
-            max_halvings: int, progress: Progress | None) -> tuple[int, Array]:  # fmt: skip
+def _follow(
+    stepper: Stepper,
+    record: TrajectoryRecorder,
+    schedule: Schedule,
+    check: bool,
+    max_halvings: int,
+    progress: Progress | None,
+) -> tuple[int, Array]:
     """Run the schedule's commands; the steps taken and the nominal time (s) at each sample."""
     u, k, dt = 0.0, 0, schedule.dt
     reached = [0.0]

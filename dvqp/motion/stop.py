@@ -60,8 +60,11 @@ def braking_steps(qdot: Array, weights: Array, qdd_max: Array | None, dt: float)
     steps = (bound + MARGIN) / dt
     if not steps <= MAX_STEPS:  # a tiny qdd_max: a stop that no memory could record
         least = math.inf if qdd_max is None else float(qdd_max.min())
-        raise ParameterError("qdd_max", f"{least:.3g} rad/s^2: a stop would take about "
-                             f"{steps:.3g} steps of dt (at most {MAX_STEPS:.0e})")  # fmt: skip
+        raise ParameterError(
+            "qdd_max",
+            f"{least:.3g} rad/s^2: a stop would take about "
+            f"{steps:.3g} steps of dt (at most {MAX_STEPS:.0e})",
+        )
     return max(1, math.ceil(steps))
 
 
@@ -75,14 +78,24 @@ def room(robot: Robot, resolver: Resolver, dt: float) -> int:
     """Steps to reserve for a stop: the bound from the velocity limits (a run that keeps them
     ends no faster) and the failed step; a stop that needs more grows the recorder then."""
     spec = resolver.spec
-    limited = resolver.holds_limits and np.all(np.isfinite(robot.qd_max)) and any(
-        isinstance(lim, JointVelocityLimit) for lim in spec.limits)  # fmt: skip
+    limited = (
+        resolver.holds_limits
+        and np.all(np.isfinite(robot.qd_max))
+        and any(isinstance(lim, JointVelocityLimit) for lim in spec.limits)
+    )
     fastest = robot.qd_max if limited else np.zeros(robot.n)
     return braking_steps(fastest, spec.diagonal(robot.n), _qdd_max(spec), dt) + 1
 
 
-def brake(stepper: Stepper, record: TrajectoryRecorder, first: int, dt: float, *,
-          verify: bool, max_halvings: int) -> int:  # fmt: skip
+def brake(
+    stepper: Stepper,
+    record: TrajectoryRecorder,
+    first: int,
+    dt: float,
+    *,
+    verify: bool,
+    max_halvings: int,
+) -> int:
     """Brake from the end of step ``first − 1`` until every joint has stopped; the number of
     braking steps recorded (0 if the run ended at rest).
 
@@ -103,8 +116,9 @@ def brake(stepper: Stepper, record: TrajectoryRecorder, first: int, dt: float, *
     stepper.stopping = True
     try:
         for k in range(first, first + bound):
-            moved = advance(stepper, still, dt, verify=verify, max_halvings=max_halvings,
-                            record=k + 1)  # fmt: skip
+            moved = advance(
+                stepper, still, dt, verify=verify, max_halvings=max_halvings, record=k + 1
+            )
             now = time.perf_counter()
             record.step(k, moved, now - started)
             started = now
@@ -119,12 +133,14 @@ def brake(stepper: Stepper, record: TrajectoryRecorder, first: int, dt: float, *
     return bound + 1
 
 
-def _not_stopped(stepper: Stepper, record: TrajectoryRecorder, k: int, qdot: Array, dt: float,
-                 within: str) -> None:  # fmt: skip
+def _not_stopped(
+    stepper: Stepper, record: TrajectoryRecorder, k: int, qdot: Array, dt: float, within: str
+) -> None:
     """Record step ``k`` as the failed end of a stop that took too long."""
     joint = int(np.argmax(np.abs(qdot)))
-    status = (f"failed: could not stop{within}: joint{joint + 1} still at "
-              f"{abs(qdot[joint]):.3g} rad/s")  # fmt: skip
+    status = (
+        f"failed: could not stop{within}: joint{joint + 1} still at {abs(qdot[joint]):.3g} rad/s"
+    )
     n = qdot.shape[0]
     stepper.observe(np.zeros(n), dt)
     stepper.record_at[0] = k + 1

@@ -21,13 +21,37 @@ from dvqp.limits.excess import StartBroken
 if TYPE_CHECKING:
     from dvqp.retime import Retimed, RunScene
 
-ARRAYS = ("t", "q", "qdot", "tool", "points", "w", "min_clearance", "solve_time", "step_time",
-          "task_error", "iterations", "success", "status")  # fmt: skip
+ARRAYS = (
+    "t",
+    "q",
+    "qdot",
+    "tool",
+    "points",
+    "w",
+    "min_clearance",
+    "solve_time",
+    "step_time",
+    "task_error",
+    "iterations",
+    "success",
+    "status",
+)
 """The arrays every trajectory file holds."""
 
-DIAGNOSTICS = ("probe_clearance", "tilt", "self_distance", "limit_excess", "limits_kept",
-               "substeps", "qddot", "solver_time", "link_height", "holder_height",
-               "rail", "path_time")  # fmt: skip
+DIAGNOSTICS = (
+    "probe_clearance",
+    "tilt",
+    "self_distance",
+    "limit_excess",
+    "limits_kept",
+    "substeps",
+    "qddot",
+    "solver_time",
+    "link_height",
+    "holder_height",
+    "rail",
+    "path_time",
+)
 """Arrays added since dvqp 0.2; a file written before one was added lacks it (loaded empty)."""
 
 CONVENTIONS = {
@@ -161,9 +185,17 @@ class Trajectory:
     accuracy: dict[str, float] = field(default_factory=dict)
 
     @classmethod
-    def from_samples(cls, *, dt: float, pipe_radius: float, backend: str, tool: NDArray[np.float64],
-                     points: NDArray[np.float64], status: Sequence[str],
-                     **arrays: NDArray[np.float64]) -> Trajectory:  # fmt: skip
+    def from_samples(
+        cls,
+        *,
+        dt: float,
+        pipe_radius: float,
+        backend: str,
+        tool: NDArray[np.float64],
+        points: NDArray[np.float64],
+        status: Sequence[str],
+        **arrays: NDArray[np.float64],
+    ) -> Trajectory:
         """Build from raw samples, unwrapping l (period 2πR) and α (period 2π).
 
         ``arrays`` are the other fields (``q``, ``qdot``, ``w``, ...), taken as they are.
@@ -178,9 +210,15 @@ class Trajectory:
         unwrapped[0, 0] = first[-1]
         unwrapped[:, 0] = unwrap(unwrapped[:, 0], period)
         unwrapped[:, 3] = unwrap(tool[:, 3], 2.0 * np.pi)
-        return cls(t=dt * np.arange(tool.shape[0]), tool=unwrapped, points=pts,
-                   status=np.asarray(list(status), dtype=np.str_), backend=backend,
-                   pipe_radius=float(pipe_radius), **arrays)  # type: ignore[arg-type]  # fmt: skip
+        return cls(
+            t=dt * np.arange(tool.shape[0]),
+            tool=unwrapped,
+            points=pts,
+            status=np.asarray(list(status), dtype=np.str_),
+            backend=backend,
+            pipe_radius=float(pipe_radius),
+            **arrays,
+        )  # type: ignore[arg-type]
 
     @property
     def n_steps(self) -> int:
@@ -248,8 +286,15 @@ class Trajectory:
 
     def _write_csv(self, fh: object) -> None:
         n = self.q.shape[1]
-        header = ["t", *(f"q{i + 1}" for i in range(n)), *(f"qdot{i + 1}" for i in range(n)),
-                  "l", "z", "h", "alpha"]  # fmt: skip
+        header = [
+            "t",
+            *(f"q{i + 1}" for i in range(n)),
+            *(f"qdot{i + 1}" for i in range(n)),
+            "l",
+            "z",
+            "h",
+            "alpha",
+        ]
         qdot = np.vstack([self.qdot, np.zeros((1, n))])
         columns = [self.t, self.q, qdot, self.tool]
         if self.tracking_error.shape[0] == self.t.shape[0]:

@@ -40,12 +40,20 @@ class Objective:
 
     @classmethod
     def paper(
-        cls, orbital_level: float, obstacles: ObstacleSet, *, k_height: ArrayLike = 1.0,
-        k_obstacle: ArrayLike = 1.0, gain: float = 1.0,
-    ) -> Objective:  # fmt: skip
+        cls,
+        orbital_level: float,
+        obstacles: ObstacleSet,
+        *,
+        k_height: ArrayLike = 1.0,
+        k_obstacle: ArrayLike = 1.0,
+        gain: float = 1.0,
+    ) -> Objective:
         """The paper's three terms: orbital level, obstacle points, obstacle links."""
-        terms = (OrbitalLevel(orbital_level, k_height), ObstaclePoints(obstacles, k_obstacle),
-                 ObstacleLinks(obstacles, k_obstacle))  # fmt: skip
+        terms = (
+            OrbitalLevel(orbital_level, k_height),
+            ObstaclePoints(obstacles, k_obstacle),
+            ObstacleLinks(obstacles, k_obstacle),
+        )
         return cls(terms, gain)
 
     def __repr__(self) -> str:

@@ -32,9 +32,16 @@ class ObstaclePoints(ObjectiveTerm):
 
 
 @njit
-def obstacle_points(penalty: Array, penalty_gradient: Array, skipped: Array, coef: Array,
-                    jacobians: Array, at_points: Array, value: Array,
-                    gradient: Array) -> None:  # fmt: skip
+def obstacle_points(
+    penalty: Array,
+    penalty_gradient: Array,
+    skipped: Array,
+    coef: Array,
+    jacobians: Array,
+    at_points: Array,
+    value: Array,
+    gradient: Array,
+) -> None:
     """Add ``Σ_j Σ_i ½ c_ji e_ji`` over the body points inside obstacle j (``e < 0``) to
     ``value`` and ``Σ ½ c ∇eᵀ ∂p/∂Q`` to ``gradient``. ``penalty`` (J, k+1) and
     ``penalty_gradient`` (J, k+1, 2) are the guarded points'; ``coef`` (J, k) is

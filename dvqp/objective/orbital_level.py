@@ -31,8 +31,9 @@ class OrbitalLevel(ObjectiveTerm):
 
 
 @njit
-def orbital_level(guarded: Array, jacobians: Array, level: float, k_height: Array,
-                  value: Array, gradient: Array) -> None:  # fmt: skip
+def orbital_level(
+    guarded: Array, jacobians: Array, level: float, k_height: Array, value: Array, gradient: Array
+) -> None:
     """Add ``−Σ_i ½ k²_i (h_i − h*)²`` to ``value`` (1,) and ``−Σ_i k²_i (h_i − h*) ∂h_i/∂Q``
     to ``gradient`` (n,), over the k body points (``k_height`` (k,), 1/m²; ``level`` h*, m;
     ``guarded`` (k+1, 3) and ``jacobians`` (k+1, 3, n) the guarded points')."""

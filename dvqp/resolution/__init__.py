@@ -7,6 +7,11 @@ from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver, Step
 
 __all__ = [
-    "PseudoinverseResolver", "QPResolver", "Resolver", "Step", "StepSpec", "available_resolvers",
+    "PseudoinverseResolver",
+    "QPResolver",
+    "Resolver",
+    "Step",
+    "StepSpec",
+    "available_resolvers",
     "make_resolver",
-]  # fmt: skip
+]

@@ -81,8 +81,12 @@ class QPResolver(Resolver):
 
     holds_limits = True
 
-    def __init__(self, spec: StepSpec, backend: str | Callable[[], solvers.Backend],
-                 options: dict[str, Any] | None = None) -> None:  # fmt: skip
+    def __init__(
+        self,
+        spec: StepSpec,
+        backend: str | Callable[[], solvers.Backend],
+        options: dict[str, Any] | None = None,
+    ) -> None:
         super().__init__(spec)
         settings = dict(options or {})
         named = isinstance(backend, str)
@@ -120,8 +124,9 @@ class QPSolver:
         ``ρ`` of the relaxed problem's slack.
     """
 
-    def __init__(self, factory: Callable[[], solvers.Backend], qp: QPBuffers,
-                 task_weight: float) -> None:  # fmt: skip
+    def __init__(
+        self, factory: Callable[[], solvers.Backend], qp: QPBuffers, task_weight: float
+    ) -> None:
         self.qp = qp
         n, m, p = qp.cost.shape[0], qp.b.shape[0], qp.h.shape[0]
         G, h = (qp.G, qp.h) if p else (None, None)
@@ -133,9 +138,15 @@ class QPSolver:
         G_r = np.zeros((p, n + m)) if p else None
         inf = np.full(m, np.inf)
         self.relaxed = solvers.Problem.trusted(
-            P_r, np.zeros(n + m), A_r, qp.b, G_r, h, np.concatenate([qp.lb, -inf]),
+            P_r,
+            np.zeros(n + m),
+            A_r,
+            qp.b,
+            G_r,
+            h,
+            np.concatenate([qp.lb, -inf]),
             np.concatenate([qp.ub, inf]),
-        )  # fmt: skip
+        )
         self.backends = factory(), factory()
         self.factory, self.task_weight = factory, task_weight
         self.feedforward = np.zeros(m)
@@ -219,9 +230,15 @@ class QPSolver:
         n, m, p = qp.cost.shape[0], qp.b.shape[0], qp.h.shape[0]
         G = np.zeros((p, n + 1)) if p else None
         return solvers.Problem.trusted(
-            np.zeros((n + 1, n + 1)), np.zeros(n + 1), np.zeros((m, n + 1)), np.zeros(m), G,
-            qp.h if p else None, np.append(qp.lb, 0.0), np.append(qp.ub, 1.0),
-        )  # fmt: skip
+            np.zeros((n + 1, n + 1)),
+            np.zeros(n + 1),
+            np.zeros((m, n + 1)),
+            np.zeros(m),
+            G,
+            qp.h if p else None,
+            np.append(qp.lb, 0.0),
+            np.append(qp.ub, 1.0),
+        )
 
     def _count(self, kind: str, problem: solvers.Problem, solution: solvers.Solution) -> None:
         """Tally one backend call (refusal, accuracy) and show it to the watchers."""

@@ -67,8 +67,13 @@ class StepSpec:
 
     def with_extra(self, tasks: Sequence[Task] = (), limits: Sequence[Limit] = ()) -> StepSpec:
         """A copy with more tasks and limits appended."""
-        return StepSpec((*self.tasks, *tasks), self.objective, (*self.limits, *limits),
-                        self.weights, self.task_weight)  # fmt: skip
+        return StepSpec(
+            (*self.tasks, *tasks),
+            self.objective,
+            (*self.limits, *limits),
+            self.weights,
+            self.task_weight,
+        )
 
 
 def _check_kind(name: str, items: Sequence[object], kind: type) -> None:

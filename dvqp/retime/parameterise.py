@@ -89,8 +89,9 @@ def parameterise(q: Array, t: Array, qd_max: Array, qdd_max: Array, rate: float)
         ta.constraint.JointVelocityConstraint(np.column_stack([-qd_max, qd_max])),
         ta.constraint.JointAccelerationConstraint(np.column_stack([-qdd_max, qdd_max])),
     ]
-    algorithm = ta.algorithm.TOPPRA(limits, path, gridpoints=grid,
-                                    parametrizer="ParametrizeConstAccel")  # fmt: skip
+    algorithm = ta.algorithm.TOPPRA(
+        limits, path, gridpoints=grid, parametrizer="ParametrizeConstAccel"
+    )
     found = algorithm.compute_trajectory(0.0, 0.0)
     if found is None or not math.isfinite(found.duration) or found.duration <= 0.0:
         raise RetimingError(
@@ -109,20 +110,24 @@ def sampled(motion: Any, qd_max: Array, qdd_max: Array, rate: float) -> Samples:
     for _ in range(MAX_STRETCHES):
         periods = max(math.ceil(duration * scale * rate - 1e-9), 1)
         if periods + 1 > MAX_SAMPLES:
-            raise ParameterError("rate", f"{rate:g} Hz gives {periods + 1:.3g} samples, more "
-                                 f"than {MAX_SAMPLES:.0e}")  # fmt: skip
+            raise ParameterError(
+                "rate", f"{rate:g} Hz gives {periods + 1:.3g} samples, more than {MAX_SAMPLES:.0e}"
+            )
         scale = periods / (rate * duration)
         t = np.arange(periods + 1) / rate
         tau = np.minimum(t / scale, duration)
         qdot, qddot = motion(tau, 1) / scale, motion(tau, 2) / scale**2
         qdot[[0, -1]] = 0.0  # ṡ = 0 there: what is left is round-off
-        use = max(float(np.max(np.abs(qdot) / qd_max)),
-                  math.sqrt(float(np.max(np.abs(qddot) / qdd_max))))  # fmt: skip
+        use = max(
+            float(np.max(np.abs(qdot) / qd_max)), math.sqrt(float(np.max(np.abs(qddot) / qdd_max)))
+        )
         q = motion(tau)
         if not (math.isfinite(use) and np.all(np.isfinite(q))):
             break
         if use <= 1.0:
             return Samples(t, q, qdot, qddot)
         scale *= use
-    raise RetimingError("the retimed motion could not be brought within the joint velocity "
-                        "and acceleration limits at the controller's samples")  # fmt: skip
+    raise RetimingError(
+        "the retimed motion could not be brought within the joint velocity "
+        "and acceleration limits at the controller's samples"
+    )

@@ -96,8 +96,10 @@ class Retimed:
         """``2.31 s (planned 4.00 s), 1156 samples at 500 Hz, limits kept`` (or the limit
         broken)."""
         kept = "limits kept" if self.kept else f"BROKEN: {self.excess.describe()}"
-        return (f"{self.duration:.2f} s (planned {self.planned_duration:.2f} s), "
-                f"{self.t.shape[0]} samples at {self.rate:g} Hz, {kept}")  # fmt: skip
+        return (
+            f"{self.duration:.2f} s (planned {self.planned_duration:.2f} s), "
+            f"{self.t.shape[0]} samples at {self.rate:g} Hz, {kept}"
+        )
 
     def save(self, path: str | Path) -> Path:
         """Write the samples atomically: ``.npz`` (``t``, ``q``, ``qdot``, ``qddot``,
@@ -113,19 +115,27 @@ class Retimed:
                 fh.write(json.dumps(doc, allow_nan=False).encode("utf-8"))
             elif suffix == ".csv":
                 n = self.q.shape[1]
-                header = ["t", *(f"{name}{i + 1}" for name in ("q", "qdot", "qddot")
-                                 for i in range(n))]  # fmt: skip
+                header = [
+                    "t",
+                    *(f"{name}{i + 1}" for name in ("q", "qdot", "qddot") for i in range(n)),
+                ]
                 table = np.column_stack([self.t, self.q, self.qdot, self.qddot])
-                np.savetxt(fh, table, delimiter=",", header=",".join(header), comments="",
-                           fmt="%.17g")  # fmt: skip
+                np.savetxt(
+                    fh, table, delimiter=",", header=",".join(header), comments="", fmt="%.17g"
+                )
             else:
                 meta = {"versions": versions(), "units": "s, rad, rad/s, rad/s^2; rate in Hz"}
                 np.savez_compressed(
-                    fh, t=self.t, q=self.q, qdot=self.qdot, qddot=self.qddot,
+                    fh,
+                    t=self.t,
+                    q=self.q,
+                    qdot=self.qdot,
+                    qddot=self.qddot,
                     joint_names=np.array(self.joint_names, dtype=np.str_),
-                    rate=np.float64(self.rate), planned_duration=np.float64(self.planned_duration),
+                    rate=np.float64(self.rate),
+                    planned_duration=np.float64(self.planned_duration),
                     meta=np.str_(json.dumps(meta)),
-                )  # fmt: skip
+                )
         return target
 
 
@@ -151,13 +161,17 @@ def retime(scene: RunScene, q: ArrayLike, t: ArrayLike, rate: float = DEFAULT_RA
     q, t = np.asarray(q, dtype=float), np.asarray(t, dtype=float)
     samples = parameterise(q, t, robot.qd_max, qdd_max, rate)
     return Retimed(
-        samples.t, samples.q, samples.qdot, samples.qddot,
-        joint_names=tuple(robot.model.names[1:]), rate=float(rate),
+        samples.t,
+        samples.q,
+        samples.qdot,
+        samples.qddot,
+        joint_names=tuple(robot.model.names[1:]),
+        rate=float(rate),
         planned_duration=float(t[-1] - t[0]),
         velocity_use=float(np.max(np.abs(samples.qdot) / robot.qd_max)),
         acceleration_use=float(np.max(np.abs(samples.qddot) / qdd_max)),
         excess=verified(scene, spec, q[0], samples.q),
-    )  # fmt: skip
+    )
 
 
 def verified(scene: RunScene, spec: StepSpec, q0: Array, samples: Array) -> Excess:

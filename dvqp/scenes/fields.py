@@ -61,8 +61,13 @@ def join(prefix: str, key: str | int) -> str:
     return f"{prefix}.{key}" if prefix else key
 
 
-KINDS = ((bool, "a boolean"), ((int, float), "a number"), (str, "a string"), (list, "an array"),
-         (dict, "a table"))  # fmt: skip
+KINDS = (
+    (bool, "a boolean"),
+    ((int, float), "a number"),
+    (str, "a string"),
+    (list, "an array"),
+    (dict, "a table"),
+)
 
 
 def kind(value: object) -> str:
@@ -132,9 +137,14 @@ class Fields:
         return default
 
     def table(
-        self, parent: dict[str, Any], key: str, prefix: str, allowed: Sequence[str], *,
+        self,
+        parent: dict[str, Any],
+        key: str,
+        prefix: str,
+        allowed: Sequence[str],
+        *,
         required: bool = True,
-    ) -> dict[str, Any]:  # fmt: skip
+    ) -> dict[str, Any]:
         """A sub-table with only ``allowed`` keys (``{}`` if optional and absent)."""
         value = self.get(parent, key, prefix, REQUIRED if required else {})
         if not isinstance(value, dict):
@@ -155,9 +165,14 @@ class Fields:
         return value
 
     def number(
-        self, table: dict[str, Any], key: str, prefix: str, default: Any = REQUIRED, *,
+        self,
+        table: dict[str, Any],
+        key: str,
+        prefix: str,
+        default: Any = REQUIRED,
+        *,
         within: Bound = ANY,
-    ) -> float:  # fmt: skip
+    ) -> float:
         """A finite number (int or float) in ``within``, m / s / rad as documented per field."""
         return self._finite(join(prefix, key), self.get(table, key, prefix, default), within)
 
@@ -176,10 +191,17 @@ class Fields:
         return value
 
     def vector(
-        self, table: dict[str, Any], key: str, prefix: str, n: int, *,
-        scalar: bool = False, default: Any = REQUIRED, infinite: bool = False,
+        self,
+        table: dict[str, Any],
+        key: str,
+        prefix: str,
+        n: int,
+        *,
+        scalar: bool = False,
+        default: Any = REQUIRED,
+        infinite: bool = False,
         within: Bound | Sequence[Bound] = ANY,
-    ) -> NDArray[np.float64]:  # fmt: skip
+    ) -> NDArray[np.float64]:
         """``n`` numbers (or one broadcast to ``n`` if ``scalar``), shape (n,), each in ``within``
         (one bound, or one per element) and finite unless ``infinite`` (then ``±inf`` pass as
         "no limit", ``nan`` does not)."""
@@ -188,9 +210,15 @@ class Fields:
         return self.vector_value(field, value, n, scalar=scalar, infinite=infinite, within=within)
 
     def vector_value(
-        self, field: str, value: Any, n: int, *, scalar: bool = False, infinite: bool = False,
+        self,
+        field: str,
+        value: Any,
+        n: int,
+        *,
+        scalar: bool = False,
+        infinite: bool = False,
         within: Bound | Sequence[Bound] = ANY,
-    ) -> NDArray[np.float64]:  # fmt: skip
+    ) -> NDArray[np.float64]:
         """Check an already fetched value as in :meth:`vector`."""
         bounds = [within] * n if isinstance(within, Bound) else list(within)
         if scalar and is_number(value):

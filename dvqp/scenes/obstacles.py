@@ -20,8 +20,7 @@ from dvqp.scenes.sections import POSITION, SIZE, WEIGHT
 
 def obstacles(f: Fields, doc: dict[str, Any], pipe_radius: float) -> ObstacleSet:
     """``[[obstacles]]``: shapes in the (l, z) plane (none if absent)."""
-    keys = ("shape", "name",
-            *dict.fromkeys(k for cls in SHAPES.values() for k in cls.SCENE_FIELDS))  # fmt: skip
+    keys = ("shape", "name", *dict.fromkeys(k for cls in SHAPES.values() for k in cls.SCENE_FIELDS))
     out, names = [], []
     for i, t in enumerate(f.tables(doc, "obstacles", "", keys)):
         prefix = join("obstacles", i)
@@ -31,8 +30,10 @@ def obstacles(f: Fields, doc: dict[str, Any], pipe_radius: float) -> ObstacleSet
             f.fail(join(prefix, "shape"), f"unknown shape {kind!r} (known: {', '.join(SHAPES)})")
         f.check_keys(t, prefix, ("shape", "name", *cls.SCENE_FIELDS))
         names.append(f.string(t, "name", prefix) if "name" in t else None)
-        values = {key: _value(f, t, prefix, key, what, default)
-                  for key, (what, default) in cls.SCENE_FIELDS.items()}  # fmt: skip
+        values = {
+            key: _value(f, t, prefix, key, what, default)
+            for key, (what, default) in cls.SCENE_FIELDS.items()
+        }
         with f.mapped(prefix):
             out.append(cls.from_scene(values, pipe_radius))
     with f.mapped(""):  # a name's error names its field, obstacles[j].name
@@ -50,5 +51,6 @@ def _value(f: Fields, t: dict[str, Any], prefix: str, key: str, kind: str, defau
     field = join(prefix, key)
     if not isinstance(raw, list) or len(raw) < 3:
         f.fail(field, "expected an array of at least 3 vertices [l, z]")
-    return np.array([f.vector_value(join(field, j), p, 2, within=POSITION)
-                     for j, p in enumerate(raw)])  # fmt: skip
+    return np.array(
+        [f.vector_value(join(field, j), p, 2, within=POSITION) for j, p in enumerate(raw)]
+    )

@@ -19,8 +19,20 @@ ANGLE = Bound(-1000.0, 1000.0, "rad")
 """A joint angle or a finite joint limit (``±inf``: no limit)."""
 JOINT_SPEED = Bound(0.0, 1000.0, "rad/s", strict=True)
 JOINT_WEIGHT = Bound(1e-6, 1e6)
-ROBOT_KEYS = ("model", "link_lengths", "urdf", "points", "tool", "rail", "q0", "q_min", "q_max",
-              "qd_max", "qdd_max", "weights")  # fmt: skip
+ROBOT_KEYS = (
+    "model",
+    "link_lengths",
+    "urdf",
+    "points",
+    "tool",
+    "rail",
+    "q0",
+    "q_min",
+    "q_max",
+    "qd_max",
+    "qdd_max",
+    "weights",
+)
 MODELS = ("ndt13",)
 
 
@@ -89,8 +101,14 @@ def _arm(f: Fields, t: dict[str, Any], base_dir: Path, limits: dict[str, Any]) -
     except (ArithmeticError, ValueError, RuntimeError) as exc:  # Pinocchio on a strange model
         f.fail("robot.urdf", f"{urdf}: cannot use this model ({exc})")
     with f.mapped("robot"):
-        return Robot(loaded.model, points, tool, rail_frame=rail, name=loaded.name,
-                     **{"qd_max": loaded.qd_max, **given})  # fmt: skip
+        return Robot(
+            loaded.model,
+            points,
+            tool,
+            rail_frame=rail,
+            name=loaded.name,
+            **{"qd_max": loaded.qd_max, **given},
+        )
 
 
 def _limits(f: Fields, t: dict[str, Any], n: int) -> dict[str, NDArray[np.float64] | None]:

@@ -40,8 +40,17 @@ else:  # pragma: no cover - Python 3.10
 
 __all__ = ["Environment", "Scene", "environment", "load_scene", "loads"]
 
-TOP_KEYS = ("name", "description", "pipe", "robot", "objective", "obstacles", "constraints",
-            "motion", "solvers")  # fmt: skip
+TOP_KEYS = (
+    "name",
+    "description",
+    "pipe",
+    "robot",
+    "objective",
+    "obstacles",
+    "constraints",
+    "motion",
+    "solvers",
+)
 """The keys a scene file may have at its top level."""
 
 
@@ -156,11 +165,24 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
     return Scene(
         name=one_line(f.string(doc, "name", "", stem)),
         description=one_line(f.string(doc, "description", "", "")),
-        source=source, text=text, pipe_radius=radius, weld=weld, robot=robot, q0=q0,
-        weights=weights, orbital_level=level, obstacles=obstacles,
-        objective=objective, limits=limits, dt=dt, jog=jog, path=path, ramp=ramp,
-        solver_options=options, saddle=saddle,
-    )  # fmt: skip
+        source=source,
+        text=text,
+        pipe_radius=radius,
+        weld=weld,
+        robot=robot,
+        q0=q0,
+        weights=weights,
+        orbital_level=level,
+        obstacles=obstacles,
+        objective=objective,
+        limits=limits,
+        dt=dt,
+        jog=jog,
+        path=path,
+        ramp=ramp,
+        solver_options=options,
+        saddle=saddle,
+    )
 
 
 @dataclass(frozen=True)

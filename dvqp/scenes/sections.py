@@ -104,8 +104,15 @@ def limits(
     height = _configured(f, SurfaceHeight, values)
     probe, tilt = _configured(f, ProbeHeight, values), _configured(f, TiltLimit, values)
     arm = doc.get("robot", {})
-    qdd = f.vector(arm, "qdd_max", "robot", robot.n, scalar=True, default=DEFAULT_QDD_MAX,
-                   within=JOINT_ACCELERATION)  # fmt: skip
+    qdd = f.vector(
+        arm,
+        "qdd_max",
+        "robot",
+        robot.n,
+        scalar=True,
+        default=DEFAULT_QDD_MAX,
+        within=JOINT_ACCELERATION,
+    )
     joints = (JointPositionLimit(robot), JointVelocityLimit(robot), AccelerationLimit(robot, qdd))
     return (*joints, damper, height, probe, tilt, _configured(f, SelfCollision, values))
 
@@ -173,13 +180,16 @@ def _following(f: Fields, t: dict[str, Any], prefix: str) -> tuple[float, dict[s
     and ``timing``."""
     speed = f.number(t, "speed", prefix, within=Bound(0.0, SPEED.high, "m/s", True))
     optional = {"gain": GAIN, "tolerance": TOLERANCE, "heading_tolerance": HEADING_TOLERANCE}
-    given: dict[str, Any] = {k: f.number(t, k, prefix, within=b) for k, b in optional.items()
-                             if k in t}  # fmt: skip
+    given: dict[str, Any] = {
+        k: f.number(t, k, prefix, within=b) for k, b in optional.items() if k in t
+    }
     if "timing" in t:
         given["timing"] = f.string(t, "timing", prefix)
         if given["timing"] not in TIMINGS:
-            f.fail(join(prefix, "timing"), f"must be one of {', '.join(TIMINGS)}, got "
-                   f"{given['timing']!r}")  # fmt: skip
+            f.fail(
+                join(prefix, "timing"),
+                f"must be one of {', '.join(TIMINGS)}, got {given['timing']!r}",
+            )
     return speed, given
 
 
@@ -193,8 +203,7 @@ def _saddle(
     inlets = {label: shape for label, shape in pairs if isinstance(shape, Inlet)}
     if name not in inlets:
         known = ", ".join(repr(k) for k in inlets if not k.startswith("obstacles[")) or "none"
-        f.fail(join(prefix, "branch"), f"no inlet obstacle named {name!r} (named inlets: "
-               f"{known})")  # fmt: skip
+        f.fail(join(prefix, "branch"), f"no inlet obstacle named {name!r} (named inlets: {known})")
     branch = inlets[name]
     offset = f.number(t, "offset", prefix, within=Bound(0.0, SIZE.high, "m"))
     arc = f.vector(t, "arc", prefix, 2, default=[-0.5 * np.pi, 1.5 * np.pi], within=HEADING)
@@ -202,6 +211,13 @@ def _saddle(
     height = f.number(t, "h", prefix, within=HEIGHT)
     speed, given = _following(f, t, prefix)
     with f.mapped(prefix):
-        weld = SaddleWeld(branch.center, branch.radius, branch.pipe_radius, offset,
-                          (float(arc[0]), float(arc[1])), heading, height)  # fmt: skip
+        weld = SaddleWeld(
+            branch.center,
+            branch.radius,
+            branch.pipe_radius,
+            offset,
+            (float(arc[0]), float(arc[1])),
+            heading,
+            height,
+        )
         return weld, weld.path(speed, **given)

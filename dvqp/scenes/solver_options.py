@@ -32,8 +32,10 @@ def solver_options(f: Fields, doc: dict[str, Any]) -> Options:
             f.fail(field, "the pseudoinverse has no settings")
         for key, value in settings.items():
             if not setting_value(value):
-                f.fail(join(field, key), f"expected a finite number, a boolean or a string, "
-                       f"got {kind(value)}")  # fmt: skip
+                f.fail(
+                    join(field, key),
+                    f"expected a finite number, a boolean or a string, got {kind(value)}",
+                )
         if name in installed:
             try:
                 check_options(name, settings)

@@ -46,8 +46,15 @@ class Advance(NamedTuple):
     excess: Excess = NO_EXCESS
 
 
-def advance(stepper: Stepper, command: NDArray[np.float64], dt: float, *, verify: bool = True,
-            max_halvings: int = MAX_HALVINGS, record: int = -1) -> Advance:  # fmt: skip
+def advance(
+    stepper: Stepper,
+    command: NDArray[np.float64],
+    dt: float,
+    *,
+    verify: bool = True,
+    max_halvings: int = MAX_HALVINGS,
+    record: int = -1,
+) -> Advance:
     """Resolve and integrate one step of ``dt`` seconds from the stepper's loaded state.
 
     Parameters
@@ -85,19 +92,42 @@ def advance(stepper: Stepper, command: NDArray[np.float64], dt: float, *, verify
     return moved
 
 
-def _attempt(stepper: Stepper, q: NDArray[np.float64], command: NDArray[np.float64], dt: float,
-             depth: int, verify: bool, halvings: int) -> Advance:  # fmt: skip
+def _attempt(
+    stepper: Stepper,
+    q: NDArray[np.float64],
+    command: NDArray[np.float64],
+    dt: float,
+    depth: int,
+    verify: bool,
+    halvings: int,
+) -> Advance:
     """A step of ``dt`` from ``q`` (loaded), halved while it breaks a limit."""
     found = stepper.resolve(command, dt)
     if not found.success:
         stepper.observe(np.zeros_like(q), dt)
-        failed = Step(np.zeros_like(q), False, found.status, math.inf, found.solve_time,
-                      found.iterations, found.solver_time, 0.0)  # fmt: skip
+        failed = Step(
+            np.zeros_like(q),
+            False,
+            found.status,
+            math.inf,
+            found.solve_time,
+            found.iterations,
+            found.solver_time,
+            0.0,
+        )
         return Advance(failed, 1)
     reached = stepper.move()
     motion = stepper.motion
-    step = Step(stepper.x.copy(), True, found.status, float(motion[0]), found.solve_time,
-                found.iterations, found.solver_time, found.rate)  # fmt: skip
+    step = Step(
+        stepper.x.copy(),
+        True,
+        found.status,
+        float(motion[0]),
+        found.solve_time,
+        found.iterations,
+        found.solver_time,
+        found.rate,
+    )
     broken = NO_EXCESS if reached else SINGULAR
     if reached and verify and stepper.broken:
         broken = stepper.excess()
@@ -151,19 +181,35 @@ def straight_excess(stepper: Stepper, q: NDArray[np.float64], end: NDArray[np.fl
 
 def _failed(step: Step, broken: Excess, substeps: int, where: str = "") -> Advance:
     status = f"failed: {where}{broken.describe()} in {substeps} substeps"
-    failed = Step(np.zeros_like(step.qdot), False, status, math.inf, step.solve_time,
-                  step.iterations, step.solver_time, 0.0)  # fmt: skip
+    failed = Step(
+        np.zeros_like(step.qdot),
+        False,
+        status,
+        math.inf,
+        step.solve_time,
+        step.iterations,
+        step.solver_time,
+        0.0,
+    )
     return Advance(failed, substeps, broken)
 
 
-def _joined(q: NDArray[np.float64], end: NDArray[np.float64], first: Advance, second: Advance,
-            dt: float) -> Advance:  # fmt: skip
+def _joined(
+    q: NDArray[np.float64], end: NDArray[np.float64], first: Advance, second: Advance, dt: float
+) -> Advance:
     a, b = first.step, second.step
     both = {a.status, b.status}
     status = "relaxed" if both - set(STATUS_RANK) else max(both, key=STATUS_RANK.index)
     counted = a.iterations is not None and b.iterations is not None
     iterations = a.iterations + b.iterations if counted else None  # type: ignore[operator]
-    step = Step((end - q) / dt, True, status, max(a.task_error, b.task_error),
-                a.solve_time + b.solve_time, iterations, a.solver_time + b.solver_time,
-                0.5 * (a.rate + b.rate))  # fmt: skip
+    step = Step(
+        (end - q) / dt,
+        True,
+        status,
+        max(a.task_error, b.task_error),
+        a.solve_time + b.solve_time,
+        iterations,
+        a.solver_time + b.solver_time,
+        0.5 * (a.rate + b.rate),
+    )
     return Advance(step, first.substeps + second.substeps)

@@ -116,9 +116,17 @@ class RecordArrays:
     def none(cls, n: int, k: int) -> RecordArrays:
         """Nothing recorded."""
         z = np.zeros(0)
-        return cls(np.full(1, -1, np.int64), np.zeros((0, n)), np.zeros((0, 4)),
-                   np.zeros((0, k, 3)), z, z.copy(), np.zeros(0, np.bool_),
-                   *(z.copy() for _ in range(6)), np.zeros((0, 3)))  # fmt: skip
+        return cls(
+            np.full(1, -1, np.int64),
+            np.zeros((0, n)),
+            np.zeros((0, 4)),
+            np.zeros((0, k, 3)),
+            z,
+            z.copy(),
+            np.zeros(0, np.bool_),
+            *(z.copy() for _ in range(6)),
+            np.zeros((0, 3)),
+        )
 
 
 @dataclass(frozen=True)

@@ -84,8 +84,9 @@ class _Union:
         return np.array([self.rows[id(s)] for s in shapes], dtype=np.int64)
 
 
-def build(robot: Robot, radius: float, spec: StepSpec, recorded: ObstacleSet, q0: np.ndarray,
-          dt: float) -> tuple[Layout, np.ndarray]:  # fmt: skip
+def build(
+    robot: Robot, radius: float, spec: StepSpec, recorded: ObstacleSet, q0: np.ndarray, dt: float
+) -> tuple[Layout, np.ndarray]:
     """The layout of ``spec``'s step on ``robot`` in a pipe of ``radius`` (m), and the rows of
     the ``recorded`` obstacles in its union; parts of your own are sized at ``q0`` (rad) with
     the step ``dt`` (s)."""
@@ -110,10 +111,12 @@ def build(robot: Robot, radius: float, spec: StepSpec, recorded: ObstacleSet, q0
         if type(limit) not in BOUNDS and not isinstance(limit, VelocityDamper):
             hooks.limit(limit)
     measures = MeasureArrays(**{key: np.array(rows, dtype=np.int64) for key, rows in table.items()})
-    measures = replace(measures, heights=measures.heights.reshape(-1, 3),
-                       chords=measures.chords.reshape(-1, 2))  # fmt: skip
-    layout = Layout(plan, tuple(union.shapes), objective, _bounds(limits, n), measures, params,
-                    hooks)  # fmt: skip
+    measures = replace(
+        measures, heights=measures.heights.reshape(-1, 3), chords=measures.chords.reshape(-1, 2)
+    )
+    layout = Layout(
+        plan, tuple(union.shapes), objective, _bounds(limits, n), measures, params, hooks
+    )
     _verified(layout, limits, blocks, n)
     return layout, union.members(recorded)
 
@@ -137,9 +140,16 @@ def _objective(spec: StepSpec, union: _Union, n: int, k: int, hooks: Hooks) -> O
                 link_coef[rows] += coef[:, :-1]
         else:
             hooks.term(term)
-    return ObjectiveArrays(np.array(levels, dtype=float), np.array(gains).reshape(-1, k),
-                           point_coef, link_coef, np.zeros((k, 2)), hooks.plan.objective_value,
-                           hooks.plan.objective_gradient, float(spec.objective.gain))  # fmt: skip
+    return ObjectiveArrays(
+        np.array(levels, dtype=float),
+        np.array(gains).reshape(-1, k),
+        point_coef,
+        link_coef,
+        np.zeros((k, 2)),
+        hooks.plan.objective_value,
+        hooks.plan.objective_gradient,
+        float(spec.objective.gain),
+    )
 
 
 def _bounds(limits: Sequence[object], n: int) -> BoundArrays:
@@ -154,21 +164,32 @@ def _bounds(limits: Sequence[object], n: int) -> BoundArrays:
         elif type(limit) is AccelerationLimit:
             accel = limit
     if accel is None:
-        return BoundArrays(q_min, q_max, qd_max, False, np.zeros(n), np.zeros(n), np.zeros(n),
-                           np.zeros(n))  # fmt: skip
-    return BoundArrays(q_min, q_max, qd_max, True, np.array(accel.qdd_max),
-                       np.array(accel.q_min), np.array(accel.q_max), accel.previous)  # fmt: skip
+        return BoundArrays(
+            q_min, q_max, qd_max, False, np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+        )
+    return BoundArrays(
+        q_min,
+        q_max,
+        qd_max,
+        True,
+        np.array(accel.qdd_max),
+        np.array(accel.q_min),
+        np.array(accel.q_max),
+        accel.previous,
+    )
 
 
-def _dampers(limits: Sequence[object], union: _Union, plan: StepPlan, hooks: Hooks,
-             table: dict[str, list]) -> tuple[DamperArrays, list[tuple]]:  # fmt: skip
+def _dampers(
+    limits: Sequence[object], union: _Union, plan: StepPlan, hooks: Hooks, table: dict[str, list]
+) -> tuple[DamperArrays, list[tuple]]:
     """Every damper's rows: dvqp's measured by the pipeline (into ``table``, the fields of
     :class:`~dvqp.step.arrays.MeasureArrays`), a user's by a hook."""
     params: list[tuple[float, ...]] = []
     blocks: list[tuple] = []
     for limit in limits:
-        if not isinstance(limit, VelocityDamper) or (type(limit) is TiltLimit
-                                                     and limit.min_tilt == 0.0):  # fmt: skip
+        if not isinstance(limit, VelocityDamper) or (
+            type(limit) is TiltLimit and limit.min_tilt == 0.0
+        ):
             continue
         if type(limit) in DAMPERS:
             start, count = _measured(limit, union, plan, table)
@@ -177,8 +198,13 @@ def _dampers(limits: Sequence[object], union: _Union, plan: StepPlan, hooks: Hoo
             start, count, safe, labels = hooks.damper(limit)
         if count == 0:
             continue
-        row = (limit.gain, limit.tolerance, limit.deceleration, float(limit.reach),
-               float(type(limit) is TiltLimit))  # fmt: skip
+        row = (
+            limit.gain,
+            limit.tolerance,
+            limit.deceleration,
+            float(limit.reach),
+            float(type(limit) is TiltLimit),
+        )
         params += [(float(s), *row) for s in np.broadcast_to(np.asarray(safe, float), (count,))]
         blocks.append((limit, start, count, labels))
     columns = np.array(params, dtype=float).reshape(-1, 6).T.copy()
@@ -186,13 +212,16 @@ def _dampers(limits: Sequence[object], union: _Union, plan: StepPlan, hooks: Hoo
     return arrays, blocks
 
 
-def _measured(limit: object, union: _Union, plan: StepPlan,
-              table: dict[str, list]) -> tuple[int, int]:  # fmt: skip
+def _measured(
+    limit: object, union: _Union, plan: StepPlan, table: dict[str, list]
+) -> tuple[int, int]:
     """Rows of one of dvqp's dampers: ``(first row, count)``, its instance recorded."""
     k, kind, members = plan.k, type(limit), []
     # heights: (points, link chords): the body points, links and carriage; the probe, holder
-    points, chords = {SurfaceHeight: (k, [*range(k - 1), *([k] if plan.rail else [])]),
-                      ProbeHeight: (1, [k - 1])}.get(kind, (0, []))  # fmt: skip
+    points, chords = {
+        SurfaceHeight: (k, [*range(k - 1), *([k] if plan.rail else [])]),
+        ProbeHeight: (1, [k - 1]),
+    }.get(kind, (0, []))
     if kind is ObstacleDamper:
         members = union.members(limit.obstacles).tolist()
         count = len(members) * (2 * k + 1 + 2 * plan.rail)
@@ -233,9 +262,15 @@ def _verified(layout: Layout, limits: Sequence[object], dampers: list[tuple], n:
         layout.blocks.append(Block(limit, first, first + count, named[:count]))
 
 
-def lay_out(robot: Robot, radius: float, resolver: Resolver, q0: ArrayLike, dt: float,
-            obstacles: ObstacleSet | None, samples: Mapping[str, np.ndarray] | None,
-            ) -> tuple[Layout, Pipeline]:  # fmt: skip
+def lay_out(
+    robot: Robot,
+    radius: float,
+    resolver: Resolver,
+    q0: ArrayLike,
+    dt: float,
+    obstacles: ObstacleSet | None,
+    samples: Mapping[str, np.ndarray] | None,
+) -> tuple[Layout, Pipeline]:
     """The layout of ``resolver``'s step and every array of its pipeline (see
     :class:`~dvqp.step.engine.Stepper` for the parameters)."""
     spec, n, k = resolver.spec, robot.n, robot.n_points
@@ -264,13 +299,34 @@ def lay_out(robot: Robot, radius: float, resolver: Resolver, q0: ArrayLike, dt: 
         shapes.far[boxed] = far[boxed]
     layout.hooks.finalize(layout.shapes, shapes.code, layout.params, layout.damper_values)
     fields = [f for f in RecordArrays.__dataclass_fields__ if f != "index"]
-    record = (RecordArrays.none(n, k) if samples is None else
-              RecordArrays(np.full(1, -1, np.int64), *(samples[f] for f in fields)))  # fmt: skip
+    record = (
+        RecordArrays.none(n, k)
+        if samples is None
+        else RecordArrays(np.full(1, -1, np.int64), *(samples[f] for f in fields))
+    )
     x = np.zeros(n)  # the step: the baseline's is written there directly
     return layout, Pipeline(
-        float(radius), plan.dt, plan.command, x, np.zeros(2), robot.model_arrays(),
-        plan.state, shapes, plan.proximity, plan.pairs, layout.objective, layout.bounds,
-        layout.measures, layout.params, plan.dampers, plan.qp,
+        float(radius),
+        plan.dt,
+        plan.command,
+        x,
+        np.zeros(2),
+        robot.model_arrays(),
+        plan.state,
+        shapes,
+        plan.proximity,
+        plan.pairs,
+        layout.objective,
+        layout.bounds,
+        layout.measures,
+        layout.params,
+        plan.dampers,
+        plan.qp,
         PinvArrays(baseline, weights, layout.hooks.soft, damping, np.zeros(2), x),
-        plan.checks, layout.joint_values, layout.damper_values, rows, np.zeros(7), record,
-    )  # fmt: skip
+        plan.checks,
+        layout.joint_values,
+        layout.damper_values,
+        rows,
+        np.zeros(7),
+        record,
+    )

@@ -82,9 +82,16 @@ class Stepper(Verification):
         The joint velocity of the last resolved step, rad/s.
     """
 
-    def __init__(self, robot: Robot, radius: float, resolver: Resolver, q0: ArrayLike,
-                 dt: float, obstacles: ObstacleSet | None = None,
-                 samples: Mapping[str, np.ndarray] | None = None) -> None:  # fmt: skip
+    def __init__(
+        self,
+        robot: Robot,
+        radius: float,
+        resolver: Resolver,
+        q0: ArrayLike,
+        dt: float,
+        obstacles: ObstacleSet | None = None,
+        samples: Mapping[str, np.ndarray] | None = None,
+    ) -> None:
         spec = resolver.spec
         self.robot, self.resolver = robot, resolver
         self.obstacles = ObstacleSet() if obstacles is None else obstacles
@@ -93,8 +100,11 @@ class Stepper(Verification):
         plan = self.layout.plan
         self.struct = as_struct(self.arrays)
         assert plan.qp is not None and plan.checks is not None
-        self.solver = (QPSolver(dropping(resolver.factory), plan.qp, spec.task_weight)
-                       if isinstance(resolver, QPResolver) else None)  # fmt: skip
+        self.solver = (
+            QPSolver(dropping(resolver.factory), plan.qp, spec.task_weight)
+            if isinstance(resolver, QPResolver)
+            else None
+        )
         self.hooks = self.layout.hooks
         self._prepare = stages.prepare_baseline if self.arrays.pinv.baseline else stages.prepare
         self.state = KinematicState.view(plan.state, radius, plan.k)
@@ -106,8 +116,11 @@ class Stepper(Verification):
         self.motion = self.arrays.motion
         """(2,): ``[‖A x − b‖∞, max |dt x|]`` of the last :meth:`move`."""
         self.limits: tuple[Limit, ...] = spec.limits
-        self._observers = [lim for lim in spec.limits if type(lim).observe is not Limit.observe
-                           and resolver.holds_limits]  # fmt: skip
+        self._observers = [
+            lim
+            for lim in spec.limits
+            if type(lim).observe is not Limit.observe and resolver.holds_limits
+        ]
         self.stopping = False
         """Braking steps: the hard tasks' right sides and the cost's linear part are 0 (the
         tool and every task held still, λ = 0), a damper holds a drift below its safe value
@@ -190,15 +203,22 @@ class Stepper(Verification):
             return Resolution(True, "optimal", None, prepared - started, prepared - started)
         if status != -1:
             lb, ub = a.qp.lb[status], a.qp.ub[status]
-            why = (f"failed: the bounds on joint{status + 1}'s velocity cross "
-                   f"({lb:.4g} > {ub:.4g} rad/s)")  # fmt: skip
+            why = (
+                f"failed: the bounds on joint{status + 1}'s velocity cross "
+                f"({lb:.4g} > {ub:.4g} rad/s)"
+            )
             return Resolution(False, why, None, 0.0, time.perf_counter() - started)
         answer = self.solver.solve(rest=self.stopping)
         if answer.x is not None:
             self.x[:] = answer.x
-        return Resolution(answer.x is not None, answer.status, answer.iterations,
-                          answer.solver_time, time.perf_counter() - started,
-                          answer.rate)  # fmt: skip
+        return Resolution(
+            answer.x is not None,
+            answer.status,
+            answer.iterations,
+            answer.solver_time,
+            time.perf_counter() - started,
+            answer.rate,
+        )
 
     def pace(self, feedforward: Array | None) -> None:
         """Let the next steps slow along ``feedforward``, the tool's nominal DV velocity in
@@ -267,8 +287,9 @@ class Stepper(Verification):
             named = self.hooks.describes.get(id(limit))
             labels = named() if named is not None else tuple(f"row{i}" for i in range(h.size))
         elif block is not None:
-            rows = slice(block.start - self.layout.damper_values,
-                         block.stop - self.layout.damper_values)  # fmt: skip
+            rows = slice(
+                block.start - self.layout.damper_values, block.stop - self.layout.damper_values
+            )
             G, h, labels = qp.G[rows], qp.h[rows], block.labels
         elif isinstance(limit, VelocityDamper):  # it has no row (e.g. no obstacle)
             return Constraint(np.zeros((0, qp.G.shape[1])), np.zeros(0))

@@ -104,8 +104,9 @@ class Hooks:
         self.constraints[id(limit)] = G, h
         return self._later(self.prepared, lambda: self._rows(limit, G, h))
 
-    def finalize(self, shapes: Sequence[Shape], code: np.ndarray, params: DamperArrays,
-                 damper_values: int) -> None:  # fmt: skip
+    def finalize(
+        self, shapes: Sequence[Shape], code: np.ndarray, params: DamperArrays, damper_values: int
+    ) -> None:
         """Make every hook (the plan is finalised) and the one of shapes of your own."""
         self._params, self._damper_values = params, damper_values
         for stage, make in self._pending:
@@ -113,8 +114,9 @@ class Hooks:
         self._pending.clear()
         if np.any(code == 3):  # OTHER: shapes of your own
             plan = self.plan
-            self.measured.append(lambda: user_rows(shapes, code, plan.state.guarded,
-                                                   plan.period, plan.proximity))  # fmt: skip
+            self.measured.append(
+                lambda: user_rows(shapes, code, plan.state.guarded, plan.period, plan.proximity)
+            )
 
     # -- the hooks ------------------------------------------------------------------------
 
@@ -198,8 +200,11 @@ class Hooks:
 def _fits(name: str, got: int, room: int, *, exact: bool) -> None:
     """A part of your own returned ``got`` rows where ``room`` were reserved at the start."""
     if got > room or (exact and got != room):
-        raise ParameterError(name, f"returned {got} rows at this state but {room} at the start "
-                             "of the run: the number of rows must not change")  # fmt: skip
+        raise ParameterError(
+            name,
+            f"returned {got} rows at this state but {room} at the start "
+            "of the run: the number of rows must not change",
+        )
 
 
 def _padded(describe: Callable[[], tuple[str, ...]], count: int) -> Callable[[], tuple[str, ...]]:

@@ -88,12 +88,30 @@ def _objective(s) -> None:  # type: ignore[no-untyped-def]
     for c in range(o.gradient.shape[0]):
         o.gradient[c] = 0.0
     for t in range(o.levels.shape[0]):
-        orbital_level(st.guarded, st.guarded_jacobians, o.levels[t], o.k_height[t], o.value,
-                      o.gradient)  # fmt: skip
-    obstacle_points(near.point_penalty, near.point_penalty_gradient, near.skipped, o.point_coef,
-                    st.guarded_jacobians, o.scratch, o.value, o.gradient)  # fmt: skip
-    obstacle_links(near.link_penalty, near.link_penalty_gradient, near.skipped, near.link_t,
-                   o.link_coef, st.guarded_jacobians, o.scratch, o.value, o.gradient)  # fmt: skip
+        orbital_level(
+            st.guarded, st.guarded_jacobians, o.levels[t], o.k_height[t], o.value, o.gradient
+        )
+    obstacle_points(
+        near.point_penalty,
+        near.point_penalty_gradient,
+        near.skipped,
+        o.point_coef,
+        st.guarded_jacobians,
+        o.scratch,
+        o.value,
+        o.gradient,
+    )
+    obstacle_links(
+        near.link_penalty,
+        near.link_penalty_gradient,
+        near.skipped,
+        near.link_t,
+        o.link_coef,
+        st.guarded_jacobians,
+        o.scratch,
+        o.value,
+        o.gradient,
+    )
 
 
 @njit(inline="always")
@@ -103,13 +121,21 @@ def _distances(s) -> None:  # type: ignore[no-untyped-def]
     out = (d.distance, d.gradient, d.usable)
     for o in range(m.obstacle_start.shape[0]):
         members = m.obstacle_members[m.obstacle_offsets[o] : m.obstacle_offsets[o + 1]]
-        obstacle_distances(s.near, st.guarded_jacobians, st.origins, st.frame_jacobians, s.radius,
-                           s.params.reach, members, m.obstacle_start[o], *out)  # fmt: skip
+        obstacle_distances(
+            s.near,
+            st.guarded_jacobians,
+            st.origins,
+            st.frame_jacobians,
+            s.radius,
+            s.params.reach,
+            members,
+            m.obstacle_start[o],
+            *out,
+        )
     for i in range(m.heights.shape[0]):
         start, first, count = m.heights[i, 0], m.heights[i, 1], m.heights[i, 2]
         height_distances(st.guarded, st.guarded_jacobians, first, count, start, *out)
-    chord_heights(st.guarded, st.origins, st.frame_jacobians, s.near.ends, s.radius, m.chords,
-                  *out)  # fmt: skip
+    chord_heights(st.guarded, st.origins, st.frame_jacobians, s.near.ends, s.radius, m.chords, *out)
     for i in range(m.tilts.shape[0]):
         tilt_distance(st.origins, st.axes, st.frame_jacobians, s.model.tool, m.tilts[i], *out)
     for i in range(m.selves.shape[0]):
@@ -197,8 +223,9 @@ def prepare(s, first, last) -> int:  # type: ignore[no-untyped-def]
         position_bounds(q, b.q_min, b.q_max, dt, qp.lb, qp.ub)
         velocity_bounds(b.qd_max, qp.lb, qp.ub)
         if b.accelerate:
-            acceleration_bounds(q, b.accel_q_min, b.accel_q_max, b.qdd_max, b.previous, dt,
-                                qp.lb, qp.ub)  # fmt: skip
+            acceleration_bounds(
+                q, b.accel_q_min, b.accel_q_max, b.qdd_max, b.previous, dt, qp.lb, qp.ub
+            )
         damper_rows(s.params, s.dampers, dt, qp.G, qp.h)
     if first <= CLOSE <= last:
         for i in range(qp.lb.shape[0]):
@@ -216,8 +243,7 @@ def prepare_baseline(s, first, last) -> int:  # type: ignore[no-untyped-def]
     if first <= ROWS <= last and not _rows(s):
         return BAD_COMMAND
     if first <= CLOSE <= last:
-        status = pinv_step(qp.A, qp.b, qp.cost, p.weights, qp.P, p.dense, p.damping, p.info,
-                           p.x)  # fmt: skip
+        status = pinv_step(qp.A, qp.b, qp.cost, p.weights, qp.P, p.dense, p.damping, p.info, p.x)
         if status != -1:
             return INDEFINITE_METRIC if status == NOT_DEFINITE else SINGULAR_TASK
     return -1

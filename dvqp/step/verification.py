@@ -40,10 +40,24 @@ class Verification:
             n, at = self.robot.n, i - self._block(i).start
             q = float(self.arrays.state.q[at % n])
             bound = q - over[i] if at < n else q + over[i]
-            return Excess(float(over[i]), float(c.tolerance[i]), label, "joint position", "rad",
-                          q, float(bound))  # fmt: skip
-        return Excess(float(over[i]), float(c.tolerance[i]), label, limit.quantity, limit.unit,  # type: ignore[attr-defined]
-                      float(c.values[i]), float(c.floor[i]))  # fmt: skip
+            return Excess(
+                float(over[i]),
+                float(c.tolerance[i]),
+                label,
+                "joint position",
+                "rad",
+                q,
+                float(bound),
+            )
+        return Excess(
+            float(over[i]),
+            float(c.tolerance[i]),
+            label,
+            limit.quantity,
+            limit.unit,  # type: ignore[attr-defined]
+            float(c.values[i]),
+            float(c.floor[i]),
+        )
 
     def start_broken(self) -> tuple[StartBroken, ...]:
         """The verified values the run's start put below their safe value that a recorded
@@ -55,8 +69,9 @@ class Verification:
     def _start_broken(self, i: int) -> StartBroken:
         c, (limit, label) = self.arrays.checks, self._named(i)
         keys = [k for k in getattr(limit, "SCENE_KEYS", {}) if not k.startswith("damper_")]
-        kind = (("joint room", "rad") if limit is JointPositionLimit
-                else (limit.quantity, limit.unit))  # type: ignore[attr-defined]  # fmt: skip
+        kind = (
+            ("joint room", "rad") if limit is JointPositionLimit else (limit.quantity, limit.unit)
+        )  # type: ignore[attr-defined]
         values = (float(a[i]) for a in (c.safe, c.floor, c.lowest, c.tolerance))
         return StartBroken(keys[0] if keys else limit.name, label, *kind, *values)  # type: ignore[attr-defined]
 

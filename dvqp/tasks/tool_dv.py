@@ -24,8 +24,13 @@ class ToolTask(Task):
 
 
 @njit
-def tool_rows(tool_jacobian: NDArray[np.float64], command: NDArray[np.float64],
-              A: NDArray[np.float64], b: NDArray[np.float64], start: int) -> None:  # fmt: skip
+def tool_rows(
+    tool_jacobian: NDArray[np.float64],
+    command: NDArray[np.float64],
+    A: NDArray[np.float64],
+    b: NDArray[np.float64],
+    start: int,
+) -> None:
     """Rows ``start .. start + 3`` of ``A``, ``b``: ``J̄`` (4, n) and the command (4,)."""
     for i in range(4):
         b[start + i] = command[i]

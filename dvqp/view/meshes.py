@@ -67,9 +67,13 @@ def pipe_mesh(radius: float, z_low: float, z_high: float, color: tuple[int, int,
 
 
 def ring_mesh(
-    name: str, z_min: float, z_max: float, radius: float, height: float,
+    name: str,
+    z_min: float,
+    z_max: float,
+    radius: float,
+    height: float,
     color: tuple[int, int, int],
-) -> Mesh:  # fmt: skip
+) -> Mesh:
     """A band as the ring it stands for: round the pipe from ``z_min`` to ``z_max`` (m),
     ``height`` (m) thick over the surface (its outer face and its two sides)."""
     l = np.linspace(0.0, 2.0 * math.pi * radius, ROUND, endpoint=False)
@@ -97,9 +101,13 @@ def patch_mesh(
 
 
 def tube_mesh(
-    name: str, center: ArrayLike, tube_radius: float, radius: float, length: float,
+    name: str,
+    center: ArrayLike,
+    tube_radius: float,
+    radius: float,
+    length: float,
     color: tuple[int, int, int],
-) -> Mesh:  # fmt: skip
+) -> Mesh:
     """A branch inlet as its tube: radius ``tube_radius`` (m) along the pipe's normal at
     ``center`` ``[l0, z0]`` (m), from where it meets the pipe (the inlet's outline, at the
     pipe's ``radius``) to ``length`` (m) above the surface."""

@@ -25,9 +25,14 @@ Array = NDArray[np.float64]
 Color = tuple[int, int, int]
 
 COLORS: dict[str, Color] = {
-    "pipe": (70, 120, 200), "obstacle": (40, 160, 70), "arm": (245, 140, 20),
-    "margin": (215, 25, 25), "rail": (80, 80, 80), "weld": (255, 255, 255), "path": (160, 40, 200),
-}  # fmt: skip
+    "pipe": (70, 120, 200),
+    "obstacle": (40, 160, 70),
+    "arm": (245, 140, 20),
+    "margin": (215, 25, 25),
+    "rail": (80, 80, 80),
+    "weld": (255, 255, 255),
+    "path": (160, 40, 200),
+}
 """The view's colours (r, g, b): the pipe blue, the obstacles green, the arm orange and a link
 at its margin red, the rail grey, the weld white, the probe's path purple."""
 PATCH_HEIGHT = 0.01
@@ -111,8 +116,9 @@ def scene_3d(scene: Scene, q: Array, t: Array, title: str) -> Scene3D:
     shapes = [obstacle_mesh(f"obstacle{j + 1}", s, radius) for j, s in enumerate(obstacles)]
     meshes = (pipe_mesh(radius, z_low, z_high, COLORS["pipe"]), *shapes)
     lines = _lines(scene, chain)
-    return Scene3D(title, radius, meshes, lines, np.asarray(t, dtype=np.float64), chain,
-                   at_margin, margin)  # fmt: skip
+    return Scene3D(
+        title, radius, meshes, lines, np.asarray(t, dtype=np.float64), chain, at_margin, margin
+    )
 
 
 def obstacle_mesh(name: str, shape: object, radius: float) -> Mesh:
@@ -133,15 +139,20 @@ def _lines(scene: Scene, chain: Array) -> tuple[Polyline, ...]:
     l_round = np.linspace(0.0, 2.0 * np.pi * radius, ROUND + 1)
     if scene.robot.has_rail:
         x, y, z = chain[0, 0]
-        lines.append(Polyline("rail", surface_points(l_round, z, np.hypot(x, y) - radius, radius),
-                              COLORS["rail"]))  # fmt: skip
+        lines.append(
+            Polyline(
+                "rail", surface_points(l_round, z, np.hypot(x, y) - radius, radius), COLORS["rail"]
+            )
+        )
     if scene.weld is not None:
-        lines.append(Polyline("weld", surface_points(l_round, scene.weld, 1e-3, radius),
-                              COLORS["weld"]))  # fmt: skip
+        lines.append(
+            Polyline("weld", surface_points(l_round, scene.weld, 1e-3, radius), COLORS["weld"])
+        )
     if len(chain) > 1:  # the probe's path over the run
         lines.append(Polyline("path", chain[:, -1].copy(), COLORS["path"]))
     elif scene.path is not None:  # the start pose: the path the probe is to follow
         w = scene.path.waypoints
-        lines.append(Polyline("path", surface_points(w[:, 0], w[:, 1], w[:, 2], radius),
-                              COLORS["path"]))  # fmt: skip
+        lines.append(
+            Polyline("path", surface_points(w[:, 0], w[:, 1], w[:, 2], radius), COLORS["path"])
+        )
     return tuple(lines)

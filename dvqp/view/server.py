@@ -84,8 +84,9 @@ class View:
         self._draw_scene()
         n = len(view.t) - 1
         gui = self.server.gui
-        self.sample = gui.add_slider("sample", min=0, max=max(n, 1), step=1, initial_value=n,
-                                     disabled=n == 0)  # fmt: skip
+        self.sample = gui.add_slider(
+            "sample", min=0, max=max(n, 1), step=1, initial_value=n, disabled=n == 0
+        )
         self.time = gui.add_text("t (s)", initial_value=f"{view.t[n]:.3f}", disabled=True)
         self.play = gui.add_checkbox("play", initial_value=False, disabled=n == 0)
         self.sample.on_update(lambda _: self.show(int(self.sample.value)))
@@ -100,8 +101,9 @@ class View:
         scene.set_up_direction("+z")
         for m in view.meshes:
             faces = m.faces.astype(np.uint32)
-            scene.add_mesh_simple(f"/{m.name}", m.vertices.astype(np.float32), faces,
-                                  color=m.color, side="double")  # fmt: skip
+            scene.add_mesh_simple(
+                f"/{m.name}", m.vertices.astype(np.float32), faces, color=m.color, side="double"
+            )
         for line in view.lines:
             scene.add_line_segments(
                 f"/{line.name}",
@@ -115,20 +117,26 @@ class View:
         out = 2.5 * view.pipe_radius + float(np.ptp(chain[:, 2]))
         camera = self.server.initial_camera
         camera.look_at = (0.0, 0.0, float(centre[2]))
-        camera.position = (out * math.cos(facing), out * math.sin(facing),
-                           float(centre[2]) + 0.3 * out)  # fmt: skip
+        camera.position = (
+            out * math.cos(facing),
+            out * math.sin(facing),
+            float(centre[2]) + 0.3 * out,
+        )
         camera.up = (0.0, 0.0, 1.0)
-        self.arm = scene.add_line_segments("/arm", _segments(view.chain[-1]),
-                                           colors=_linear(COLORS["arm"]),
-                                           thickness=LINK_THICKNESS)  # fmt: skip
-        self.probe = scene.add_icosphere("/probe", radius=0.6 * LINK_THICKNESS,
-                                         color=COLORS["arm"])  # fmt: skip
+        self.arm = scene.add_line_segments(
+            "/arm",
+            _segments(view.chain[-1]),
+            colors=_linear(COLORS["arm"]),
+            thickness=LINK_THICKNESS,
+        )
+        self.probe = scene.add_icosphere("/probe", radius=0.6 * LINK_THICKNESS, color=COLORS["arm"])
 
     def show(self, n: int) -> None:
         """Put the arm at sample ``n``: its links, red where at their margin, and the probe."""
         view = self.view
-        colors = np.where(view.at_margin[n][:, None], _linear(COLORS["margin"]),
-                          _linear(COLORS["arm"]))  # fmt: skip
+        colors = np.where(
+            view.at_margin[n][:, None], _linear(COLORS["margin"]), _linear(COLORS["arm"])
+        )
         self.arm.points = _segments(view.chain[n])
         self.arm.colors = np.repeat(colors[:, None, :], 2, axis=1).astype(np.uint8)
         self.probe.position = tuple(view.chain[n, -1])

@@ -6,6 +6,15 @@ from dvqp.workspace.plan import CheckBuffers, DamperBuffers, Kernel, QPBuffers, 
 from dvqp.workspace.struct import as_struct
 
 __all__ = [
-    "CheckBuffers", "DamperBuffers", "Kernel", "PairBuffers", "ProximityBuffers", "QPBuffers",
-    "Slot", "StateBuffers", "StepPlan", "as_struct", "link_ends",
-]  # fmt: skip
+    "CheckBuffers",
+    "DamperBuffers",
+    "Kernel",
+    "PairBuffers",
+    "ProximityBuffers",
+    "QPBuffers",
+    "Slot",
+    "StateBuffers",
+    "StepPlan",
+    "as_struct",
+    "link_ends",
+]

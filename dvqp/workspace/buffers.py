@@ -52,9 +52,16 @@ class StateBuffers:
     def allocate(cls, n: int, k: int, rail: bool = False) -> StateBuffers:
         """Zeroed buffers for n joints, k body points and the rail point if ``rail``."""
         m = k + 1 + rail
-        return cls(np.zeros(n), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros((m, 6, n)),
-                   np.zeros((m, 3)), np.zeros((m, 3, n)), np.zeros(4),
-                   np.zeros((4, n)))  # fmt: skip
+        return cls(
+            np.zeros(n),
+            np.zeros((m, 3)),
+            np.zeros((m, 3)),
+            np.zeros((m, 6, n)),
+            np.zeros((m, 3)),
+            np.zeros((m, 3, n)),
+            np.zeros(4),
+            np.zeros((4, n)),
+        )
 
 
 def link_ends(k: int, rail: bool = False) -> NDArray[np.int64]:
@@ -129,11 +136,26 @@ class ProximityBuffers:
     def sized(cls, count: int, points: int, ends: NDArray[np.int64]) -> ProximityBuffers:
         """Zeroed buffers for ``count`` obstacles, ``points`` points and the links ``ends``."""
         p, s = (count, points), (count, ends.shape[0])
-        return cls(np.ascontiguousarray(ends, dtype=np.int64), np.zeros(p), np.zeros((*p, 2)),
-                   np.zeros(p), np.zeros((*p, 2)), np.zeros(s), np.zeros((*s, 2)), np.zeros(s),
-                   np.zeros((*s, 2)), np.zeros(s), np.zeros(s), np.zeros((*s, 2)), np.zeros(s),
-                   np.zeros(s), np.ones(s), np.zeros(ends.shape[0]),
-                   np.zeros(count, np.bool_), np.zeros(count))  # fmt: skip
+        return cls(
+            np.ascontiguousarray(ends, dtype=np.int64),
+            np.zeros(p),
+            np.zeros((*p, 2)),
+            np.zeros(p),
+            np.zeros((*p, 2)),
+            np.zeros(s),
+            np.zeros((*s, 2)),
+            np.zeros(s),
+            np.zeros((*s, 2)),
+            np.zeros(s),
+            np.zeros(s),
+            np.zeros((*s, 2)),
+            np.zeros(s),
+            np.zeros(s),
+            np.ones(s),
+            np.zeros(ends.shape[0]),
+            np.zeros(count, np.bool_),
+            np.zeros(count),
+        )
 
 
 @dataclass(frozen=True)
@@ -166,8 +188,12 @@ class PairBuffers:
         """The pairs among the guarded links of k body points (and the rail point if
         ``rail``), geometry zeroed."""
         ends = link_ends(k, rail)
-        pairs = [(a, b) for a in range(len(ends)) for b in range(a + 1, len(ends))
-                 if not set(ends[a]) & set(ends[b])]  # fmt: skip
+        pairs = [
+            (a, b)
+            for a in range(len(ends))
+            for b in range(a + 1, len(ends))
+            if not set(ends[a]) & set(ends[b])
+        ]
         i, j = np.array(pairs, dtype=np.int64).reshape(-1, 2).T.copy()
         p = i.shape[0]
         return cls(ends, i, j, np.zeros(p), np.zeros((p, 3)), np.zeros(p), np.zeros(p))

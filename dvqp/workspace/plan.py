@@ -26,9 +26,16 @@ from dvqp.workspace.buffers import PairBuffers, ProximityBuffers, StateBuffers
 
 Array = NDArray[np.float64]
 
-BLOCKS = {"A": "tasks", "b": "tasks", "distance": "dampers", "gradient": "dampers",
-          "usable": "dampers", "G": "constraints", "h": "constraints",
-          "values": "values"}  # fmt: skip
+BLOCKS = {
+    "A": "tasks",
+    "b": "tasks",
+    "distance": "dampers",
+    "gradient": "dampers",
+    "usable": "dampers",
+    "G": "constraints",
+    "h": "constraints",
+    "values": "values",
+}
 """Each array a :class:`Slot` may name, and the block of rows it belongs to."""
 
 
@@ -130,8 +137,9 @@ class StepPlan:
         The finalised arrays (None before :meth:`finalize`).
     """
 
-    def __init__(self, n: int, k: int, radius: float, obstacles: int = 0,
-                 rail: bool = False) -> None:  # fmt: skip
+    def __init__(
+        self, n: int, k: int, radius: float, obstacles: int = 0, rail: bool = False
+    ) -> None:
         self.n, self.k, self.radius, self.rail = n, k, float(radius), bool(rail)
         self.state = StateBuffers.allocate(n, k, rail)
         self.proximity = ProximityBuffers.allocate(obstacles, k, rail)
@@ -191,21 +199,33 @@ class StepPlan:
         n, s = self.n, self._sizes
         m, d, p, v = s["tasks"], s["dampers"], s["constraints"], s["values"]
         G, h = np.zeros((d + p, n)), np.full(d + p, np.inf)
-        self.qp = QPBuffers(np.eye(n), np.zeros(n), np.zeros((m, n)), np.zeros(m), G, h, self.lb,
-                            self.ub)  # fmt: skip
+        self.qp = QPBuffers(
+            np.eye(n), np.zeros(n), np.zeros((m, n)), np.zeros(m), G, h, self.lb, self.ub
+        )
         self.dampers = DamperBuffers(np.zeros(d), np.zeros((d, n)), np.zeros(d, dtype=np.bool_))
         joined = lambda parts: np.concatenate(parts) if parts else np.zeros(0)  # noqa: E731
-        self.checks = CheckBuffers(np.zeros(v), joined(self._safe), joined(self._tolerance),
-                                   np.zeros(v), np.zeros(2), np.full(v, np.inf),
-                                   np.full(v, np.inf), np.full(1, -1, np.int64))  # fmt: skip
+        self.checks = CheckBuffers(
+            np.zeros(v),
+            joined(self._safe),
+            joined(self._tolerance),
+            np.zeros(v),
+            np.zeros(2),
+            np.full(v, np.inf),
+            np.full(v, np.inf),
+            np.full(1, -1, np.int64),
+        )
 
     def view(self, slot: Slot) -> Array:
         """The rows of the finalised array that ``slot`` names."""
         self.finalize()
         assert self.qp is not None and self.dampers is not None and self.checks is not None
         offset = self._sizes["dampers"] if BLOCKS[slot.array] == "constraints" else 0
-        owner = {"tasks": self.qp, "constraints": self.qp, "dampers": self.dampers,
-                 "values": self.checks}[BLOCKS[slot.array]]  # fmt: skip
+        owner = {
+            "tasks": self.qp,
+            "constraints": self.qp,
+            "dampers": self.dampers,
+            "values": self.checks,
+        }[BLOCKS[slot.array]]
         return getattr(owner, slot.array)[offset + slot.start : offset + slot.stop]  # type: ignore[no-any-return]
 
     def bind(self, kernel: Kernel) -> Kernel:

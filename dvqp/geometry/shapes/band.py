@@ -35,8 +35,9 @@ class Band(Shape):
     weight: float = 1.0
     kind: ClassVar[str] = "band"
     SCENE_FIELDS: ClassVar[dict[str, tuple[str, Any]]] = {
-        "z": ("interval", None), "weight": ("weight", 1.0),
-    }  # fmt: skip
+        "z": ("interval", None),
+        "weight": ("weight", 1.0),
+    }
 
     def __post_init__(self) -> None:
         lo, hi = float(self.z_min), float(self.z_max)

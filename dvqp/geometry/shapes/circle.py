@@ -39,8 +39,10 @@ class Circle(Shape):
     weight: float = 1.0
     kind: ClassVar[str] = "circle"
     SCENE_FIELDS: ClassVar[dict[str, tuple[str, Any]]] = {
-        "center": ("point", None), "radius": ("length", None), "weight": ("weight", 1.0),
-    }  # fmt: skip
+        "center": ("point", None),
+        "radius": ("length", None),
+        "weight": ("weight", 1.0),
+    }
 
     def __post_init__(self) -> None:
         center = _validate.readonly(_validate.vector("center", self.center, 2))

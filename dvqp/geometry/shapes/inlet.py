@@ -59,8 +59,10 @@ class Inlet(Shape):
     weight: float = 1.0
     kind: ClassVar[str] = "inlet"
     SCENE_FIELDS: ClassVar[dict[str, tuple[str, Any]]] = {
-        "center": ("point", None), "radius": ("length", None), "weight": ("weight", 1.0),
-    }  # fmt: skip
+        "center": ("point", None),
+        "radius": ("length", None),
+        "weight": ("weight", 1.0),
+    }
     samples: Array = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -69,8 +71,9 @@ class Inlet(Shape):
         r = _validate.positive("radius", self.radius)
         big = _validate.positive("pipe_radius", self.pipe_radius)
         if not r < big:
-            raise ParameterError("radius", f"{r:g} m must be smaller than the pipe radius "
-                                 f"{big:g} m")  # fmt: skip
+            raise ParameterError(
+                "radius", f"{r:g} m must be smaller than the pipe radius {big:g} m"
+            )
         object.__setattr__(self, "radius", r)
         object.__setattr__(self, "weight", _validate.positive("weight", self.weight, strict=False))
         samples = _validate.readonly(self.curve(SAMPLES) - self.center)
@@ -219,8 +222,11 @@ def _deepest(al, az, el, ez, r, big, sl, sz, a_end, b_end):  # type: ignore[no-u
     glo = a_end[1] * el + a_end[2] * ez
     ghi = b_end[1] * el + b_end[2] * ez
     if glo >= 0.0 or ghi <= 0.0:
-        return (a_end[0], 0.0, a_end[1], a_end[2]) if glo >= 0.0 else (
-            b_end[0], 1.0, b_end[1], b_end[2])  # fmt: skip
+        return (
+            (a_end[0], 0.0, a_end[1], a_end[2])
+            if glo >= 0.0
+            else (b_end[0], 1.0, b_end[1], b_end[2])
+        )
     dlo, dhi, wlo, whi = a_end[0], b_end[0], glo, ghi  # w: the slopes Illinois weighs
     flat = 1e-14 * math.hypot(el, ez)  # a slope this small is the root (to ~1e-14 of it)
     last, side, kink, before = (math.nan, 0.0, 0.0, 0.0), 0, False, -1.0

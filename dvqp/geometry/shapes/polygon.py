@@ -37,8 +37,9 @@ class Polygon(Shape):
     weight: float = 1.0
     kind: ClassVar[str] = "polygon"
     SCENE_FIELDS: ClassVar[dict[str, tuple[str, Any]]] = {
-        "vertices": ("points", None), "weight": ("weight", 1.0),
-    }  # fmt: skip
+        "vertices": ("points", None),
+        "weight": ("weight", 1.0),
+    }
     l_ref: float = field(init=False)
     local_vertices: Array = field(init=False, repr=False)
 
