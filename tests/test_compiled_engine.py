@@ -294,7 +294,7 @@ class _Unchanged(dvqp.limits.SelfCollision):
     """Derives from a built-in limit and implements nothing of its own."""
 
 
-def test_a_subclass_of_a_built_in_part_is_a_part_of_your_own(
+def test_a_subclass_that_changes_a_built_ins_math_is_a_part_of_your_own(
     robot: dvqp.Robot, q0: np.ndarray
 ) -> None:
     spec = dvqp.StepSpec((dvqp.ToolTask(),), dvqp.Objective((_Level(0.08),)))
@@ -302,6 +302,27 @@ def test_a_subclass_of_a_built_in_part_is_a_part_of_your_own(
     step.start(q0)
     assert step.objective.value == 1.0
     np.testing.assert_array_equal(step.objective.gradient, np.arange(13.0))
-    spec = dvqp.StepSpec((dvqp.ToolTask(),), limits=(_Unchanged(),))
-    with pytest.raises(NotImplementedError, match="_Unchanged has no distances"):
-        Stepper(robot, 0.254, QPResolver(spec, "daqp"), q0, 0.005)
+
+
+def test_a_plain_subclass_of_a_built_in_limit_keeps_its_compiled_rows(
+    robot: dvqp.Robot, q0: np.ndarray
+) -> None:
+    steps = [
+        Stepper(
+            robot,
+            0.254,
+            QPResolver(dvqp.StepSpec((dvqp.ToolTask(),), limits=(limit,)), "daqp"),
+            q0,
+            0.005,
+        )
+        for limit in (dvqp.limits.SelfCollision(), _Unchanged())
+    ]
+    for step in steps:
+        step.start(q0)
+    assert not steps[1].layout.hooks.active
+    np.testing.assert_array_equal(
+        steps[0].arrays.dampers.distance, steps[1].arrays.dampers.distance
+    )
+    np.testing.assert_array_equal(
+        steps[0].arrays.dampers.gradient, steps[1].arrays.dampers.gradient
+    )

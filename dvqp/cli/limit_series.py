@@ -17,14 +17,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.errors import ParameterError
-from dvqp.limits import (
-    JointPositionLimit,
-    ObstacleDamper,
-    ProbeHeight,
-    SelfCollision,
-    SurfaceHeight,
-    TiltLimit,
-)
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.pinv import PseudoinverseResolver
 from dvqp.scenes.scene import Scene
@@ -120,8 +112,9 @@ def limit_series(scene: Scene, traj: Trajectory) -> LimitPage:
         values[k] = c.values
     curves = []
     for block in stepper.layout.blocks:
-        if block.limit is JointPositionLimit:
-            curves += _positions(traj.t, values[:, block.start : block.stop], scene)
+        if not block.damper:  # the joints' room
+            room = values[:, block.start : block.stop]
+            curves += _positions(traj.t, room, c.tolerance[block.start], scene)
         else:
             curves += _damper(traj.t, values, c.safe, c.tolerance, block, scene)
     curves += _rates(traj, stepper, dt)
@@ -131,33 +124,10 @@ def limit_series(scene: Scene, traj: Trajectory) -> LimitPage:
 
 
 def _groups(block: Block, scene: Scene) -> list[tuple[str, str, slice | list[int]]]:
-    """``(panel, label, rows)`` of a damper's block: its rows grouped into curves."""
-    limit, count = block.limit, block.stop - block.start
-    k, rail = scene.robot.n_points, int(scene.robot.has_rail)
-    if type(limit) is ObstacleDamper:  # points then links, obstacle-major (its labels)
-        names, points, links = limit.obstacles.labels, k + 1 + rail, k + rail
-        at = len(names) * points
-        return [
-            (
-                "clearance",
-                name,
-                [
-                    *range(j * points, (j + 1) * points),
-                    *range(at + j * links, at + (j + 1) * links),
-                ],
-            )
-            for j, name in enumerate(names)
-        ]
-    if type(limit) is SurfaceHeight:
-        return [("height", "body points", slice(0, k)), ("height", "link chords", slice(k, count))]
-    if type(limit) is ProbeHeight:
-        return [("height", "probe", [0]), ("height", "holder", [1])]
-    if type(limit) is SelfCollision:
-        return [("self distance", "non-adjacent links", slice(0, count))]
-    if type(limit) is TiltLimit:
-        return [("tilt", "probe from radial", slice(0, count))]
-    name = getattr(limit, "name", "limit")  # a limit of your own: one curve
-    return [(getattr(limit, "quantity", name), name, slice(0, count))]
+    """``(panel, label, rows)`` of a damper's block: its rows grouped into curves, as the
+    damper groups them."""
+    k, rail = scene.robot.n_points, bool(scene.robot.has_rail)
+    return block.limit.series(block.stop - block.start, k, rail)  # type: ignore[attr-defined]
 
 
 def _damper(
@@ -184,9 +154,10 @@ def _damper(
     return curves
 
 
-def _positions(t: Array, room: Array, scene: Scene) -> list[Curve]:
+def _positions(t: Array, room: Array, tolerance: float, scene: Scene) -> list[Curve]:
     """Each limited joint's position as a fraction of its half range from the middle: 1 less
-    its verified room (``[q_max − q, q − q_min]``) over the half range."""
+    its verified room (``[q_max − q, q − q_min]``, verified to ``tolerance`` rad) over the
+    half range."""
     robot, n = scene.robot, scene.robot.n
     half = 0.5 * (robot.q_max - robot.q_min)
     least = np.minimum(room[:, :n], room[:, n:])
@@ -197,7 +168,7 @@ def _positions(t: Array, room: Array, scene: Scene) -> list[Curve]:
             t,
             1.0 - least[:, i] / half[i],
             1.0,
-            JointPositionLimit.tolerance / half[i],
+            tolerance / half[i],
             "",
             upper=True,
         )

@@ -17,19 +17,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.geometry.broad_phase import box_bound, chain_box, obstacle_bound
-from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon, Shape
+from dvqp.geometry.shapes import Shape
 from dvqp.geometry.shapes.band import band_point, band_segment
 from dvqp.geometry.shapes.circle import circle_point, circle_segment
 from dvqp.geometry.shapes.inlet import UNKNOWN, inlet_point, inlet_segment
 from dvqp.geometry.shapes.polygon import polygon_point, polygon_segment
+from dvqp.geometry.shapes.shape import BAND, CIRCLE, INLET, OTHER, POLYGON
 from dvqp.kinematics.developed_view import wrap_period
 from dvqp.workspace import ProximityBuffers
 from solvers.jit import njit
 
 Array = NDArray[np.float64]
-
-CIRCLE, BAND, POLYGON, OTHER, INLET = 0, 1, 2, 3, 4
-"""Codes of the compiled shape kinds; OTHER is a shape of your own (measured in NumPy)."""
 
 
 @dataclass(frozen=True)
@@ -82,34 +80,22 @@ class ShapeArrays:
 
     @classmethod
     def of(cls, shapes: Sequence[Shape], period: float) -> ShapeArrays:
-        """Pack ``shapes`` (dvqp's own classes compiled, any other :data:`OTHER`)."""
+        """Pack ``shapes``: each as it says itself (:meth:`~dvqp.geometry.shapes.Shape.compiled`;
+        a shape of your own :data:`OTHER`)."""
         count = len(shapes)
         code, data = np.full(count, OTHER, np.int64), np.zeros((count, 4))
         start, stop = np.zeros(count, np.int64), np.zeros(count, np.int64)
         vertices: list[Array] = []
         box, at = np.zeros((count, 4)), 0
         for j, shape in enumerate(shapes):
-            kind = type(shape)
-            if kind is Circle:
-                code[j], data[j] = CIRCLE, (*shape.center, shape.radius, 0.0)  # type: ignore[attr-defined]
-                box[j] = (-data[j, 2], data[j, 2], data[j, 1] - data[j, 2], data[j, 1] + data[j, 2])
-            elif kind is Band:
-                code[j], data[j] = BAND, (shape.z_min, shape.z_max, 0.0, 0.0)  # type: ignore[attr-defined]
-                box[j] = (-math.inf, math.inf, data[j, 0], data[j, 1])
-            elif kind is Inlet:
-                code[j], data[j] = INLET, (*shape.center, shape.radius, shape.pipe_radius)  # type: ignore[attr-defined]
-                local = shape.samples  # type: ignore[attr-defined]
-            elif kind is Polygon:
-                local = shape.local_vertices  # type: ignore[attr-defined]
-                code[j], data[j, 0] = POLYGON, shape.l_ref  # type: ignore[attr-defined]
-            if kind in (Polygon, Inlet):
-                low, high = local.min(axis=0), local.max(axis=0)
-                box[j] = (low[0], high[0], low[1], high[1])
-                if kind is Inlet:  # its samples hold the tips (φ = 0, π): the box is exact
-                    box[j, 2:] += data[j, 1]
-                start[j], stop[j] = at, at + local.shape[0]
-                vertices.append(local)
-                at += local.shape[0]
+            packed = shape.compiled()
+            if packed is None:
+                continue
+            code[j], data[j], box[j] = packed.code, packed.data, packed.box
+            if packed.samples is not None:
+                start[j], stop[j] = at, at + packed.samples.shape[0]
+                vertices.append(packed.samples)
+                at += packed.samples.shape[0]
         packed = np.concatenate(vertices) if vertices else np.zeros((0, 2))
         vl, vz = np.ascontiguousarray(packed[:, 0]), np.ascontiguousarray(packed[:, 1])
         return cls(

@@ -181,16 +181,23 @@ def measure(
     return near
 
 
-def proximity(state: KinematicState, obstacles: ObstacleSet | Sequence[Shape]) -> Proximity:
-    """The :class:`Proximity` of ``state``'s guarded parts to ``obstacles``."""
-    near = measure(
+def measure_state(
+    state: KinematicState, obstacles: ObstacleSet | Sequence[Shape]
+) -> ProximityBuffers:
+    """Every distance of ``state``'s guarded parts to ``obstacles`` (the links' real ones
+    included), in new buffers, as a run's step measures them with every row exact."""
+    return measure(
         tuple(obstacles),
         np.array(state.guarded),
         2.0 * np.pi * state.radius,
         link_ends(state.k, state.rail),
         (np.array(state.origins), state.radius, state.k),
     )
-    return Proximity.of(near, state.k)
+
+
+def proximity(state: KinematicState, obstacles: ObstacleSet | Sequence[Shape]) -> Proximity:
+    """The :class:`Proximity` of ``state``'s guarded parts to ``obstacles``."""
+    return Proximity.of(measure_state(state, obstacles), state.k)
 
 
 def min_clearance(state: KinematicState, obstacles: ObstacleSet | Sequence[Shape]) -> float:

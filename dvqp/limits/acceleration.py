@@ -21,7 +21,9 @@ from numpy.typing import ArrayLike, NDArray
 from dvqp import _validate
 from dvqp.errors import ParameterError
 from dvqp.kinematics.robot import Robot
-from dvqp.limits.limit import Limit
+from dvqp.kinematics.state import KinematicState
+from dvqp.limits.limit import Bounds, Limit, SceneLimits
+from dvqp.workspace.wiring import StepWiring, overrides
 from solvers.jit import njit
 
 DEFAULT_QDD_MAX = 10.0
@@ -52,6 +54,11 @@ class AccelerationLimit(Limit):
         self.q_min, self.q_max = robot.q_min, robot.q_max
         self._previous = np.zeros(robot.n)
 
+    @classmethod
+    def from_scene(cls, scene: SceneLimits) -> AccelerationLimit:
+        """The arm's limits and the scene's ``[robot] qdd_max``."""
+        return cls(scene.robot, scene.qdd_max)
+
     @property
     def previous(self) -> NDArray[np.float64]:
         """The last observed joint velocity, rad/s, shape (n,).
@@ -68,6 +75,21 @@ class AccelerationLimit(Limit):
         """The joint velocity (rad/s, shape (n,)) applied over the step just taken, copied in
         place."""
         np.copyto(self._previous, qdot)
+
+    def compute(self, state: KinematicState, dt: float) -> Bounds:
+        """The box :func:`acceleration_bounds` intersects at ``state`` for a step of ``dt`` s
+        (after the velocity last observed)."""
+        lb, ub = np.full(state.n, -np.inf), np.full(state.n, np.inf)
+        q, a, dt = np.asarray(state.q), self.qdd_max, float(dt)
+        acceleration_bounds(q, self.q_min, self.q_max, a, self._previous, dt, lb, ub)
+        return Bounds(lb, ub)
+
+    def join(self, step: StepWiring) -> None:
+        """Be the compiled step's acceleration box (the last to join, if several)."""
+        if overrides(self, AccelerationLimit, "compute", "kernel"):
+            return super().join(step)
+        step.acceleration = self
+        return None
 
 
 @njit(inline="always")

@@ -33,6 +33,7 @@ from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.limit import Limit
 from dvqp.workspace import Kernel, StepPlan
+from dvqp.workspace.wiring import StepWiring
 from solvers.jit import njit
 
 Array = NDArray[np.float64]
@@ -56,12 +57,21 @@ class Distances:
         ``d_safe``, m.
     describe : callable, optional
         Labels of the p rows, computed only when asked.
+    usable : ndarray of bool, shape (p,), optional
+        Whether each row applies (its gradient is defined); None: every row.
     """
 
     value: Array
     gradient: Array
     safe: float | Array
     describe: Callable[[], tuple[str, ...]] | None = field(default=None, repr=False)
+    usable: NDArray[np.bool_] | None = None
+
+
+def fresh_rows(count: int, n: int) -> tuple[Array, Array, NDArray[np.bool_]]:
+    """Zeroed ``(distance (count,), gradient (count, n), usable (count,))`` for a damper's
+    kernel to write, as the step's own damper rows."""
+    return np.zeros(count), np.zeros((count, n)), np.zeros(count, dtype=np.bool_)
 
 
 class VelocityDamper(Limit):
@@ -94,6 +104,8 @@ class VelocityDamper(Limit):
     unit = "m"
     tolerance = 1e-4
     reach = math.inf
+    angular = False
+    """Whether the distance is the sine of an angle (verified as the angle, in rad)."""
 
     def __init__(self, gain: float = 0.5, deceleration: float = DEFAULT_DECELERATION) -> None:
         if not 0.0 < float(gain) <= 1.0:
@@ -114,6 +126,18 @@ class VelocityDamper(Limit):
         :class:`~dvqp.workspace.Kernel` writing ``d``, ``∂d/∂Q`` and whether each row applies
         from ``plan.state`` at every state; its safe value is then :attr:`safe`."""
         return None
+
+    def series(self, count: int, k: int, rail: bool) -> list[tuple[str, str, slice | list[int]]]:
+        """How a limits page groups this damper's ``count`` rows into curves (the least of
+        each group): ``(panel, label, rows)``; one curve by default."""
+        return [(self.quantity, self.name, slice(0, count))]
+
+    def join(self, step: StepWiring) -> None:
+        """Join the run's step: a damper of your own through the run's hooks (its
+        :meth:`kernel`, else :meth:`distances`); dvqp's own dampers measure their distances in
+        the compiled step's tables instead. Either way its rows and their verification are the
+        same compiled code."""
+        step.hooked_damper(self)
 
     @property
     def safe(self) -> float | ArrayLike:

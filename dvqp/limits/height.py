@@ -22,8 +22,9 @@ import numpy as np
 from dvqp.errors import ParameterError
 from dvqp.geometry.proximity import link_label
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
+from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, fresh_rows
 from dvqp.workspace import link_ends
+from dvqp.workspace.wiring import StepWiring, overrides
 from solvers.jit import njit
 
 
@@ -44,6 +45,7 @@ class SurfaceHeight(VelocityDamper):
 
     name = "height"
     quantity = "height"
+    IN_EVERY_SCENE = True
     SCENE_KEYS: ClassVar[dict[str, str]] = {
         "damper_deceleration": "deceleration",
         "min_height": "min_height",
@@ -70,6 +72,24 @@ class SurfaceHeight(VelocityDamper):
         links = (*(f"link{i + 1}" for i in range(k - 1)), *(("carriage",) if rail else ()))
         return (*(f"point{i + 1}/height" for i in range(k)), *(f"{a}/height" for a in links))
 
+    def series(self, count: int, k: int, rail: bool) -> list[tuple[str, str, slice | list[int]]]:
+        """The body points' curve and the link chords'."""
+        return [("height", "body points", slice(0, k)), ("height", "link chords", slice(k, count))]
+
+    def distances(self, state: KinematicState) -> Distances:
+        """The rows its kernels write at ``state``: the body points', then the chords'."""
+        k, rail = state.k, state.rail
+        return _height_rows(self, state, 0, k, [*range(k - 1), *([k] if rail else [])])
+
+    def join(self, step: StepWiring) -> None:
+        """Rows of the k body points, then of the chords of the body links (and the carriage
+        link), measured by :func:`height_distances` and :func:`chord_heights`."""
+        if overrides(self, SurfaceHeight, "distances", "kernel"):
+            return super().join(step)
+        k = step.plan.k
+        _join_heights(self, step, 0, k, [*range(k - 1), *([k] if step.plan.rail else [])])
+        return None
+
 
 class ProbeHeight(VelocityDamper):
     """``h ≥ floor`` for the probe (the tool point) and the lowest point of its holder, two
@@ -90,6 +110,7 @@ class ProbeHeight(VelocityDamper):
 
     name = "probe_height"
     quantity = "height"
+    IN_EVERY_SCENE = True
     SCENE_KEYS: ClassVar[dict[str, str]] = {
         "damper_deceleration": "deceleration",
         "damper_gain": "gain",
@@ -109,6 +130,57 @@ class ProbeHeight(VelocityDamper):
     def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
         """``("probe/height", "holder/height")``."""
         return ("probe/height", "holder/height")
+
+    def series(self, count: int, k: int, rail: bool) -> list[tuple[str, str, slice | list[int]]]:
+        """The probe's curve and its holder's."""
+        return [("height", "probe", [0]), ("height", "holder", [1])]
+
+    def distances(self, state: KinematicState) -> Distances:
+        """The rows its kernels write at ``state``: the probe's, then its holder's chord."""
+        return _height_rows(self, state, state.k, 1, [state.k - 1])
+
+    def join(self, step: StepWiring) -> None:
+        """Rows of the probe (guarded point k) and of its holder's chord (link k − 1)."""
+        if overrides(self, ProbeHeight, "distances", "kernel"):
+            return super().join(step)
+        k = step.plan.k
+        _join_heights(self, step, k, 1, [k - 1])
+        return None
+
+
+def _height_rows(
+    limit: VelocityDamper, state: KinematicState, first: int, points: int, chords: list[int]
+) -> Distances:
+    """What :func:`height_distances` and :func:`chord_heights` write for ``limit`` at
+    ``state`` (the rows :func:`_join_heights` reserves)."""
+    k, rail = state.k, state.rail
+    distance, gradient, usable = fresh_rows(points + len(chords), state.n)
+    guarded, jacobians = state.guarded, state.guarded_jacobians
+    height_distances(guarded, jacobians, first, points, 0, distance, gradient, usable)
+    table = np.array([(points + c, link) for c, link in enumerate(chords)], dtype=np.int64)
+    ends, labels = link_ends(k, rail), limit.labels(k, rail)
+    chord_heights(
+        guarded,
+        state.origins,
+        state.frame_jacobians,
+        ends,
+        state.radius,
+        table.reshape(-1, 2),
+        distance,
+        gradient,
+        usable,
+    )
+    return Distances(distance, gradient, limit.safe, lambda: labels, usable)
+
+
+def _join_heights(
+    limit: VelocityDamper, step: StepWiring, first: int, points: int, chords: list[int]
+) -> None:
+    """Damper rows of guarded points ``first .. first + points − 1``, then of the lowest point
+    of each guarded link in ``chords``."""
+    start = step.damper(limit, points + len(chords), limit.labels(step.plan.k, step.plan.rail))
+    step.measures["heights"].append((start, first, points))
+    step.measures["chords"].extend((start + points + c, link) for c, link in enumerate(chords))
 
 
 def _finite(name: str, value: float) -> float:

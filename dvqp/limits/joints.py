@@ -6,7 +6,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.kinematics.robot import Robot
-from dvqp.limits.limit import Limit
+from dvqp.kinematics.state import KinematicState
+from dvqp.limits.limit import Bounds, Limit, SceneLimits
+from dvqp.workspace.wiring import StepWiring, overrides
 from solvers.jit import njit
 
 Array = NDArray[np.float64]
@@ -26,12 +28,33 @@ class JointPositionLimit(Limit):
     """
 
     name = "joint_position"
+    quantity, unit = "joint room", "rad"
     tolerance = 1e-6
     """rad: how far past a limit an integrated step may end (the QP holds it exactly)."""
 
     def __init__(self, robot: Robot) -> None:
         self.q_min = robot.q_min
         self.q_max = robot.q_max
+
+    @classmethod
+    def from_scene(cls, scene: SceneLimits) -> JointPositionLimit:
+        """The arm's own position limits."""
+        return cls(scene.robot)
+
+    def compute(self, state: KinematicState, dt: float) -> Bounds:
+        """The box :func:`position_bounds` intersects at ``state`` for a step of ``dt`` s."""
+        lb, ub = np.full(state.n, -np.inf), np.full(state.n, np.inf)
+        position_bounds(np.asarray(state.q), self.q_min, self.q_max, float(dt), lb, ub)
+        return Bounds(lb, ub)
+
+    def join(self, step: StepWiring) -> None:
+        """Intersect the compiled position box, and verify the joints' room exactly."""
+        if overrides(self, JointPositionLimit, "compute", "kernel"):
+            return super().join(step)
+        step.intersect(q_min=self.q_min, q_max=self.q_max)
+        if step.joint_limit is None:
+            step.joint_limit = self
+        return None
 
 
 @njit
@@ -65,6 +88,24 @@ class JointVelocityLimit(Limit):
 
     def __init__(self, robot: Robot) -> None:
         self.qd_max = robot.qd_max
+
+    @classmethod
+    def from_scene(cls, scene: SceneLimits) -> JointVelocityLimit:
+        """The arm's own speed limits."""
+        return cls(scene.robot)
+
+    def compute(self, state: KinematicState, dt: float) -> Bounds:
+        """The box :func:`velocity_bounds` intersects."""
+        lb, ub = np.full(state.n, -np.inf), np.full(state.n, np.inf)
+        velocity_bounds(self.qd_max, lb, ub)
+        return Bounds(lb, ub)
+
+    def join(self, step: StepWiring) -> None:
+        """Intersect the compiled speed box."""
+        if overrides(self, JointVelocityLimit, "compute", "kernel"):
+            return super().join(step)
+        step.intersect(qd_max=self.qd_max)
+        return None
 
 
 @njit

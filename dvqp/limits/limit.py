@@ -9,14 +9,16 @@ parts, on the same state, and writes its rows into the same QP.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.kinematics.state import KinematicState
 from dvqp.workspace import Kernel, StepPlan
+from dvqp.workspace.wiring import StepWiring
 
 
 @dataclass(frozen=True)
@@ -50,6 +52,32 @@ class Constraint:
         return int(self.h.shape[0])
 
 
+SHARED_KEYS = "damper_"
+"""The prefix of the ``[constraints]`` keys that several limits share (``damper_gain``)."""
+
+
+@dataclass(frozen=True)
+class SceneLimits:
+    """What a scene file gives its limits (:meth:`Limit.from_scene`).
+
+    Attributes
+    ----------
+    robot : Robot
+        The arm.
+    obstacles : ObstacleSet
+        The scene's obstacles.
+    constraints : dict of str to float
+        The numbers of its ``[constraints]`` table (validated as numbers).
+    qdd_max : ndarray, shape (n,)
+        ``[robot] qdd_max``, rad/s².
+    """
+
+    robot: Any
+    obstacles: Any
+    constraints: dict[str, float]
+    qdd_max: NDArray[np.float64]
+
+
 @dataclass(frozen=True)
 class Bounds:
     """Box ``lb ≤ Q̇ ≤ ub`` on the joint velocities, rad/s, each shape (n,)."""
@@ -71,6 +99,26 @@ class Limit:
     """
 
     name: str = "limit"
+    SCENE_KEYS: ClassVar[dict[str, str]] = {}
+    """Keys of the scene file's ``[constraints]`` table -> the arguments they give."""
+    IN_EVERY_SCENE: ClassVar[bool] = False
+    """Whether every scene makes it (with its defaults), not only one giving its keys."""
+
+    @classmethod
+    def from_scene(cls, scene: SceneLimits) -> Limit | None:
+        """The limit a scene file makes (see :mod:`dvqp.limits.registry`): by default, the
+        class called with the ``SCENE_KEYS`` the scene gives; None if it gives none of them
+        (unless :attr:`IN_EVERY_SCENE`; the keys every damper shares, ``damper_*``, alone do
+        not ask for it)."""
+        own = (key for key in cls.SCENE_KEYS if not key.startswith(SHARED_KEYS))
+        asked = cls.IN_EVERY_SCENE or any(key in scene.constraints for key in own)
+        return cls(**cls.scene_arguments(scene)) if asked else None
+
+    @classmethod
+    def scene_arguments(cls, scene: SceneLimits) -> dict[str, float]:
+        """The arguments the scene's ``[constraints]`` keys give (see :attr:`SCENE_KEYS`)."""
+        values = scene.constraints
+        return {param: values[key] for key, param in cls.SCENE_KEYS.items() if key in values}
 
     def compute(self, state: KinematicState, dt: float) -> Constraint | Bounds:
         """The limit's rows at ``state`` for a step of ``dt`` seconds (a limit of your own).
@@ -86,6 +134,17 @@ class Limit:
         writing them from ``plan.state`` and ``plan.dt`` at every step (or intersecting its
         box into ``plan.lb``, ``plan.ub``). None (the default): :meth:`compute` is used."""
         return None
+
+    @property
+    def measured(self) -> Sequence[Any]:
+        """The obstacles whose distances the step must measure for this limit (none)."""
+        return ()
+
+    def join(self, step: StepWiring) -> None:
+        """Join the run's step: a limit of your own hands itself to the run's hooks (its
+        :meth:`kernel`, else :meth:`compute`, called between the compiled stages); dvqp's own
+        limits write their rows into the compiled step's tables instead."""
+        step.hooks.limit(self)
 
     def observe(self, qdot: NDArray[np.float64], dt: float) -> None:
         """The joint velocity (rad/s) applied over the step just taken (a limit that remembers

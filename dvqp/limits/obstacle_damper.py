@@ -15,9 +15,13 @@ import numpy as np
 from dvqp import _validate
 from dvqp.errors import ParameterError
 from dvqp.geometry.obstacle import ObstacleSet
-from dvqp.geometry.proximity import link_label, point_label
+from dvqp.geometry.proximity import link_label, measure_state, point_label
 from dvqp.geometry.real_links import real_link_gradient
-from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
+from dvqp.kinematics.state import KinematicState
+from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, fresh_rows
+from dvqp.limits.limit import SceneLimits
+from dvqp.workspace import as_struct
+from dvqp.workspace.wiring import StepWiring, overrides
 from solvers.jit import njit
 
 
@@ -63,6 +67,11 @@ class ObstacleDamper(VelocityDamper):
             raise ParameterError("influence", "must be finite and > margin")
         self.influence = float(influence)
 
+    @classmethod
+    def from_scene(cls, scene: SceneLimits) -> ObstacleDamper:
+        """The scene's obstacles, with its ``[constraints]`` keys."""
+        return cls(scene.obstacles, **cls.scene_arguments(scene))
+
     @property
     def safe(self) -> float:
         """``margin``, m."""
@@ -72,6 +81,68 @@ class ObstacleDamper(VelocityDamper):
     def reach(self) -> float:  # type: ignore[override]
         """``influence``, m."""
         return self.influence
+
+    @property
+    def measured(self) -> ObstacleSet:
+        """Its obstacles."""
+        return self.obstacles
+
+    def distances(self, state: KinematicState) -> Distances:
+        """The rows :func:`obstacle_distances` writes at ``state`` (every row measured
+        exactly: a run's broad phase may give a far obstacle's rows its lower bound)."""
+        k, rail, count = state.k, state.rail, len(self.obstacles)
+        near = measure_state(state, self.obstacles)
+        distance, gradient, usable = fresh_rows(count * (2 * k + 1 + 2 * rail), state.n)
+        obstacle_distances(
+            as_struct(near),
+            state.guarded_jacobians,
+            state.origins,
+            state.frame_jacobians,
+            state.radius,
+            np.full(distance.shape[0], self.reach),
+            np.arange(count, dtype=np.int64),
+            0,
+            distance,
+            gradient,
+            usable,
+        )
+        labels = self.labels(k, rail)
+        return Distances(distance, gradient, self.safe, lambda: labels, usable)
+
+    def join(self, step: StepWiring) -> None:
+        """Rows of every guarded point and link to each of its obstacles (``2k + 1`` a
+        obstacle, ``+ 2`` with a rail point), measured by :func:`obstacle_distances`."""
+        if overrides(self, ObstacleDamper, "distances", "kernel"):
+            return super().join(step)
+        k, rail = step.plan.k, step.plan.rail
+        members = step.rows_of(self.obstacles)
+        count = members.shape[0] * (2 * k + 1 + 2 * rail)
+        if count == 0:
+            return None
+        start = step.damper(self, count, self.labels(k, rail))
+        table = step.measures
+        table["obstacle_start"].append(start)
+        table["obstacle_members"].extend(members.tolist())
+        table["obstacle_offsets"].append(len(table["obstacle_members"]))
+        step.refine(members, self.safe, self.reach)
+        return None
+
+    def series(self, count: int, k: int, rail: bool) -> list[tuple[str, str, slice | list[int]]]:
+        """One clearance curve per obstacle: its points' rows and its links' (obstacle-major,
+        as :meth:`labels`)."""
+        names, points, links = self.obstacles.labels, k + 1 + rail, k + rail
+        at = len(names) * points
+        return [
+            (
+                "clearance",
+                name,
+                [
+                    *range(j * points, (j + 1) * points),
+                    *range(at + j * links, at + (j + 1) * links),
+                ],
+            )
+            for j, name in enumerate(names)
+        ]
 
     def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
         """``"point3/obstacles[0]"`` (or ``"point3/<name>"``), ...: every point then every

@@ -22,8 +22,9 @@ import numpy as np
 from dvqp import _validate
 from dvqp.geometry.proximity import link_label
 from dvqp.kinematics.state import KinematicState
-from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
+from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, fresh_rows
 from dvqp.workspace import PairBuffers, as_struct
+from dvqp.workspace.wiring import StepWiring, overrides
 from solvers.jit import njit
 
 
@@ -46,6 +47,7 @@ class SelfCollision(VelocityDamper):
 
     name = "self"
     quantity = "self distance"
+    IN_EVERY_SCENE = True
     SCENE_KEYS: ClassVar[dict[str, str]] = {
         "damper_deceleration": "deceleration",
         "self_margin": "margin",
@@ -72,6 +74,30 @@ class SelfCollision(VelocityDamper):
     def reach(self) -> float:  # type: ignore[override]
         """``margin + influence``, m."""
         return self.margin + self.influence
+
+    def series(self, count: int, k: int, rail: bool) -> list[tuple[str, str, slice | list[int]]]:
+        """One curve: the least over the non-adjacent link pairs."""
+        return [("self distance", "non-adjacent links", slice(0, count))]
+
+    def distances(self, state: KinematicState) -> Distances:
+        """The rows :func:`pair_distances` and :func:`self_distances` write at ``state``."""
+        pairs = PairBuffers.allocate(state.k, state.rail)
+        distance, gradient, usable = fresh_rows(pairs.i.shape[0], state.n)
+        packed = as_struct(pairs)
+        pair_distances(np.ascontiguousarray(state.origins), packed)
+        self_distances(packed, state.frame_jacobians, 0, distance, gradient, usable)
+        labels = self.labels(state.k, state.rail)
+        return Distances(distance, gradient, self.safe, lambda: labels, usable)
+
+    def join(self, step: StepWiring) -> None:
+        """A row per pair of non-adjacent guarded links, measured by :func:`self_distances`."""
+        if overrides(self, SelfCollision, "distances", "kernel"):
+            return super().join(step)
+        plan = step.plan
+        count = plan.pairs.i.shape[0]
+        if count:
+            step.measures["selves"].append(step.damper(self, count, self.labels(plan.k, plan.rail)))
+        return None
 
     def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
         """The pairs' names, e.g. ``"link1/link3"``, ``"link2/holder"``, ``"link2/carriage"``

@@ -16,7 +16,9 @@ import math
 from typing import ClassVar
 
 from dvqp.errors import ParameterError
-from dvqp.limits.damper import DEFAULT_DECELERATION, VelocityDamper
+from dvqp.kinematics.state import KinematicState
+from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, fresh_rows
+from dvqp.workspace.wiring import StepWiring, overrides
 from solvers.jit import njit
 
 SIN_FLOOR = 1e-9
@@ -42,6 +44,8 @@ class TiltLimit(VelocityDamper):
     unit = "rad"
     tolerance = 1e-3
     """rad: how far below ``min(θ_min, θ at the start)`` an integrated step may end."""
+    angular = True
+    IN_EVERY_SCENE = True
     SCENE_KEYS: ClassVar[dict[str, str]] = {
         "damper_deceleration": "deceleration",
         "min_tilt": "min_tilt",
@@ -64,6 +68,26 @@ class TiltLimit(VelocityDamper):
     def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
         """``("probe/tilt",)``."""
         return ("probe/tilt",)
+
+    def series(self, count: int, k: int, rail: bool) -> list[tuple[str, str, slice | list[int]]]:
+        """One curve: the probe axis's angle from the radial."""
+        return [("tilt", "probe from radial", slice(0, count))]
+
+    def distances(self, state: KinematicState) -> Distances:
+        """The row :func:`tilt_distance` writes at ``state``: ``sin θ`` of the probe."""
+        distance, gradient, usable = fresh_rows(1, state.n)
+        frames = state.frame_jacobians
+        tilt_distance(state.origins, state.axes, frames, state.k, 0, distance, gradient, usable)
+        return Distances(distance, gradient, self.safe, lambda: ("probe/tilt",), usable)
+
+    def join(self, step: StepWiring) -> None:
+        """One row, ``sin θ``, measured by :func:`tilt_distance` (none if ``θ_min = 0``)."""
+        if self.min_tilt == 0.0:
+            return None
+        if overrides(self, TiltLimit, "distances", "kernel"):
+            return super().join(step)
+        step.measures["tilts"].append(step.damper(self, 1, self.labels(step.plan.k)))
+        return None
 
 
 @njit

@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import numpy as np
 from numpy.typing import ArrayLike
 
 from dvqp.geometry.obstacle import ObstacleSet
-from dvqp.objective.term import Array, ObjectiveTerm, point_gains, pull_points
+from dvqp.geometry.proximity import measure_state
+from dvqp.kinematics.state import KinematicState
+from dvqp.objective.term import Array, ObjectiveTerm, Term, per_point, point_gains, pull_points
+from dvqp.workspace.wiring import StepWiring, overrides
 from solvers.jit import njit
 
 
@@ -29,6 +33,36 @@ class ObstaclePoints(ObjectiveTerm):
     def __init__(self, obstacles: ObstacleSet, k_obstacle: ArrayLike = 1.0) -> None:
         self.obstacles = ObstacleSet.of(obstacles)
         self.k_obstacle = point_gains("k_obstacle", k_obstacle)
+
+    @property
+    def measured(self) -> ObstacleSet:
+        """Its obstacles."""
+        return self.obstacles
+
+    def evaluate(self, state: KinematicState) -> Term:
+        """What :func:`obstacle_points` adds at ``state``."""
+        near, value, gradient = measure_state(state, self.obstacles), np.zeros(1), np.zeros(state.n)
+        gains = per_point("k_obstacle", self.k_obstacle, state.k)
+        obstacle_points(
+            near.point_penalty,
+            near.point_penalty_gradient,
+            near.skipped,
+            self.obstacles.weights[:, None] * gains[None, :],
+            state.guarded_jacobians,
+            np.zeros((state.k, 2)),
+            value,
+            gradient,
+        )
+        return Term(float(value[0]), gradient)
+
+    def join(self, step: StepWiring) -> None:
+        """Its coefficients ``w_j k¹_i`` in the compiled objective's tables."""
+        if overrides(self, ObstaclePoints, "evaluate", "kernel"):
+            return super().join(step)
+        gains = per_point("k_obstacle", self.k_obstacle, step.plan.k)
+        coef = self.obstacles.weights[:, None] * gains[None, :]
+        step.point_coefficients(step.rows_of(self.obstacles), coef)
+        return None
 
 
 @njit

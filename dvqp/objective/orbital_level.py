@@ -6,7 +6,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from dvqp.errors import ParameterError
-from dvqp.objective.term import Array, ObjectiveTerm, point_gains
+from dvqp.kinematics.state import KinematicState
+from dvqp.objective.term import Array, ObjectiveTerm, Term, per_point, point_gains
+from dvqp.workspace.wiring import StepWiring, overrides
 from solvers.jit import njit
 
 
@@ -28,6 +30,21 @@ class OrbitalLevel(ObjectiveTerm):
             raise ParameterError("orbital_level", "must be finite")
         self.level = float(level)
         self.k_height = point_gains("k_height", k_height)
+
+    def evaluate(self, state: KinematicState) -> Term:
+        """What :func:`orbital_level` adds at ``state``."""
+        value, gradient = np.zeros(1), np.zeros(state.n)
+        gains = per_point("k_height", self.k_height, state.k)
+        orbital_level(state.guarded, state.guarded_jacobians, self.level, gains, value, gradient)
+        return Term(float(value[0]), gradient)
+
+    def join(self, step: StepWiring) -> None:
+        """A row of the compiled objective's levels (``h*``, ``k²`` per body point)."""
+        if overrides(self, OrbitalLevel, "evaluate", "kernel"):
+            return super().join(step)
+        step.levels.append(self.level)
+        step.k_height.append(per_point("k_height", self.k_height, step.plan.k))
+        return None
 
 
 @njit

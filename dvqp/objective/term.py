@@ -9,7 +9,9 @@ adds it after the compiled terms, on the same state.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -18,6 +20,7 @@ from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.kinematics.state import KinematicState
 from dvqp.workspace import Kernel, StepPlan
+from dvqp.workspace.wiring import StepWiring
 from solvers.jit import njit
 
 Array = NDArray[np.float64]
@@ -52,6 +55,17 @@ class ObjectiveTerm:
         ``plan.objective_value`` (1,) and ``plan.objective_gradient`` (n,) at ``plan.state``.
         None (the default): :meth:`evaluate` is used."""
         return None
+
+    @property
+    def measured(self) -> Sequence[Any]:
+        """The obstacles whose distances the step must measure for this term (none)."""
+        return ()
+
+    def join(self, step: StepWiring) -> None:
+        """Join the run's step: a term of your own through the run's hooks (its
+        :meth:`kernel`, else :meth:`evaluate`); dvqp's own terms write their coefficients into
+        the compiled objective's tables instead."""
+        step.hooks.term(self)
 
 
 def point_gains(name: str, value: ArrayLike) -> Array:

@@ -16,18 +16,9 @@ from dvqp.errors import ParameterError
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.shapes.inlet import Inlet
 from dvqp.kinematics.robot import Robot
-from dvqp.limits import (
-    DEFAULT_QDD_MAX,
-    AccelerationLimit,
-    JointPositionLimit,
-    JointVelocityLimit,
-    Limit,
-    ObstacleDamper,
-    ProbeHeight,
-    SelfCollision,
-    SurfaceHeight,
-    TiltLimit,
-)
+from dvqp.limits import DEFAULT_QDD_MAX, Limit
+from dvqp.limits.limit import SceneLimits
+from dvqp.limits.registry import SCENE_LIMITS, constraint_keys
 from dvqp.motion.jog import DEFAULT_RAMP, MAX_STEPS, JogSegment, jog_step_count
 from dvqp.motion.path import ToolPath
 from dvqp.motion.saddle import SaddleWeld
@@ -58,9 +49,6 @@ PATH_KEYS = ("waypoints", "speed", "gain", "tolerance", "heading_tolerance", "ti
 FOLLOW_KEYS = PATH_KEYS[1:]
 ONE_MOTION = "give exactly one of [[motion.jog]] segments, a [motion.path] or a [motion.saddle]"
 SADDLE_KEYS = ("branch", "offset", "arc", "heading", "h", *FOLLOW_KEYS)
-SCENE_LIMITS = (ObstacleDamper, SurfaceHeight, ProbeHeight, TiltLimit, SelfCollision)
-"""The limits configured by the ``[constraints]`` table, in row order."""
-CONSTRAINT_KEYS = tuple(dict.fromkeys(key for cls in SCENE_LIMITS for key in cls.SCENE_KEYS))
 
 
 def pipe(f: Fields, doc: dict[str, Any]) -> tuple[float, float | None]:
@@ -78,7 +66,7 @@ def orbital_level(f: Fields, doc: dict[str, Any]) -> float:
 
 def min_height(f: Fields, doc: dict[str, Any]) -> float | None:
     """``constraints.min_height``, m (None: the scene does not set it)."""
-    t = f.table(doc, "constraints", "", CONSTRAINT_KEYS, required=False)
+    t = f.table(doc, "constraints", "", constraint_keys(), required=False)
     return f.number(t, "min_height", "constraints") if "min_height" in t else None
 
 
@@ -96,13 +84,11 @@ def objective(f: Fields, doc: dict[str, Any], k: int, obstacles: ObstacleSet) ->
 def limits(
     f: Fields, doc: dict[str, Any], robot: Robot, obstacles: ObstacleSet
 ) -> tuple[Limit, ...]:
-    """Joint position, velocity and acceleration limits (``[robot]``), then the dampers of
-    ``[constraints]`` (optional)."""
-    t = f.table(doc, "constraints", "", CONSTRAINT_KEYS, required=False)
-    values = {key: f.number(t, key, "constraints") for key in CONSTRAINT_KEYS if key in t}
-    damper = _configured(f, ObstacleDamper, values, obstacles)
-    height = _configured(f, SurfaceHeight, values)
-    probe, tilt = _configured(f, ProbeHeight, values), _configured(f, TiltLimit, values)
+    """Every limit of :data:`~dvqp.limits.registry.SCENE_LIMITS` the scene makes, in order:
+    the joints' (``[robot]``), then the dampers of ``[constraints]`` (optional)."""
+    keys = constraint_keys()
+    t = f.table(doc, "constraints", "", keys, required=False)
+    values = {key: f.number(t, key, "constraints") for key in keys if key in t}
     arm = doc.get("robot", {})
     qdd = f.vector(
         arm,
@@ -113,15 +99,16 @@ def limits(
         default=DEFAULT_QDD_MAX,
         within=JOINT_ACCELERATION,
     )
-    joints = (JointPositionLimit(robot), JointVelocityLimit(robot), AccelerationLimit(robot, qdd))
-    return (*joints, damper, height, probe, tilt, _configured(f, SelfCollision, values))
+    scene = SceneLimits(robot, obstacles, values, qdd)
+    made = (_configured(f, cls, scene) for cls in SCENE_LIMITS)
+    return tuple(limit for limit in made if limit is not None)
 
 
-def _configured(f: Fields, cls: Any, values: dict[str, float], *args: Any) -> Any:
-    """``cls(*args, **keys)`` from the scene keys it declares; errors name the scene key."""
-    keys: dict[str, str] = cls.SCENE_KEYS
+def _configured(f: Fields, cls: type[Limit], scene: SceneLimits) -> Limit | None:
+    """``cls.from_scene(scene)``; errors name the scene key."""
+    keys = cls.SCENE_KEYS
     try:
-        return cls(*args, **{param: values[key] for key, param in keys.items() if key in values})
+        return cls.from_scene(scene)
     except ParameterError as exc:
         field = next((key for key, param in keys.items() if param == exc.name), exc.name)
         f.fail(join("constraints", field), exc.reason)

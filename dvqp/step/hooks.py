@@ -162,7 +162,8 @@ class Hooks:
         def hook() -> None:
             found = limit.distances(self.view)
             _fits(limit.name, np.asarray(found.value).shape[0], count, exact=True)
-            distance[:], gradient[:], usable[:] = found.value, found.gradient, True
+            distance[:], gradient[:] = found.value, found.gradient
+            usable[:] = True if found.usable is None else found.usable
             safe[:] = verified[at] = found.safe
             if found.describe is not None:
                 self.describes[id(limit)] = found.describe

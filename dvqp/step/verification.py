@@ -10,7 +10,6 @@ from __future__ import annotations
 import numpy as np
 
 from dvqp.kinematics.robot import Robot
-from dvqp.limits import JointPositionLimit
 from dvqp.limits.excess import NO_EXCESS, Excess, StartBroken
 from dvqp.step.arrays import Pipeline
 from dvqp.step.build import Block, Layout
@@ -36,7 +35,7 @@ class Verification:
         i = int(np.argmax(np.where(np.isnan(ratio), np.inf, ratio)))
         broken = not over[i] <= 0.0  # past the floor, or NaN
         limit, label = self._named(i) if broken else (self._block(i).limit, "")
-        if limit is JointPositionLimit:
+        if not self._block(i).damper:  # the joints' room: reported as their positions
             n, at = self.robot.n, i - self._block(i).start
             q = float(self.arrays.state.q[at % n])
             bound = q - over[i] if at < n else q + over[i]
@@ -69,9 +68,7 @@ class Verification:
     def _start_broken(self, i: int) -> StartBroken:
         c, (limit, label) = self.arrays.checks, self._named(i)
         keys = [k for k in getattr(limit, "SCENE_KEYS", {}) if not k.startswith("damper_")]
-        kind = (
-            ("joint room", "rad") if limit is JointPositionLimit else (limit.quantity, limit.unit)
-        )  # type: ignore[attr-defined]
+        kind = (limit.quantity, limit.unit)  # type: ignore[attr-defined]
         values = (float(a[i]) for a in (c.safe, c.floor, c.lowest, c.tolerance))
         return StartBroken(keys[0] if keys else limit.name, label, *kind, *values)  # type: ignore[attr-defined]
 

@@ -9,14 +9,16 @@ dvqp's own task (:class:`~dvqp.tasks.ToolTask`) is compiled; a task of your own 
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.kinematics.state import KinematicState
 from dvqp.workspace import Kernel, StepPlan
+from dvqp.workspace.wiring import StepWiring
 
 
 @dataclass(frozen=True)
@@ -87,3 +89,14 @@ class Task:
         ``J`` and ``v`` from ``plan.state``, ``plan.command`` and ``plan.dt`` at every step.
         None (the default): :meth:`compute` is used."""
         return None
+
+    @property
+    def measured(self) -> Sequence[Any]:
+        """The obstacles whose distances the step must measure for this task (none)."""
+        return ()
+
+    def join(self, step: StepWiring) -> None:
+        """Join the run's step: a task of your own through the run's hooks (its
+        :meth:`kernel`, else :meth:`compute`); dvqp's own tasks write their rows in the
+        compiled step instead."""
+        step.hooks.task(self)

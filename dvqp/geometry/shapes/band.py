@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -9,7 +10,8 @@ import numpy as np
 
 from dvqp import _validate
 from dvqp.errors import ParameterError
-from dvqp.geometry.shapes.shape import Array, Shape
+from dvqp.geometry.shapes.shape import BAND, Array, CompiledShape, Shape
+from dvqp.workspace.wiring import overrides
 from solvers.jit import njit
 
 _FLAT = 1e-15
@@ -63,6 +65,14 @@ class Band(Shape):
     def z_range(self) -> tuple[float, float]:
         """``(z_min, z_max)``, m."""
         return self.z_min, self.z_max
+
+    def compiled(self) -> CompiledShape | None:
+        """``[z_min, z_max, 0, 0]``, measured by :func:`band_point` and :func:`band_segment`
+        (its box unbounded in l)."""
+        if overrides(self, Band, "point_distance", "segment_distance"):
+            return None
+        low, high = float(self.z_min), float(self.z_max)
+        return CompiledShape(BAND, (low, high, 0.0, 0.0), (-math.inf, math.inf, low, high))
 
     def outline(self) -> Array:
         """``[[nan, z_min], [nan, z_max]]``: a band has edges, not a closed outline."""

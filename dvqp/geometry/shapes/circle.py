@@ -10,8 +10,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp import _validate
-from dvqp.geometry.shapes.shape import Array, Shape
+from dvqp.geometry.shapes.shape import CIRCLE, Array, CompiledShape, Shape
 from dvqp.kinematics.developed_view import wrap_period
+from dvqp.workspace.wiring import overrides
 from solvers.jit import njit
 
 _TINY = 1e-12
@@ -64,6 +65,13 @@ class Circle(Shape):
     def z_range(self) -> tuple[float, float]:
         """``z ± radius``, m."""
         return float(self.center[1] - self.radius), float(self.center[1] + self.radius)
+
+    def compiled(self) -> CompiledShape | None:
+        """``[l, z, r, 0]``, measured by :func:`circle_point` and :func:`circle_segment`."""
+        if overrides(self, Circle, "point_distance", "segment_distance"):
+            return None
+        (l, z), r = self.center, self.radius
+        return CompiledShape(CIRCLE, (float(l), float(z), float(r), 0.0), (-r, r, z - r, z + r))
 
     def outline(self) -> Array:
         """128 points on the circle, closed, m."""

@@ -19,7 +19,8 @@ from numpy.typing import NDArray
 
 from dvqp import _validate
 from dvqp.errors import ParameterError
-from dvqp.geometry.shapes.shape import Array, Shape
+from dvqp.geometry.shapes.shape import INLET, Array, CompiledShape, Shape
+from dvqp.workspace.wiring import overrides
 from solvers.jit import njit
 
 SAMPLES = 32
@@ -100,6 +101,18 @@ class Inlet(Shape):
     def z_range(self) -> tuple[float, float]:
         """``z0 ± r``, m."""
         return float(self.center[1] - self.radius), float(self.center[1] + self.radius)
+
+    def compiled(self) -> CompiledShape | None:
+        """``[l0, z0, r, R]`` and its outline samples (from its centre), measured by
+        :func:`inlet_point` and :func:`inlet_segment`; its samples hold the tips
+        (φ = 0, π): their box is exact."""
+        if overrides(self, Inlet, "point_distance", "segment_distance"):
+            return None
+        (l, z), local = self.center, self.samples
+        low, high = local.min(axis=0), local.max(axis=0)
+        box = (float(low[0]), float(high[0]), float(low[1] + z), float(high[1] + z))
+        data = (float(l), float(z), float(self.radius), float(self.pipe_radius))
+        return CompiledShape(INLET, data, box, local)
 
     def outline(self) -> Array:
         """512 points of the exact outline, closed."""

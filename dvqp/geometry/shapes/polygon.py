@@ -16,7 +16,8 @@ import numpy as np
 from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry.shapes import polygon_geometry as geo
-from dvqp.geometry.shapes.shape import Array, Shape
+from dvqp.geometry.shapes.shape import POLYGON, Array, CompiledShape, Shape
+from dvqp.workspace.wiring import overrides
 from solvers.jit import njit
 
 
@@ -80,6 +81,16 @@ class Polygon(Shape):
     def z_range(self) -> tuple[float, float]:
         """Lowest and highest vertex z, m."""
         return float(self.vertices[:, 1].min()), float(self.vertices[:, 1].max())
+
+    def compiled(self) -> CompiledShape | None:
+        """``[l_ref, 0, 0, 0]`` and its vertices (l from ``l_ref``), measured by
+        :func:`polygon_point` and :func:`polygon_segment`."""
+        if overrides(self, Polygon, "point_distance", "segment_distance"):
+            return None
+        local = self.local_vertices
+        low, high = local.min(axis=0), local.max(axis=0)
+        box = (float(low[0]), float(high[0]), float(low[1]), float(high[1]))
+        return CompiledShape(POLYGON, (float(self.l_ref), 0.0, 0.0, 0.0), box, local)
 
     def outline(self) -> Array:
         """The vertices, closed."""

@@ -9,20 +9,48 @@ theorem). The objective's repulsion uses the penalty ``e = d (d + 2ρ)`` with ``
 ``‖S − p‖² − R²``). Differences in l are wrapped modulo ``2πR`` (``period``).
 
 dvqp's own shapes (circle, inlet, band, polygon) are measured by compiled kernels in their
-modules, called by :mod:`dvqp.geometry.measure`; a shape of your own derives from
-:class:`Shape` and implements :meth:`Shape.point_distance` and :meth:`Shape.segment_distance`
-in NumPy.
+modules: each says itself how (:meth:`Shape.compiled`: its kind's code, by which
+:mod:`dvqp.geometry.measure` calls its kernels, and its parameters); a shape of your own
+derives from :class:`Shape` and implements :meth:`Shape.point_distance` and
+:meth:`Shape.segment_distance` in NumPy. A subclass of a built-in shape inherits its compiled
+measurement, unless it replaces those methods.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 Array = NDArray[np.float64]
+
+CIRCLE, BAND, POLYGON, OTHER, INLET = 0, 1, 2, 3, 4
+"""Codes of the compiled shape kinds; OTHER is a shape of your own (measured in NumPy)."""
+
+
+@dataclass(frozen=True)
+class CompiledShape:
+    """How the compiled measurement reads one shape.
+
+    Attributes
+    ----------
+    code : int
+        Its kind's kernels: :data:`CIRCLE`, :data:`BAND`, :data:`POLYGON` or :data:`INLET`.
+    data : tuple of 4 floats
+        Its parameters (see :class:`~dvqp.geometry.measure.ShapeArrays`).
+    box : tuple of 4 floats
+        ``[l_lo, l_hi, z_lo, z_hi]`` (m), l from ``data[0]``.
+    samples : ndarray, shape (V, 2), optional
+        Its vertices or outline samples in its local frame (m).
+    """
+
+    code: int
+    data: tuple[float, float, float, float]
+    box: tuple[float, float, float, float]
+    samples: Array | None = None
 
 
 class Shape(ABC):
@@ -66,6 +94,11 @@ class Shape(ABC):
         A band has no bounded outline: it returns its two edges' z as a (2, 2) array
         ``[[nan, z_min], [nan, z_max]]``.
         """
+
+    def compiled(self) -> CompiledShape | None:
+        """How the compiled measurement reads this shape; None (a shape of your own): its
+        NumPy :meth:`point_distance` and :meth:`segment_distance`."""
+        return None
 
     def point_distance(self, lz: Array, period: float) -> tuple[Array, Array]:
         """Signed distance ``(m,)`` and normal ``(m, 2)`` of m points ``lz`` (m, 2), for a
