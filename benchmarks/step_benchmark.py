@@ -14,7 +14,9 @@ pseudoinverse), "solver" the time inside the QP backend's own calls (data update
 "rest" the full step less the solver. The peer line is
 pink's ``solve_ik`` (FrameTask on the tool frame, ConfigurationLimit, VelocityLimit, DAQP) on
 the same Pinocchio model, integration included (``pip install 'dvqp[bench]'``; skipped without
-it). Ratios compare medians measured in this same run. Timing is noisy on a shared machine:
+it). "daqp/subclassed" is DAQP on the scene with every part a plain subclass of its built-in
+class (the same compiled step: its ratio to daqp's should be about 1). Ratios compare medians
+measured in this same run. Timing is noisy on a shared machine:
 compare ratios, not absolute numbers across runs.
 """
 
@@ -72,6 +74,23 @@ def measure(scene_file: str, name: str) -> tuple[dict[str, np.ndarray], np.ndarr
     return {f: getattr(traj, f)[1:] for f in FIELDS}, traj.iterations[traj.iterations >= 0]
 
 
+SUBCLASSED = "daqp/subclassed"
+"""The DAQP run of the scene with every part a trivial subclass of its built-in class."""
+
+
+def measure_subclassed(scene_file: str) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """:func:`measure` of DAQP on the scene with every part (task, terms, limits, shapes) a
+    trivial subclass of its built-in class: the same compiled step, which should cost the
+    same."""
+    sys.path.insert(0, str(ROOT))
+    from tests.step.subclassing import subclassed_tool_task, swapped
+
+    scene, _ = swapped(dvqp.load_scene(scene_file))
+    with subclassed_tool_task():
+        traj = dvqp.plan(scene, "daqp")
+    return {f: getattr(traj, f)[1:] for f in FIELDS}, traj.iterations[traj.iterations >= 0]
+
+
 def pink_steps_of(scene_file: str) -> np.ndarray | None:
     """:func:`pink_steps` for as many steps as the scene has."""
     scene = dvqp.load_scene(scene_file)
@@ -104,13 +123,18 @@ def main(argv: list[str] | None = None) -> int:
         plain = default_resolvers()
         direct = [f"qpsolvers:{b}" for b in ("osqp", "clarabel", "daqp", "proxqp") if b in plain]
         backends = [*plain, *(b for b in direct if b in solvers.available_backends())]
+    if "daqp" in backends:
+        backends.insert(backends.index("daqp") + 1, SUBCLASSED)
     got: dict[str, dict[str, list[np.ndarray]]] = {b: {f: [] for f in FIELDS} for b in backends}
     iterations: dict[str, list[np.ndarray]] = {b: [] for b in backends}
     peer: list[np.ndarray] = []
     for r in range(args.repeat):
         order = backends[r % len(backends) :] + backends[: r % len(backends)]
         for name in order:
-            fields, its = isolated(measure, args.scene, name)
+            if name == SUBCLASSED:
+                fields, its = isolated(measure_subclassed, args.scene)
+            else:
+                fields, its = isolated(measure, args.scene, name)
             for f in FIELDS:
                 got[name][f].append(fields[f])
             iterations[name].append(its)
@@ -152,6 +176,9 @@ def report(scene, backends, got, iterations, peer, repeat) -> None:  # type: ign
             f"{b:<20} {m['step_time']:8.1f} {m['solve_time']:8.1f} {m['solver_time']:7.1f} "
             f"{rest:7.1f} {it} {ratio} {vs_pink} {vs}"
         )
+    if SUBCLASSED in med and "daqp" in med:
+        ratio = med[SUBCLASSED]["step_time"] / med["daqp"]["step_time"]
+        print(f"{SUBCLASSED}: every part a plain subclass, {ratio:.2f}x daqp's step (<= 1.3)")
     if pink_med is not None:
         print(f"{'pink (peer)':<20} {pink_med:8.1f}")
     else:

@@ -302,25 +302,7 @@ def judged(
     shape) this is :meth:`Solution.checked`, which copies ``x`` and names the problem.
     """
     residuals = passing(values, tolerance)
-    if residuals is not None:
-        return Solution(
-            problem,
-            x,
-            status,
-            True,
-            backend,
-            tolerance,
-            iterations,
-            0.0,
-            y,
-            z,
-            z_box,
-            residuals,
-            "",
-            False,
-            solver_time,
-        )
-    if values[0] == MISFIT:
+    if residuals is None and values[0] == MISFIT:
         return Solution.checked(
             problem,
             x,
@@ -333,23 +315,21 @@ def judged(
             z_box=z_box,
             solver_time=solver_time,
         )
-    return _verdict(
-        Solution(
-            problem,
-            x,
-            status,
-            False,
-            backend,
-            tolerance,
-            iterations,
-            0.0,
-            y,
-            z,
-            z_box,
-            None,
-            "",
-            False,
-            solver_time,
-        ),
-        values,
+    found = Solution(
+        problem,
+        x,
+        status,
+        residuals is not None,
+        backend,
+        tolerance,
+        iterations,
+        0.0,
+        y,
+        z,
+        z_box,
+        residuals,
+        "",
+        False,
+        solver_time,
     )
+    return found if residuals is not None else _verdict(found, values)

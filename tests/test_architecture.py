@@ -1,4 +1,5 @@
-"""The package's shape: short functions, small modules, grouped subpackages, no import cycle."""
+"""The package's shape: short functions, grouped subpackages, no import cycle (a module's length
+is a guide, never a cap: ruff format owns the layout, nothing packs lines to meet a size)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,6 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGES = ("dvqp", "solvers")
 MAX_FUNCTION_LINES = 60
-MAX_MODULE_LINES = 300
 MAX_TOP_LEVEL_MODULES = 15
 
 
@@ -57,16 +57,6 @@ def long_functions(path: Path) -> list[str]:
 @pytest.mark.parametrize("package", PACKAGES)
 def test_no_function_is_longer_than_sixty_lines_of_code(package: str) -> None:
     found = [entry for path in modules(package) for entry in long_functions(path)]
-    assert not found, found
-
-
-@pytest.mark.parametrize("package", PACKAGES)
-def test_no_module_is_longer_than_three_hundred_lines(package: str) -> None:
-    found = [
-        f"{p.relative_to(ROOT)} ({n})"
-        for p in modules(package)
-        if (n := len(p.read_text(encoding="utf-8").splitlines())) > MAX_MODULE_LINES
-    ]
     assert not found, found
 
 

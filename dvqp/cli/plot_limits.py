@@ -114,12 +114,12 @@ def _draw_panel(ax: Axes, panel: str, curves: list[Curve], page: LimitPage) -> N
 def _draw_marks(ax: Axes, page: LimitPage) -> None:
     """Each run of consecutive marked steps as one band over their duration, in its kind's
     colour."""
-    for kind in MARKS:
-        starts = page.marks[kind]
+    for mark in MARKS:
+        starts = page.marks[mark]
         cut = np.flatnonzero(np.diff(starts) > 1.5 * page.dt) + 1
         for run in np.split(starts, cut) if starts.shape[0] else ():
             ax.axvspan(
-                run[0], run[-1] + page.dt, color=MARK_COLOURS[kind], alpha=0.25, lw=0, zorder=1
+                run[0], run[-1] + page.dt, color=MARK_COLOURS[mark], alpha=0.25, lw=0, zorder=1
             )
 
 
@@ -129,7 +129,7 @@ def _mark_handles(page: LimitPage) -> list:
     from matplotlib.patches import Patch
 
     handles: list = [Line2D([], [], color="tab:red", ls="--", label="bound (shaded: past it)")]
-    for kind in MARKS:
-        count = page.marks[kind].shape[0]
-        handles.append(Patch(color=MARK_COLOURS[kind], alpha=0.4, label=f"{kind} steps ({count})"))
+    for mark in MARKS:
+        count = page.marks[mark].shape[0]
+        handles.append(Patch(color=MARK_COLOURS[mark], alpha=0.4, label=f"{mark} steps ({count})"))
     return handles

@@ -77,10 +77,10 @@ def _bounded_revolute(model: pin.Model) -> pin.Model:
 
 def _twin(joint: pin.JointModel) -> pin.JointModel | None:
     """The nq = 1 revolute joint of a continuous (nq = 2) one; None for any other joint."""
-    kind = joint.shortname()
-    if kind in UNBOUNDED_REVOLUTE:
-        return UNBOUNDED_REVOLUTE[kind]()
-    if kind != "JointModelRevoluteUnboundedUnaligned":
+    joint_type = joint.shortname()
+    if joint_type in UNBOUNDED_REVOLUTE:
+        return UNBOUNDED_REVOLUTE[joint_type]()
+    if joint_type != "JointModelRevoluteUnboundedUnaligned":
         return None
     data = joint.createData()  # the axis is not exposed: read it from the motion subspace
     joint.calc(data, np.array([1.0, 0.0]))

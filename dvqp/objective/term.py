@@ -47,7 +47,7 @@ class ObjectiveTerm:
 
     def evaluate(self, state: KinematicState) -> Term:
         """Value and gradient ``∂w/∂Q`` (shape (n,)) of the term at ``state``: implement it for
-        a term of your own (dvqp's terms are compiled and read through the step)."""
+        a term of your own (dvqp's terms return what their kernels add)."""
         raise NotImplementedError(f"{type(self).__name__} has no evaluate(state)")
 
     def kernel(self, plan: StepPlan) -> Kernel | None:

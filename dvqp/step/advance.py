@@ -128,15 +128,7 @@ def _attempt(
         found.solver_time,
         found.rate,
     )
-    broken = NO_EXCESS if reached else SINGULAR
-    if reached and verify and stepper.broken:
-        broken = stepper.excess()
-    elif reached and verify and motion[1] > JOINT_STRIDE:
-        record, end = int(stepper.record_at[0]), stepper.state.q.copy()
-        stepper.record_at[0] = -1
-        broken = straight_excess(stepper, q, end)
-        stepper.record_at[0] = record
-        stepper.load(end)
+    broken = _excess(stepper, q, verify) if reached else SINGULAR
     if not reached and (not verify or depth >= halvings):
         raise stepper.singular()
     if not verify or not broken.broken:
@@ -157,6 +149,21 @@ def _attempt(
     if not second.step.success:
         return Advance(second.step, first.substeps + second.substeps, second.excess)
     return _joined(q, stepper.state.q, first, second, dt)
+
+
+def _excess(stepper: Stepper, q: NDArray[np.float64], verify: bool) -> Excess:
+    """What the step just integrated from ``q`` breaks (if ``verify``): at its end, else, for a
+    large step, at interior points of its straight motion (the end is loaded again after)."""
+    if verify and stepper.broken:
+        return stepper.excess()
+    if not verify or stepper.motion[1] <= JOINT_STRIDE:
+        return NO_EXCESS
+    record, end = int(stepper.record_at[0]), stepper.state.q.copy()
+    stepper.record_at[0] = -1
+    broken = straight_excess(stepper, q, end)
+    stepper.record_at[0] = record
+    stepper.load(end)
+    return broken
 
 
 def straight_excess(stepper: Stepper, q: NDArray[np.float64], end: NDArray[np.float64]) -> Excess:

@@ -16,51 +16,17 @@ import numpy as np
 import pytest
 
 import dvqp
-from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.limits import SurfaceHeight
 from dvqp.limits.damper import Distances
-from dvqp.scenes import scene as scene_module
+from tests.step.subclassing import subclassed, subclassed_tool_task, swapped
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENE = ROOT / "scenes" / "paper-two-inlets.toml"
 
 
-def _subclassed(part: object) -> object:
-    """``part`` as an instance of a trivial subclass of its class (same state)."""
-    cls = type(part)
-    clone = object.__new__(type(f"My{cls.__name__}", (cls,), {}))
-    clone.__dict__.update(part.__dict__)
-    return clone
-
-
-def _swapped(scene: dvqp.Scene) -> tuple[dvqp.Scene, list[str]]:
-    """``scene`` with every limit, objective term and obstacle a trivial subclass."""
-    shapes = {id(s): _subclassed(s) for s in scene.obstacles}
-
-    def obstacles(found: ObstacleSet) -> ObstacleSet:
-        clone = object.__new__(ObstacleSet)
-        clone.__dict__.update(found.__dict__, obstacles=tuple(shapes[id(s)] for s in found))
-        return clone
-
-    parts = []
-    for part in (*scene.limits, *scene.objective.terms):
-        clone = _subclassed(part)
-        if "obstacles" in clone.__dict__:
-            clone.__dict__["obstacles"] = obstacles(clone.__dict__["obstacles"])
-        parts.append(clone)
-    limits, terms = parts[: len(scene.limits)], parts[len(scene.limits) :]
-    objective = dvqp.Objective(terms, scene.objective.gain)
-    swapped = dataclasses.replace(
-        scene, limits=tuple(limits), objective=objective, obstacles=obstacles(scene.obstacles)
-    )
-    return swapped, [type(p).__name__ for p in parts]
-
-
-def test_every_builtin_of_the_paper_scene_subclassed_plans_the_same_trajectory(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_every_builtin_of_the_paper_scene_subclassed_plans_the_same_trajectory() -> None:
     scene = dvqp.load_scene(SCENE)
-    swapped, names = _swapped(scene)
+    changed, names = swapped(scene)
     assert set(names) >= {
         "MyJointPositionLimit",
         "MyJointVelocityLimit",
@@ -75,16 +41,16 @@ def test_every_builtin_of_the_paper_scene_subclassed_plans_the_same_trajectory(
         "MyObstacleLinks",
     }
     reference = dvqp.plan(scene, "daqp")
-    monkeypatch.setattr(scene_module, "ToolTask", type("MyToolTask", (dvqp.ToolTask,), {}))
-    assert type(swapped.spec().tasks[0]).__name__ == "MyToolTask"
-    found = dvqp.plan(swapped, "daqp")
+    with subclassed_tool_task():
+        assert type(changed.spec().tasks[0]).__name__ == "MyToolTask"
+        found = dvqp.plan(changed, "daqp")
     assert reference.q.shape == found.q.shape
     np.testing.assert_allclose(found.q, reference.q, rtol=0.0, atol=1e-9)
-    assert dvqp.check_run(swapped, found) is None
+    assert dvqp.check_run(changed, found) is None
     # the same compiled step, not the hooks of parts of your own: the same cost a step
     # (benchmarks/step_benchmark.py prints the two steps' medians side by side)
-    resolver = dvqp.make_resolver("daqp", swapped.spec())
-    stepper = dvqp.Stepper(swapped.robot, swapped.pipe_radius, resolver, swapped.q0, swapped.dt)
+    resolver = dvqp.make_resolver("daqp", changed.spec())
+    stepper = dvqp.Stepper(changed.robot, changed.pipe_radius, resolver, changed.q0, changed.dt)
     assert not stepper.layout.hooks.active
 
 
@@ -118,7 +84,7 @@ def test_a_subclassed_shape_keeps_its_compiled_measurement(shape: str) -> None:
         "Band": lambda: kinds.Band(0.1, 0.2),
         "Polygon": lambda: kinds.Polygon(np.array([[0.0, 0.0], [0.1, 0.0], [0.0, 0.1]])),
     }[shape]()
-    mine = _subclassed(base)
+    mine = subclassed(base)
     assert isinstance(mine, cls)
     ours, theirs = mine.compiled(), base.compiled()
     assert ours is not None and theirs is not None

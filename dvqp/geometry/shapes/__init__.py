@@ -1,8 +1,9 @@
 """Obstacle shapes in the developed view, one per module, and the list of them.
 
-Adding a shape: a new module with a :class:`Shape` subclass, its ``kind`` in :data:`SHAPES`
-(the scene file reads its keys in :mod:`dvqp.scenes.obstacles`), and its compiled distances in
-:mod:`dvqp.geometry.measure`.
+Adding a shape: a new module with a :class:`Shape` subclass and its ``kind`` in :data:`SHAPES`
+(the scene file reads its keys in :mod:`dvqp.scenes.obstacles`); it is measured by its NumPy
+methods, or by compiled kernels if it says so (:meth:`Shape.compiled`, a code that
+:mod:`dvqp.geometry.measure` calls them by).
 """
 
 from dvqp.geometry.shapes.band import Band
