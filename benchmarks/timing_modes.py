@@ -20,9 +20,9 @@ from pathlib import Path
 import numpy as np
 
 import dvqp
-from dvqp.comparison import summarize
 from dvqp.motion.schedule import path_deviation
-from dvqp.planning import scene_commands
+from dvqp.run.comparison import summarize
+from dvqp.run.planning import scene_commands
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -12,8 +12,10 @@ The pieces, from the bottom up (one subpackage each):
 - :mod:`dvqp.resolution` — :class:`StepSpec`, the QP and pseudoinverse resolvers, their names;
 - :mod:`dvqp.step` — the compiled step (:class:`Stepper`) and one verified step (``advance``);
 - :mod:`dvqp.motion` — JOG and path commands, :func:`simulate`, :class:`Trajectory`;
-- :mod:`dvqp.scenes` — scene files; :func:`plan` runs one with a named backend, and
-  :func:`export_qps` writes each QP of such a run to a file.
+- :mod:`dvqp.scenes` — scene files;
+- :mod:`dvqp.run` — the run level: :func:`plan` runs a scene with a named backend,
+  :func:`export_qps` writes each QP of such a run to a file, and backends are compared
+  (:mod:`dvqp.run.comparison`).
 """
 
 from dvqp._versions import __version__
@@ -33,10 +35,10 @@ from dvqp.kinematics import KinematicState, Robot
 from dvqp.limits import Bounds, Constraint, Distances, Limit, VelocityDamper
 from dvqp.motion import JogSegment, ToolPath, Trajectory, jog_commands, simulate
 from dvqp.objective import Objective, ObjectiveTerm, Term
-from dvqp.planning import check_run, plan
-from dvqp.qp_export import export_qps
 from dvqp.resolution import PseudoinverseResolver, QPResolver, Resolver, StepSpec, make_resolver
 from dvqp.resolution.step import Step
+from dvqp.run.planning import check_run, plan
+from dvqp.run.qp_export import export_qps
 from dvqp.scenes import Scene, load_scene
 from dvqp.step import Stepper
 from dvqp.tasks import Task, TaskRows, ToolTask

@@ -22,8 +22,8 @@ from dvqp import (
     ToolTask,
 )
 from dvqp.limits import AccelerationLimit, ObstacleDamper
-from dvqp.planning import scene_commands
 from dvqp.resolution import make_resolver
+from dvqp.run.planning import scene_commands
 from dvqp.step import JOINT_STRIDE, MAX_HALVINGS, advance
 from dvqp.step.engine import Resolution
 from tests.common import PIPE_RADIUS, Q0

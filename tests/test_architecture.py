@@ -142,7 +142,7 @@ def test_imports_in_functions_under_type_checking_and_relative_ones_count() -> N
     source = (
         "from typing import TYPE_CHECKING\n"
         "if TYPE_CHECKING:\n    from dvqp.step import Stepper\n"
-        "def f():\n    from ..proximity import measure\n    import dvqp.planning\n"
+        "def f():\n    from ..proximity import measure\n    import dvqp.run.planning\n"
         "from . import band\n"
     )
     names = {module_name(p) for p in modules("dvqp")}
@@ -150,7 +150,8 @@ def test_imports_in_functions_under_type_checking_and_relative_ones_count() -> N
     assert found == {
         "dvqp.step",
         "dvqp.geometry.proximity",
-        "dvqp.planning",
+        "dvqp.run.planning",
+        "dvqp.run",
         "dvqp.geometry.shapes.band",
     }
     # a module of another package runs that package's __init__ first
@@ -160,6 +161,35 @@ def test_imports_in_functions_under_type_checking_and_relative_ones_count() -> N
     }
     cycle = find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}})
     assert cycle == ["a", "b", "c", "a"]
+
+
+def facade_imports(source: str, modules: set[str]) -> list[str]:
+    """The imports in ``source`` (anywhere) that take a name from the facade ``dvqp/__init__``:
+    ``import dvqp`` or ``from dvqp import X`` where ``dvqp.X`` is no module of the package."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            found += [f"{node.lineno}: import dvqp" for a in node.names if a.name == "dvqp"]
+        elif isinstance(node, ast.ImportFrom) and node.module == "dvqp" and not node.level:
+            found += [
+                f"{node.lineno}: from dvqp import {a.name}"
+                for a in node.names
+                if f"dvqp.{a.name}" not in modules
+            ]
+    return found
+
+
+def test_no_module_of_the_package_imports_the_facade() -> None:
+    names = {module_name(p) for p in modules("dvqp")}
+    found = [
+        f"{path.relative_to(ROOT)}:{entry}"
+        for path in modules("dvqp")
+        if module_name(path) != "dvqp"
+        for entry in facade_imports(path.read_text(encoding="utf-8"), names)
+    ]
+    assert not found, found
+    source = "import dvqp\nfrom dvqp import _validate\ndef f():\n    from dvqp import plan\n"
+    assert facade_imports(source, names) == ["1: import dvqp", "4: from dvqp import plan"]
 
 
 def test_the_bottom_package_imports_no_domain_module() -> None:

@@ -12,7 +12,7 @@ import pytest
 import solvers
 from dvqp import Trajectory, load_scene, plan
 from dvqp.cli import main
-from dvqp.comparison import summarize
+from dvqp.run.comparison import summarize
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 INFEASIBLE = solvers.Problem(

@@ -11,7 +11,7 @@ import numpy as np
 
 from dvqp import Constraint, KinematicState, QPResolver, Scene, Stepper, Trajectory, plan
 from dvqp.limits import ObstacleDamper, SurfaceHeight
-from dvqp.planning import check_run, scene_commands
+from dvqp.run.planning import check_run, scene_commands
 from dvqp.scenes.scene import loads
 from tests.oracle_limits import measure
 from tests.runs import run, scene

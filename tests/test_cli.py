@@ -543,7 +543,7 @@ def test_the_time_left_counts_from_the_first_step_not_from_compiling(
 def test_a_quiet_worker_ends_on_ctrl_c_without_a_word() -> None:
     code = (
         "import os, signal, time\n"
-        "from dvqp.comparison import quiet_worker\n"
+        "from dvqp.run.comparison import quiet_worker\n"
         "quiet_worker()\n"
         "os.kill(os.getpid(), signal.SIGINT)\n"
         "time.sleep(5)\n"

@@ -21,8 +21,8 @@ from dvqp import Bounds, Limit, ObjectiveTerm, QPResolver, Stepper, Term
 from dvqp.geometry.bend import PRECISION
 from dvqp.motion.simulate import dv_error
 from dvqp.objective import OrbitalLevel
-from dvqp.planning import scene_commands, scene_timing
 from dvqp.resolution.pinv import PseudoinverseResolver
+from dvqp.run.planning import scene_commands, scene_timing
 from tests import safety
 from tests.oracle_resolution import (
     eq18,

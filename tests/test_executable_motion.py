@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import dvqp
-from dvqp.comparison import summarize
 from dvqp.limits import AccelerationLimit, SelfCollision, self_distance
+from dvqp.run.comparison import summarize
 from tests.oracle_resolution import frames, self_distances
 from tests.runs import BUNDLED, QP, run, scene
 

@@ -19,7 +19,7 @@ import dvqp
 import solvers
 import solvers.tiers
 from dvqp.cli.main import main
-from dvqp.qp_export import ANSWERS, INDEX
+from dvqp.run.qp_export import ANSWERS, INDEX
 from solvers.residuals import failed_checks, kkt_residuals
 
 SCENE = """

@@ -11,7 +11,7 @@ import pytest
 from dvqp import Scene, Trajectory
 from dvqp.cli import main
 from dvqp.cli.report import format_summary
-from dvqp.comparison import summarize
+from dvqp.run.comparison import summarize
 from tests import runs
 from tests.oracle_limits import chord_low, guarded_links, link_name
 from tests.oracle_resolution import frames

@@ -6,12 +6,12 @@ from __future__ import annotations
 import pytest
 
 from dvqp import SceneError, plan
-from dvqp.comparison import run_error, summarize
 from dvqp.console.recording import Sample
 from dvqp.geometry import ObstacleSet
 from dvqp.geometry.shapes import Circle
 from dvqp.limits import ObstacleDamper
 from dvqp.resolution.registry import make_resolver
+from dvqp.run.comparison import run_error, summarize
 from dvqp.scenes import loads
 from dvqp.step import Stepper
 from tests.runs import SCENES, run

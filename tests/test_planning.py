@@ -13,8 +13,8 @@ from dvqp import BackendError, KinematicState, Trajectory, plan
 from dvqp.errors import UnreachableTargetError
 from dvqp.motion.path import ToolPath
 from dvqp.motion.simulate import dv_error
-from dvqp.planning import check_run, scene_commands
 from dvqp.resolution.registry import available_resolvers, default_resolvers
+from dvqp.run.planning import check_run, scene_commands
 from dvqp.scenes.scene import Scene, loads
 from tests.common import PIPE_RADIUS
 

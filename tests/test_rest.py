@@ -19,11 +19,11 @@ import dvqp
 import solvers
 from dvqp import Bounds, Limit, Scene, Trajectory
 from dvqp.cli.report import format_summary
-from dvqp.comparison import summarize
 from dvqp.errors import UnreachableTargetError
 from dvqp.limits import AccelerationLimit, JointVelocityLimit
 from dvqp.motion.stop import MARGIN, braking_steps, room
-from dvqp.planning import check_run, scene_commands, scene_timing
+from dvqp.run.comparison import summarize
+from dvqp.run.planning import check_run, scene_commands, scene_timing
 from dvqp.scenes.scene import loads
 from tests.runs import BUNDLED, QP, run, scene
 

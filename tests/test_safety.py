@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 import dvqp
 from dvqp.geometry import link_bends
 from dvqp.geometry.bend import PRECISION
-from dvqp.planning import final_errors
+from dvqp.run.planning import final_errors
 from tests import safety
 from tests.runs import QP, SCENES, run, scene
 

@@ -14,7 +14,7 @@ import pytest
 import solvers
 from dvqp import ParameterError, load_scene, plan
 from dvqp.cli import main
-from dvqp.comparison import summarize
+from dvqp.run.comparison import summarize
 from solvers.tiers import EPS, SETTING_NAMES, TIERS, tier_settings
 from tests.test_cli import write_scene
 

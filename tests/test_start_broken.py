@@ -13,11 +13,11 @@ import pytest
 from dvqp import DvqpError, Trajectory, plan
 from dvqp.cli import main
 from dvqp.cli.report import format_summary
-from dvqp.comparison import summarize
 from dvqp.kinematics import KinematicState
 from dvqp.limits import ObstacleDamper, SurfaceHeight
 from dvqp.motion.recorder import TrajectoryRecorder
 from dvqp.resolution.pinv import PseudoinverseResolver
+from dvqp.run.comparison import summarize
 from dvqp.scenes import loads
 from dvqp.step import Stepper
 from tests.oracle_limits import measure

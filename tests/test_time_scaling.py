@@ -12,8 +12,8 @@ import dvqp
 from dvqp.cli.main import main
 from dvqp.errors import ParameterError, SceneError, UnreachableTargetError
 from dvqp.motion.schedule import Schedule, path_deviation
-from dvqp.planning import check_run, path_figures, scene_commands
 from dvqp.resolution.qp import QPSolver, make_backend
+from dvqp.run.planning import check_run, path_figures, scene_commands
 from dvqp.scenes.scene import loads
 from dvqp.workspace import QPBuffers
 from tests.test_cli import no_traceback

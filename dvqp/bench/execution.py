@@ -28,7 +28,7 @@ from multiprocessing.context import BaseContext
 
 from dvqp.bench.generate import BenchScene, generate_scene
 from dvqp.bench.runner import Job, Row, lost_rows, run_job
-from dvqp.comparison import quiet_worker
+from dvqp.run.comparison import quiet_worker
 
 Progress = Callable[[int, int, str], None]
 """``progress(done, total, label)``, counting runs (scene × backend)."""

@@ -23,7 +23,7 @@ from dvqp.bench.toml_text import Table, dumps
 from dvqp.errors import DvqpError, ParameterError
 from dvqp.geometry import min_clearance
 from dvqp.kinematics import KinematicState, Robot
-from dvqp.planning import scene_commands
+from dvqp.run.planning import scene_commands
 from dvqp.scenes import Scene, loads
 
 PIPE_RADIUS = 0.254

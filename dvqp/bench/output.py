@@ -15,9 +15,9 @@ from typing import IO, Any
 from dvqp._versions import versions
 from dvqp.bench.execution import Where
 from dvqp.bench.runner import EXTRA_FIELDS, Row, is_lost
-from dvqp.comparison import FIELDS, machine
-from dvqp.comparison import rows_to_csv as csv_text
-from dvqp.table_text import aligned, cell
+from dvqp.run.comparison import FIELDS, machine
+from dvqp.run.comparison import rows_to_csv as csv_text
+from dvqp.run.table_text import aligned, cell
 
 COLUMNS = (  # (summary key, header, format of a defined value)
     ("runs", "runs", "{}"),

@@ -12,10 +12,10 @@ from typing import Any
 
 import numpy as np
 
-from dvqp.comparison import Row, add_ratios, error_row, summarize
 from dvqp.errors import DvqpError
 from dvqp.motion import Trajectory
-from dvqp.planning import plan
+from dvqp.run.comparison import Row, add_ratios, error_row, summarize
+from dvqp.run.planning import plan
 from dvqp.scenes import Scene, loads
 
 EXTRA_FIELDS = (
@@ -28,7 +28,7 @@ EXTRA_FIELDS = (
     "total_step_s",
     "capped_calls",
 )
-"""Keys a bench row adds to :data:`dvqp.comparison.FIELDS`, after ``index`` (its first key)."""
+"""Keys a bench row adds to :data:`dvqp.run.comparison.FIELDS`, after ``index`` (its first key)."""
 
 WORKER_LOST = "worker lost"
 """The ``error`` of a run whose worker died (twice) before answering."""
@@ -53,9 +53,9 @@ class Job:
 def run_job(job: Job, on_run: Callable[[str], None] | None = None) -> list[Row]:
     """Load the scene and run it with every backend; one row per backend, in order.
 
-    The rows are those of :func:`dvqp.comparison.summarize` with ``ratio_to_pinv`` and
+    The rows are those of :func:`dvqp.run.comparison.summarize` with ``ratio_to_pinv`` and
     :data:`EXTRA_FIELDS`; a run that raises a :class:`~dvqp.errors.DvqpError` gives a
-    :func:`dvqp.comparison.error_row`. ``on_run(backend)`` is called after each run.
+    :func:`dvqp.run.comparison.error_row`. ``on_run(backend)`` is called after each run.
     """
     scene = loads(job.text, f"{job.name}.toml")
     rows = []
@@ -75,7 +75,8 @@ def run_job(job: Job, on_run: Callable[[str], None] | None = None) -> list[Row]:
 
 def lost_rows(job: Job, reason: str = WORKER_LOST) -> list[Row]:
     """The rows of a scene whose worker gave no answer: one per backend, as a run that raised
-    (:func:`dvqp.comparison.error_row`) with ``error`` ``reason`` (beginning as :data:`LOST`)."""
+    (:func:`dvqp.run.comparison.error_row`) with ``error`` ``reason`` (beginning as
+    :data:`LOST`)."""
     scene = loads(job.text, f"{job.name}.toml")
     error = DvqpError(reason)
     return [_with_scene(job, scene, error_row(scene, b, error, EXTRA_FIELDS)) for b in job.backends]
@@ -93,7 +94,7 @@ def _with_scene(job: Job, scene: Scene, row: Row) -> Row:
 
 
 def _figures(scene: Scene, traj: Trajectory, tier: str) -> Row:
-    """:func:`dvqp.comparison.summarize`'s figures, then the bench's timings (µs, s)."""
+    """:func:`dvqp.run.comparison.summarize`'s figures, then the bench's timings (µs, s)."""
     steps_us, solve_us = traj.step_time * 1e6, traj.solve_time * 1e6
     return {
         **summarize(scene, traj, tier),

@@ -8,12 +8,11 @@ import sys
 from pathlib import Path
 from typing import Any
 
-import dvqp
 import solvers
 from dvqp.errors import DvqpError
 from solvers.jit import entry_files
 
-ROOTS = [Path(dvqp.__file__).parent, Path(solvers.__file__).parent]
+ROOTS = [Path(__file__).parent.parent, Path(solvers.__file__).parent]
 """The packages whose compiled functions the cache commands see."""
 
 

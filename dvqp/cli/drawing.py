@@ -22,8 +22,8 @@ from dvqp.kinematics.developed_view import unwrap, wrap
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from dvqp import Trajectory
     from dvqp.geometry.shapes import Shape
+    from dvqp.motion.trajectory import Trajectory
 
 SHIFTS = (-1, 0, 1)
 """Copies of seam-periodic drawings, in periods ``2πR``."""

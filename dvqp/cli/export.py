@@ -1,6 +1,6 @@
 """``dvqp export-qps SCENE --backend NAME -o DIR``: every QP of a run as a qpsolvers file.
 
-See ``docs/qp-export.md`` (:mod:`dvqp.qp_export` writes it).
+See ``docs/qp-export.md`` (:mod:`dvqp.run.qp_export` writes it).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from typing import Any
 from dvqp.cli import solver_option
 from dvqp.cli.progress import ProgressBar, check_size
 from dvqp.cli.solver_option import solver_options
-from dvqp.qp_export import INDEX, export_qps
+from dvqp.run.qp_export import INDEX, export_qps
 from dvqp.scenes import load_scene
 
 

@@ -20,10 +20,8 @@ import os
 import sys
 from collections.abc import Sequence
 
-from dvqp import __version__, load_scene, plan
-from dvqp import comparison as cmp
 from dvqp._files import output_path
-from dvqp._versions import versions
+from dvqp._versions import __version__, versions
 from dvqp.cli import bench as bench_cmd
 from dvqp.cli import cache as cache_cmd
 from dvqp.cli import console as console_cli
@@ -37,13 +35,15 @@ from dvqp.cli.report import format_summary, format_table, rows_to_csv, write_tex
 from dvqp.cli.solver_option import solver_options
 from dvqp.errors import DvqpError, SingularConfigurationError, one_line
 from dvqp.motion.schedule import TIMINGS
-from dvqp.planning import scene_timing
 from dvqp.resolution.registry import (
     PINV,
     check_name,
     default_resolvers,
     describe_resolvers,
 )
+from dvqp.run import comparison as cmp
+from dvqp.run.planning import plan, scene_timing
+from dvqp.scenes.scene import load_scene
 
 __all__ = ["format_table", "main"]
 

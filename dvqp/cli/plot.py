@@ -33,8 +33,8 @@ if TYPE_CHECKING:
     from matplotlib.cm import ScalarMappable
     from matplotlib.figure import Figure
 
-    from dvqp import Trajectory
     from dvqp.geometry.shapes import Shape
+    from dvqp.motion.trajectory import Trajectory
 
 __all__ = ["FIGURE_FORMATS", "animate_trajectory", "plot_trajectory"]
 

@@ -1,4 +1,4 @@
-"""A figure of a backend comparison (the rows of :func:`dvqp.comparison.compare`)."""
+"""A figure of a backend comparison (the rows of :func:`dvqp.run.comparison.compare`)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from dvqp._files import output_path
 from dvqp.cli.figures import FIGURE_FORMATS, new_figure, save_figure
 
 if TYPE_CHECKING:
-    from dvqp.comparison import Row
+    from dvqp.run.comparison import Row
 
 
 def plot_comparison(rows: Sequence[Row], path: str | Path) -> Path:

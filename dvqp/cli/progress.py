@@ -21,7 +21,8 @@ from dvqp.errors import SceneError, one_line
 from dvqp.motion.jog import jog_step_count
 
 if TYPE_CHECKING:
-    from dvqp import Robot, Scene
+    from dvqp.kinematics.robot import Robot
+    from dvqp.scenes.scene import Scene
 
 STEP_SECONDS = 1e-4
 """Typical time of one step, s: the estimate's rate. A compiled step with DAQP takes about

@@ -1,7 +1,7 @@
 """What the command line prints and writes: the comparison table, a run's summary, CSV.
 
-The rows are those of :func:`dvqp.comparison.summarize`; an undefined figure (None) is shown
-as ``-`` in the table and as an empty CSV cell (:func:`dvqp.comparison.rows_to_csv`).
+The rows are those of :func:`dvqp.run.comparison.summarize`; an undefined figure (None) is shown
+as ``-`` in the table and as an empty CSV cell (:func:`dvqp.run.comparison.rows_to_csv`).
 """
 
 from __future__ import annotations
@@ -11,14 +11,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from dvqp.cli.figures import write_atomic
-from dvqp.comparison import Row
-from dvqp.comparison import rows_to_csv as rows_to_csv  # part of this module's API (docs)
 from dvqp.errors import one_line
 from dvqp.limits import start_broken_lines
-from dvqp.table_text import aligned, cell
+from dvqp.run.comparison import Row
+from dvqp.run.comparison import rows_to_csv as rows_to_csv  # part of this module's API (docs)
+from dvqp.run.table_text import aligned, cell
 
 if TYPE_CHECKING:
-    from dvqp import Scene, Trajectory
+    from dvqp.motion.trajectory import Trajectory
+    from dvqp.scenes.scene import Scene
 
 TABLE = (  # (row key, header, format)
     ("scene", "scene", "{}"),
@@ -61,7 +62,7 @@ def format_table(rows: Sequence[Row]) -> str:
 
 
 def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None) -> str:
-    """What ``dvqp plan`` prints about a run: ``row`` from :func:`dvqp.comparison.summarize`,
+    """What ``dvqp plan`` prints about a run: ``row`` from :func:`dvqp.run.comparison.summarize`,
     ``output`` the file the trajectory was saved to (or None)."""
     tool = traj.tool[-1]
     lines = [

@@ -23,7 +23,7 @@ Array = NDArray[np.float64]
 
 MAX_SLOWDOWN = 4.0
 """A time-scaled run takes at most this many times its nominal steps; a path not finished by
-then is reported as not reached (:func:`dvqp.planning.check_run`)."""
+then is reported as not reached (:func:`dvqp.run.planning.check_run`)."""
 
 TIMINGS = ("fixed", "scaled")
 """How a path's progress is timed: the nominal schedule, or slowed where the limits bind."""

@@ -16,19 +16,20 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp import load_scene, plan
 from dvqp.errors import DvqpError
 from dvqp.geometry import proximity
 from dvqp.kinematics import KinematicState
 from dvqp.limits import lowest_link, self_distance, start_broken_lines
-from dvqp.planning import check_run, path_figures
 from dvqp.resolution.registry import PINV
-from dvqp.sample_checks import final_errors, worst_sample_excess
-from dvqp.table_text import csv_text
+from dvqp.run.planning import check_run, path_figures, plan
+from dvqp.run.sample_checks import final_errors, worst_sample_excess
+from dvqp.run.table_text import csv_text
+from dvqp.scenes.scene import load_scene
 from solvers.accuracy import METRICS
 
 if TYPE_CHECKING:
-    from dvqp import Scene, Trajectory
+    from dvqp.motion.trajectory import Trajectory
+    from dvqp.scenes.scene import Scene
 
 FIELDS = (
     "scene",
@@ -97,11 +98,11 @@ def summarize(scene: Scene, traj: Trajectory, settings: str = "default") -> Row:
     """The figures of one run of ``scene`` (``traj`` from :func:`dvqp.plan` under the
     ``settings`` tier, :mod:`solvers.tiers`), as a dict:
 
-    ``success``: the run can be sent to the arm (:func:`dvqp.planning.check_run`); ``error``
+    ``success``: the run can be sent to the arm (:func:`dvqp.run.planning.check_run`); ``error``
     says why not. ``steps``; ``failures`` (steps not solved or that broke a limit even in
     substeps); ``slowed`` (a time-scaled path's progress slowed to keep the limits; a path's
     ``nominal_duration``, ``path_duration`` and ``max_deviation`` are those of
-    :func:`dvqp.planning.path_figures`); ``relaxed`` (the task gave way to a limit) and
+    :func:`dvqp.run.planning.path_figures`); ``relaxed`` (the task gave way to a limit) and
     ``braking`` (the limits conflicted: the arm slowed toward rest); ``substepped``;
     median and 95th-percentile full step time (µs), the medians of the solver call alone and
     of the rest of the step (µs) and of the solver's iterations; the backend calls refused (no
@@ -231,7 +232,7 @@ def _limit_figures(scene: Scene, traj: Trajectory) -> Row:
 
 
 def run_error(scene: Scene, traj: Trajectory) -> str | None:
-    """Why a planned run failed (:func:`dvqp.planning.check_run`'s message), or None."""
+    """Why a planned run failed (:func:`dvqp.run.planning.check_run`'s message), or None."""
     try:
         check_run(scene, traj)
     except DvqpError as exc:

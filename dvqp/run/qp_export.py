@@ -25,8 +25,8 @@ import solvers
 from dvqp._versions import __version__
 from dvqp.errors import LimitViolationError, OutputError, ParameterError, UnreachableTargetError
 from dvqp.motion.trajectory import Trajectory
-from dvqp.planning import backend_settings, check_run, plan
 from dvqp.resolution.registry import PINV, check_name
+from dvqp.run.planning import backend_settings, check_run, plan
 from dvqp.scenes.scene import Scene
 
 INDEX = "index.json"
@@ -64,7 +64,7 @@ def export_qps(
 
     The files are written into a temporary folder beside ``folder``, renamed to it once all
     are written: an error or an interrupt leaves nothing. A failed run is exported too (its
-    index's ``error`` says why :func:`~dvqp.planning.check_run` fails it).
+    index's ``error`` says why :func:`~dvqp.run.planning.check_run` fails it).
 
     Parameters
     ----------
@@ -76,7 +76,7 @@ def export_qps(
         Settings of the backend, over the scene's ``[solvers.<backend>]`` ones, over the
         settings ``tier``'s (:mod:`solvers.tiers`; the index's ``tier`` and ``settings``).
     progress, notice
-        As :func:`~dvqp.planning.plan`'s.
+        As :func:`~dvqp.run.planning.plan`'s.
 
     Raises
     ------

@@ -25,7 +25,7 @@ from dvqp.motion.schedule import MAX_SLOWDOWN, TIMINGS, path_deviation
 from dvqp.motion.simulate import StepWatcher, dv_error, simulate
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.registry import make_resolver, tier_options
-from dvqp.sample_checks import final_errors, worst_sample_excess
+from dvqp.run.sample_checks import final_errors, worst_sample_excess
 from dvqp.scenes.scene import Scene
 from dvqp.tasks import Task
 
