@@ -51,9 +51,6 @@ def run(args: argparse.Namespace) -> int:
             tier=args.settings,
             force=args.force,
             progress=lambda k, n: bar.show(k, n, "steps"),
-            notice=lambda text: (
-                bar.note(text) if text.startswith("compiled") else bar.show(0, 1, text)
-            ),
         )
     index = exported.index
     kinds = Counter(entry["kind"] for entry in index["problems"])

@@ -29,6 +29,7 @@ from dvqp.cli import export as export_cmd
 from dvqp.cli import plot_command, solver_option
 from dvqp.cli import retime as retime_cli
 from dvqp.cli import view as view_cli
+from dvqp.cli.compiling import announced
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
 from dvqp.cli.report import format_summary, format_table, rows_to_csv, write_text
@@ -74,7 +75,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _run(args: argparse.Namespace) -> int:
     """Run the subcommand; a dvqp error is its one line on stderr and exit code 2."""
     try:
-        return int(args.run(args))
+        with announced(getattr(args, "command", "")):
+            return int(args.run(args))
     except DvqpError as exc:
         print(f"dvqp: {one_line(str(exc))}", file=sys.stderr)
         return 2
@@ -88,7 +90,7 @@ def _parser() -> argparse.ArgumentParser:
         "failed, 2 bad input (nothing written), 130 interrupted",
     )
     parser.add_argument("--version", action="version", version=f"dvqp {__version__}")
-    sub = parser.add_subparsers(title="commands", metavar="COMMAND")
+    sub = parser.add_subparsers(title="commands", metavar="COMMAND", dest="command")
     p = sub.add_parser("plan", help="run a scene and save its trajectory")
     p.add_argument("scene", help="scene file (.toml)")
     p.add_argument("--backend", default="daqp", help="pinv or a QP backend (default: daqp)")
@@ -156,14 +158,6 @@ def _positive_int(text: str) -> int:
     return value
 
 
-def _notice(bar: ProgressBar, text: str) -> None:
-    """While compiling, the bar says so; once done, a line says how long it took."""
-    if text.startswith("compiled"):
-        bar.note(text)
-    else:
-        bar.show(0, 1, text)
-
-
 def _plan(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     formats = retime_cli.FORMATS if args.retime else (".npz", ".csv")
@@ -179,7 +173,6 @@ def _plan(args: argparse.Namespace) -> int:
                 scene,
                 args.backend,
                 progress=lambda k, n: bar.show(k, n, "steps"),
-                notice=lambda text: _notice(bar, text),
                 options=options,
                 tier=args.settings,
                 timing=args.timing,
