@@ -281,10 +281,8 @@ class Stepper(Verification):
     def rows(self, limit: Limit) -> Constraint | Bounds:
         """What ``limit`` put in the problem of the last :meth:`prepare`: its rows that apply
         (``h`` finite; labelled), or for a box limit the box of all box limits, intersected."""
-        qp, block = (
-            self.arrays.qp,
-            next((b for b in self.layout.blocks if b.limit is limit and b.damper), None),
-        )
+        qp, blocks = self.arrays.qp, self.layout.blocks
+        block = next((b for b in blocks if b.limit is limit and b.damper), None)
         if id(limit) in self.hooks.constraints:
             G, h = (self.layout.plan.view(slot) for slot in self.hooks.constraints[id(limit)])
             named = self.hooks.describes.get(id(limit))
