@@ -32,7 +32,13 @@ from dvqp.cli import view as view_cli
 from dvqp.cli.compiling import announced
 from dvqp.cli.figures import FIGURE_FORMATS
 from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
-from dvqp.cli.report import format_summary, format_table, rows_to_csv, write_text
+from dvqp.cli.report import (
+    footer_lines,
+    format_summary,
+    format_table,
+    rows_to_csv,
+    write_text,
+)
 from dvqp.cli.solver_option import solver_options
 from dvqp.errors import DvqpError, SingularConfigurationError, one_line
 from dvqp.motion.schedule import TIMINGS
@@ -117,6 +123,11 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--csv", help="write the figures as CSV")
     c.add_argument("--plot", help="write a figure of the comparison (.png/.svg/.pdf)")
     c.add_argument("--jobs", type=_positive_int, default=1, help="worker processes (scenes)")
+    c.add_argument(
+        "--wide",
+        action="store_true",
+        help="every column in the table (default: the deciding figures, within 100 characters)",
+    )
     c.add_argument(
         "--check",
         "--strict",
@@ -211,10 +222,9 @@ def _compare(args: argparse.Namespace) -> int:
         )
     if args.settings != "default":
         print(f"settings: {args.settings}")
-    print(format_table(rows))
-    for row in rows:
-        if row["error"]:
-            print(f"  {row['scene']} / {row['backend']}: {row['error']}")
+    print(format_table(rows, wide=args.wide))
+    for line in footer_lines(rows):
+        print(line)
     if json_out is not None:  # no NaN in it: an undefined figure is null
         doc = {
             "backends": backends,

@@ -6,6 +6,7 @@ as ``-`` in the table and as an empty CSV cell (:func:`dvqp.run.comparison.rows_
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -25,6 +26,21 @@ TABLE = (  # (row key, header, format)
     ("scene", "scene", "{}"),
     ("backend", "backend", "{}"),
     ("success", "ok", "{}"),
+    ("tracked", "tracked", "{}"),
+    ("max_task_error", "task err", "{:.1e}"),
+    ("min_clearance", "clear m", "{:+.4f}"),
+    ("median_step_us", "step us", "{:.0f}"),
+    ("median_solver_us", "solv us", "{:.1f}"),
+    ("primal_residual", "r_prim", "{:.0e}"),
+)
+"""Columns of :func:`format_table` by default, the figures a reader decides on, in at most
+100 characters: (row key, header, format of a defined value)."""
+
+WIDE_TABLE = (  # (row key, header, format)
+    ("scene", "scene", "{}"),
+    ("backend", "backend", "{}"),
+    ("success", "ok", "{}"),
+    ("tracked", "tracked", "{}"),
     ("steps", "steps", "{}"),
     ("median_step_us", "med us", "{:.0f}"),
     ("p95_step_us", "p95 us", "{:.0f}"),
@@ -52,13 +68,35 @@ TABLE = (  # (row key, header, format)
     ("final_joint_speed", "end qd", "{:.3g}"),
     ("braking_time", "brake s", "{:.3f}"),
 )
-"""Columns of :func:`format_table`: (row key, header, format of a defined value)."""
+"""Every column (``--wide``)."""
 
 
-def format_table(rows: Sequence[Row]) -> str:
-    """The comparison as an aligned text table, a header and a rule first (``-``: undefined)."""
-    table = [[h for _, h, _ in TABLE]] + [[cell(r.get(k), f) for k, _, f in TABLE] for r in rows]
+def format_table(rows: Sequence[Row], wide: bool = False) -> str:
+    """The comparison as an aligned text table, a header and a rule first (``-``: undefined):
+    the :data:`TABLE` columns, or with ``wide`` every one (:data:`WIDE_TABLE`)."""
+    columns = WIDE_TABLE if wide else TABLE
+    table = [[h for _, h, _ in columns]]
+    table += [[cell(r.get(k), f) for k, _, f in columns] for r in rows]
     return aligned(table, left=2)
+
+
+def footer_lines(rows: Sequence[Row], width: int = 100) -> list[str]:
+    """Why a run is not ``ok`` (its error) or ``ok`` but not ``tracked`` (safe, every limit
+    kept, yet the tool left the commanded motion), wrapped to ``width`` characters."""
+    notes = []
+    for r in rows:
+        name = f"{r['scene']} / {r['backend']}"
+        if r["error"]:
+            notes.append(f"{name}: {r['error']}")
+        elif r.get("tracked") is False:
+            refused = f"; {r['refused_calls']} backend calls refused" if r["refused_calls"] else ""
+            notes.append(
+                f"{name}: ok (every limit kept) but not tracked: the tool was up to "
+                f"{r['max_tracking_error'] * 1e3:.3g} mm and {r['max_heading_error']:.3g} rad "
+                f"from the commanded motion{refused}"
+            )
+    wrap = textwrap.TextWrapper(width, initial_indent="  ", subsequent_indent="    ")
+    return [line for note in notes for line in wrap.wrap(note)]
 
 
 def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None) -> str:

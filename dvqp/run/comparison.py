@@ -22,7 +22,7 @@ from dvqp.kinematics import KinematicState
 from dvqp.limits import lowest_link, self_distance, start_broken_lines
 from dvqp.resolution.registry import PINV
 from dvqp.run.planning import check_run, path_figures, plan
-from dvqp.run.sample_checks import final_errors, worst_sample_excess
+from dvqp.run.sample_checks import final_errors, tracking, worst_sample_excess
 from dvqp.run.table_text import csv_text
 from dvqp.scenes.scene import load_scene
 from solvers.accuracy import METRICS
@@ -37,6 +37,7 @@ FIELDS = (
     "backend",
     "settings",
     "success",
+    "tracked",
     "steps",
     "failures",
     "slowed",
@@ -60,6 +61,8 @@ FIELDS = (
     "duality_gap",
     "ratio_to_pinv",
     "max_task_error",
+    "max_tracking_error",
+    "max_heading_error",
     "min_clearance",
     "closest",
     "min_probe_clearance",
@@ -99,7 +102,10 @@ def summarize(scene: Scene, traj: Trajectory, settings: str = "default") -> Row:
     ``settings`` tier, :mod:`solvers.tiers`), as a dict:
 
     ``success``: the run can be sent to the arm (:func:`dvqp.run.planning.check_run`); ``error``
-    says why not. ``steps``; ``failures`` (steps not solved or that broke a limit even in
+    says why not. ``tracked``: the tool followed the commanded motion within the scene's
+    tolerance at every sample, with ``max_tracking_error`` (m) and ``max_heading_error`` (rad)
+    (a safe run, ``success``, may still fall behind or leave the path where a backend's answers
+    were refused). ``steps``; ``failures`` (steps not solved or that broke a limit even in
     substeps); ``slowed`` (a time-scaled path's progress slowed to keep the limits; a path's
     ``nominal_duration``, ``path_duration`` and ``max_deviation`` are those of
     :func:`dvqp.run.planning.path_figures`); ``relaxed`` (the task gave way to a limit) and
@@ -147,6 +153,7 @@ def summarize(scene: Scene, traj: Trajectory, settings: str = "default") -> Row:
         **_accuracy(traj),
         "ratio_to_pinv": None,
         "max_task_error": _finite(np.max(traj.task_error[ok])) if np.any(ok) else None,
+        **_tracking(scene, traj),
         **_clearances(scene, traj),
         **_limit_figures(scene, traj),
         "final_tracking_error": final_errors(traj)[0] if traj.tracking_error.size else None,
@@ -154,6 +161,21 @@ def summarize(scene: Scene, traj: Trajectory, settings: str = "default") -> Row:
         "braking_time": traj.braking_time,
         "final_tool": [float(v) for v in traj.tool[-1]],
         "error": why,
+    }
+
+
+def _tracking(scene: Scene, traj: Trajectory) -> Row:
+    """``tracked`` (the tool within the scene's tolerance of the commanded motion at every
+    sample, :func:`~dvqp.run.sample_checks.tracking`), ``max_tracking_error`` (m) and
+    ``max_heading_error`` (rad); None without a recorded tracking error."""
+    found = tracking(scene, traj)
+    if found is None:
+        return {"tracked": None, "max_tracking_error": None, "max_heading_error": None}
+    tracked, position, heading = found
+    return {
+        "tracked": tracked,
+        "max_tracking_error": _finite(position),
+        "max_heading_error": _finite(heading),
     }
 
 

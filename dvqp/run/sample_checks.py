@@ -1,5 +1,5 @@
 """What a planned run's saved samples show: its worst limit excess, recomputed exactly from
-the samples, and its final tracking error."""
+the samples, its final tracking error and whether it tracked the commanded motion."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from dvqp.limits import Excess, Limit
+from dvqp.motion.path import ToolPath
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.pinv import PseudoinverseResolver
 from dvqp.scenes.scene import Scene
@@ -38,3 +39,18 @@ def final_errors(traj: Trajectory) -> tuple[float, float]:
     """Final tracking error: largest of |l|, |z|, |h| (m) and |α| (rad)."""
     last = traj.tracking_error[-1]
     return float(np.max(np.abs(last[:3]))), float(abs(last[3]))
+
+
+def tracking(scene: Scene, traj: Trajectory) -> tuple[bool, float, float] | None:
+    """Whether the tool followed the commanded motion: ``(tracked, position, heading)``, the
+    largest tracking error of any sample in l, z, h (m) and in α (rad), tracked when both are
+    within the scene path's ``tolerance`` and ``heading_tolerance`` (a JOG scene: a path's
+    defaults, 5 mm and 0.05 rad); None if the trajectory records no tracking error."""
+    if not traj.tracking_error.shape[0]:
+        return None
+    path = scene.path
+    tolerance = ToolPath.tolerance if path is None else path.tolerance
+    heading_tolerance = ToolPath.heading_tolerance if path is None else path.heading_tolerance
+    error = np.abs(traj.tracking_error)
+    position, heading = float(np.max(error[:, :3])), float(np.max(error[:, 3]))
+    return position <= tolerance and heading <= heading_tolerance, position, heading
