@@ -29,7 +29,7 @@ FINITE, DUALS, MISFIT = 1, 2, -1
 MISFITTING = (float(MISFIT),) + (math.nan,) * 7
 #: Reassociation only, so that the dot products vectorise (~0.15 µs a call); no finite-math
 #: assumption: NaN and inf keep their meaning. Both kernels inline the same body, so they
-#: give bitwise the same values on the same data (tests/test_solvers_daqp_fast.py holds them
+#: give bitwise the same values on the same data (tests/solvers/test_daqp_fast.py holds them
 #: to it; without this flag that would hold by IEEE rules alone).
 _FASTMATH = {"reassoc"}
 

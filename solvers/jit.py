@@ -242,7 +242,7 @@ def compiled_on_first_call(
     refused their ``compile`` with ``RuntimeError('compilation disabled')``, e.g. in a Dask
     worker's threads). Meant for functions called
     from Python: numba's typing of a call from other jitted code would compile the callee for
-    the caller's argument types instead. ``tests/test_solvers_structure.py`` checks, in a fresh
+    the caller's argument types instead. ``tests/solvers/test_structure.py`` checks, in a fresh
     interpreter, that importing compiles nothing and that each kernel ends with one overload.
     """
 

@@ -108,7 +108,7 @@ class SaddleWeld:
 
         A chord's largest distance from the curve is taken at its mid-parameter point, and
         that is kept to half the tolerance: the true largest distance differs from it only
-        to a higher order in the step (``tests/test_saddle_weld.py`` measures it on a dense
+        to a higher order in the step (``tests/motion/test_saddle_weld.py`` measures it on a dense
         sampling).
         """
         start, end = self.arc

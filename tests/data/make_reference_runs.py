@@ -32,7 +32,7 @@ pieces, to the same 10 µm. The baselines' joint paths are bit for bit the same,
 recorded clearances moved by up to 5.7 µm (weld-circumference); the QP runs that hold a link
 at its margin moved by up to 1.7e-4 rad (narrow-passage; many-obstacles 1.7e-4; paper-two-inlets
 not at all) and their clearances by up to 7.7 µm; every status is the same.
-``tests/test_reference_runs.py`` checks that today's code reproduces it within 1e-9. Run
+``tests/run/test_reference_runs.py`` checks that today's code reproduces it within 1e-9. Run
 ``python tests/data/make_reference_runs.py`` only when a change of results is intended, and say
 why in the commit.
 """
