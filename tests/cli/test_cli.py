@@ -148,7 +148,17 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
     scenes = [write_scene(tmp_path, "one"), write_scene(tmp_path, "two", radius=0.05)]
     js, cs = tmp_path / "cmp.json", tmp_path / "cmp.csv"
     code = main(
-        ["compare", *scenes, "--backends", "pinv,daqp", "--json", str(js), "--csv", str(cs)]
+        [
+            "compare",
+            *scenes,
+            "--backends",
+            "pinv,daqp",
+            "--json",
+            str(js),
+            "--csv",
+            str(cs),
+            "--wide",
+        ]
     )
     assert code == 0
     captured = capsys.readouterr()
@@ -157,6 +167,7 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
         "scene",
         "backend",
         "ok",
+        "tracked",
         "steps",
         "med",
         "us",
@@ -200,11 +211,11 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
         "brake",
         "s",
     ]
-    assert [line.split()[:4] for line in lines[2:6]] == [
-        ["one", "pinv", "yes", "21"],
-        ["one", "daqp", "yes", "23"],
-        ["two", "pinv", "yes", "21"],
-        ["two", "daqp", "yes", "23"],
+    assert [line.split()[:5] for line in lines[2:6]] == [
+        ["one", "pinv", "yes", "yes", "21"],
+        ["one", "daqp", "yes", "yes", "23"],
+        ["two", "pinv", "yes", "yes", "21"],
+        ["two", "daqp", "yes", "yes", "23"],
     ]
     assert no_traceback(captured.err)
     doc = json.loads(js.read_text(encoding="utf-8"), parse_constant=pytest.fail)  # no NaN/inf
@@ -266,7 +277,8 @@ def test_compare_reports_a_failed_run_in_its_table_and_exits_1_only_when_strict(
     assert main(["compare", scene, "--backends", "daqp"]) == 0  # the comparison ran
     out = capsys.readouterr().out
     assert out.splitlines()[2].split()[:3] == ["far", "daqp", "NO"]
-    assert "far / daqp: " in out and "target not reached" in out
+    said = " ".join(out.split())  # the footer is wrapped to 100 columns
+    assert "far / daqp: " in said and "target not reached" in said
     assert main(["compare", scene, "--backends", "daqp", "--check"]) == 1
     assert main(["compare", write_scene(tmp_path), "--backends", "daqp", "--check"]) == 0
 
