@@ -87,6 +87,7 @@ def test_compare_reports_accuracy_for_every_qp_backend_and_none_for_the_baseline
         "high_accuracy",
         "--json",
         str(out),
+        "--wide",
     ]
     assert main(argv) == 0
     printed = capsys.readouterr().out
