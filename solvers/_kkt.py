@@ -1,8 +1,9 @@
 """The compiled KKT kernel behind :mod:`solvers.kkt` (see there for what it computes).
 
 :func:`kernel` and :func:`stacked` compile (or load numba's cache) at their first call, for
-their one declared signature (:func:`solvers.jit.compiled_on_first_call`); the ``@njit``
-helpers are inlined into both and never compiled on their own.
+their one declared signature (:func:`solvers.jit.compiled_on_first_call`); both call one
+separately compiled body, :func:`_residuals`, on read-only arrays: it compiles once, for
+whichever of them runs first.
 """
 
 from __future__ import annotations
@@ -11,6 +12,8 @@ import math
 
 import numpy as np
 from numba import types
+from numba.core.extending import intrinsic
+from numba.core.imputils import impl_ret_borrowed
 
 from .jit import compiled_on_first_call, njit
 
@@ -28,25 +31,25 @@ FINITE, DUALS, MISFIT = 1, 2, -1
 #: The kernels' values on a misfit.
 MISFITTING = (float(MISFIT),) + (math.nan,) * 7
 #: Reassociation only, so that the dot products vectorise (~0.15 µs a call); no finite-math
-#: assumption: NaN and inf keep their meaning. Both kernels inline the same body, so they
-#: give bitwise the same values on the same data (tests/solvers/test_daqp_fast.py holds them
-#: to it; without this flag that would hold by IEEE rules alone).
+#: assumption: NaN and inf keep their meaning. Both kernels call the same compiled body, so
+#: they give bitwise the same values on the same data (tests/solvers/test_daqp_fast.py holds
+#: them to it).
 _FASTMATH = {"reassoc"}
 
 
-@njit(inline="always")
+@njit(fastmath=_FASTMATH)
 def _max(a: float, b: float) -> float:
     """``max(a, b)`` that propagates NaN from either side."""
     return a if (a >= b or a != a) else b
 
 
-@njit(inline="always")
+@njit(fastmath=_FASTMATH)
 def _weight(slack: float) -> float:
     """``|slack|``, or 1 for an infinite slack (complementarity of an inactive row)."""
     return abs(slack) if math.isfinite(slack) else 1.0
 
 
-@njit(inline="always")
+@njit(fastmath=_FASTMATH)
 def _fit(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags):  # type: ignore[no-untyped-def]
     """:data:`MISFIT` if a size does not fit ``x``'s, else :data:`DUALS` or 0."""
     n, m, p = x.shape[0], A.shape[0], G.shape[0]
@@ -68,7 +71,7 @@ def _fit(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags):  # type: ignore[no-un
     return 0 if box and not flags & HAS_BOX else DUALS
 
 
-@njit(inline="always")
+@njit(fastmath=_FASTMATH)
 def _bounds(lb, ub, x, z_box, flags, duals, grad):  # type: ignore[no-untyped-def]
     """``(bounds, complementarity of the bounds, lbᵀz_box⁻ + ubᵀz_box⁺ over finite bounds)``,
     adding ``z_box`` to ``grad``."""
@@ -97,9 +100,22 @@ def _bounds(lb, ub, x, z_box, flags, duals, grad):  # type: ignore[no-untyped-de
     return bounds, complementarity, gap
 
 
-@njit(inline="always")
+@intrinsic
+def _readonly(typingctx, array):  # type: ignore[no-untyped-def]
+    """``array`` typed as read-only (the same array): :func:`stacked`'s views of its buffer
+    then have :func:`kernel`'s types, and :func:`_residuals` one specialisation."""
+    if not isinstance(array, types.Array):
+        return None
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        return impl_ret_borrowed(context, builder, signature.return_type, args[0])
+
+    return array.copy(readonly=True)(array), codegen
+
+
+@njit(separate=True, fastmath=_FASTMATH)
 def _residuals(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags):  # type: ignore[no-untyped-def]
-    """The body of :func:`kernel` and :func:`stacked` (inlined in both)."""
+    """The body of :func:`kernel` and :func:`stacked` (compiled once, on read-only arrays)."""
     code = _fit(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags)
     if code == MISFIT:
         return MISFITTING
@@ -196,6 +212,7 @@ def stacked(
     size = n * (n + 1 + p + m) + 2 * rows
     if data.shape[0] != size or x.shape[0] != n or lam.shape[0] != rows or ms not in (0, n):
         return MISFITTING
+    data, x, lam = _readonly(data), _readonly(x), _readonly(lam)
     f, M = n * n, n * n + n  # offsets of f, M, upper, lower in data
     upper = M + (p + m) * n
     lower = upper + rows

@@ -32,13 +32,17 @@ from pathlib import Path
 from typing import Any
 
 import numba
+from numba import types
 from numba.core.caching import FunctionCache, IndexDataCacheFile, NullCache
 from numba.core.dispatcher import Dispatcher
+from numba.core.registry import CPUDispatcher
 from numba.core.typing.templates import Signature
+
+from . import linking
 
 _MAGIC = b"dvqp-sha256\n"
 _DIGEST = 32
-_FORMAT = "+dvqp-sha256"  # appended to the numba version written at the head of an index
+_FORMAT = "+dvqp-sha256-needs"  # appended to the numba version written at the head of an index
 _ENTRY_SUFFIXES = (".nbi", ".nbc")
 
 CACHES: list[SoftCache] = []
@@ -139,10 +143,29 @@ class SoftCache(FunctionCache):
         if found is None:
             return None
         try:
-            return self._impl.rebuild(target_context, found[1])
+            needs, reduced = found[1]
+            needs = [linking.need(item) for item in needs]
+        except (TypeError, ValueError) as exc:  # unpickled, but not an entry of this format
+            self._cache_file.discard(found[0], exc)
+            return None
+        if not linking.provide(needs):  # a kernel its code calls changed its signature
+            return None
+        try:
+            cres = self._impl.rebuild(target_context, reduced)
         except Exception as exc:  # unpickled, but not a compiled function numba can load
             self._cache_file.discard(found[0], exc)
             return None
+        linking.record(cres.library, needs)
+        return cres
+
+    def _save_overload(self, sig: Any, data: Any) -> None:
+        """numba's, the entry holding the symbols its code calls (:mod:`solvers.linking`)."""
+        if not self._enabled or not self._impl.check_cachable(data):
+            return
+        self._impl.locator.ensure_cache_path()
+        key = self._index_key(sig, data.codegen)
+        needs = linking.needed_by(data.library)
+        self._cache_file.save(key, (needs, self._impl.reduce(data)))
 
     def save_overload(self, sig: Any, data: Any) -> None:
         try:
@@ -166,16 +189,53 @@ def _cache_for(function: Callable[..., Any]) -> SoftCache | NullCache:
     return cache
 
 
-def njit(function: Callable[..., Any] | None = None, **options: Any) -> Any:
+class KernelDispatcher(CPUDispatcher):  # type: ignore[misc]
+    """numba's CPU dispatcher, compiled for the plain types of a compiled caller's arguments.
+
+    numba compiles a function called from compiled code for its arguments' types as typed
+    there, a constant as its literal type: ``f(x, True)`` and ``f(x, False)`` were two
+    specialisations of ``f`` and of everything it calls (with a cold cache, seconds). No
+    kernel here asks for a literal, so a call is typed with each argument's plain type (one
+    specialisation; the constant is converted at the call).
+    """
+
+    separate = False
+    """Whether compiled callers call it through its symbol (:mod:`solvers.linking`)."""
+
+    def get_call_template(self, args: tuple[Any, ...], kws: dict[str, Any]) -> Any:
+        plain = tuple(types.unliteral(a) for a in args)
+        return super().get_call_template(plain, {k: types.unliteral(v) for k, v in kws.items()})
+
+
+class SeparateDispatcher(KernelDispatcher):
+    """A :class:`KernelDispatcher` compiled and cached on its own: a compiled caller calls it
+    through its symbol instead of linking its code in (:mod:`solvers.linking`)."""
+
+    separate = True
+
+    def add_overload(self, cres: Any) -> None:
+        super().add_overload(cres)
+        if not cres.objectmode:
+            linking.expose(self, cres)
+
+
+def njit(
+    function: Callable[..., Any] | None = None, *, separate: bool = False, **options: Any
+) -> Any:
     """``numba.njit(cache=True, **options)``, its cache a :class:`SoftCache`.
 
-    Use as ``@njit`` or ``@njit(inline="always")``; compiles at the first call, as numba's.
+    Use as ``@njit``, ``@njit(inline="always")`` or ``@njit(separate=True)`` (a kernel
+    compiled and cached on its own, :class:`SeparateDispatcher`); compiles at the first call, as
+    numba's.
     """
     if "cache" in options:
         raise TypeError("njit: always cached, no 'cache' option")
+    if separate and options.get("inline", "never") != "never":
+        raise TypeError("njit: a separate kernel is never inlined")
 
-    def decorate(f: Callable[..., Any]) -> Dispatcher:
-        dispatcher = numba.njit(**options)(f)
+    def decorate(f: Callable[..., Any]) -> KernelDispatcher:
+        kind = SeparateDispatcher if separate else KernelDispatcher
+        dispatcher = kind(py_func=f, locals={}, targetoptions={"nopython": True, **options})
         dispatcher._cache = _cache_for(f)  # what numba's enable_caching() sets, soft
         return dispatcher
 

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 from dvqp import KinematicState, Robot
 from dvqp.geometry import proximity, segment_distances
-from dvqp.geometry.measure import OTHER, ShapeArrays
+from dvqp.geometry.measure import ShapeArrays
 from dvqp.geometry.proximity import measure as measure_chain
 from dvqp.limits import (
     NO_EXCESS,
@@ -417,7 +417,7 @@ def real_clearances(
     guarded, period = np.asarray(frames.guarded), 2.0 * math.pi * radius  # type: ignore[attr-defined]
     ends = guarded_links(k, frames.rail)  # type: ignore[attr-defined]
     shapes = tuple(obstacles)
-    own = ShapeArrays.of(shapes, period).code == OTHER  # shapes of your own: one piece
+    own = ~ShapeArrays.of(shapes, period).compiled  # shapes of your own: one piece
     straight = measure_chain(shapes, guarded, period, ends)
     whole = radius * np.abs(bends(o[ends[:, 0]], o[ends[:, 1]])[0])
     value = straight.link_distance - whole[None]

@@ -13,8 +13,8 @@ import math
 import numpy as np
 
 from dvqp.geometry.bend import PRECISION, link_bend, link_point
-from dvqp.geometry.measure import INLET, shape_point, shape_segment
-from dvqp.geometry.shapes.inlet import UNKNOWN
+from dvqp.geometry.measure import shape_point, shape_segment
+from dvqp.geometry.shapes.shape import UNKNOWN
 from solvers.jit import njit
 
 MAX_PIECES = 256
@@ -27,7 +27,7 @@ T0, T1, END0, END1, WIDTH = 0, 1, 2, 7, 12
 (the real image's point there and its distance to the obstacle, or ``d = nan``: not taken)."""
 
 
-@njit(inline="always")
+@njit
 def _end(shapes, j, a, b, la, radius, t, piece, col):  # type: ignore[no-untyped-def]
     """The real image's point at ``t`` of the link ``a → b`` (``l`` unwrapped from ``la``)
     into ``piece[col : col + 5]``, with its distance to obstacle j where a segment's distance
@@ -36,12 +36,12 @@ def _end(shapes, j, a, b, la, radius, t, piece, col):  # type: ignore[no-untyped
     piece[col] = la + radius * math.atan2(a[0] * y - a[1] * x, a[0] * x + a[1] * y)
     piece[col + 1] = z
     d, nl, nz = UNKNOWN
-    if shapes.code[j] == INLET:
+    if shapes.ends[j]:
         d, nl, nz = shape_point(shapes, j, piece[col], z)
     piece[col + 2], piece[col + 3], piece[col + 4] = d, nl, nz
 
 
-@njit(inline="always")
+@njit
 def _copy_end(source, col, target, to) -> None:  # type: ignore[no-untyped-def]
     for c in range(5):
         target[to + c] = source[col + c]
@@ -66,7 +66,7 @@ def _piece(shapes, j, a, b, radius, piece):  # type: ignore[no-untyped-def]
     return d, radius * abs(link_bend(x0, y0, x1, y1)[0]), s, nl, nz
 
 
-@njit
+@njit(separate=True)
 def link_clearance(shapes, j, i, a, b, la, radius, near) -> None:  # type: ignore[no-untyped-def]
     """Link i's clearance to obstacle j (its ends ``a``, ``b`` in 3-D, m; ``la`` the DV ``l``
     of ``a``) into ``near``'s ``real_*`` rows, by halving its pieces a level at a time from

@@ -1,10 +1,11 @@
 """Signed distances of the arm's guarded chain to every obstacle, compiled.
 
-:class:`ShapeArrays` packs an obstacle sequence once; :func:`measure_chain` writes every
-built-in shape's distances and normals into :class:`~dvqp.workspace.ProximityBuffers` (the
-kernels of each shape's module, selected per row), :func:`user_rows` those of shapes of your
-own (their NumPy methods), and :func:`penalties` every row's objective penalty
-``e = d (d + 2ρ)`` and ``∇e = 2 (d + ρ) ∇d``.
+:class:`ShapeArrays` packs an obstacle sequence once, each obstacle with the addresses of its
+kind's kernels (:meth:`~dvqp.geometry.shapes.Shape.compiled`): :func:`measure_chain` calls
+them by those addresses (:func:`solvers.linking.indirect`), so that a run compiles the kinds it
+measures and no other; :func:`user_rows` writes the rows of shapes of your own (their NumPy
+methods), and :func:`penalties` every row's objective penalty ``e = d (d + 2ρ)`` and
+``∇e = 2 (d + ρ) ∇d``.
 """
 
 from __future__ import annotations
@@ -12,20 +13,18 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from numba import types
 from numpy.typing import NDArray
 
 from dvqp.geometry.broad_phase import box_bound, chain_box, obstacle_bound
 from dvqp.geometry.shapes import Shape
-from dvqp.geometry.shapes.band import band_point, band_segment
-from dvqp.geometry.shapes.circle import circle_point, circle_segment
-from dvqp.geometry.shapes.inlet import UNKNOWN, inlet_point, inlet_segment
-from dvqp.geometry.shapes.polygon import polygon_point, polygon_segment
-from dvqp.geometry.shapes.shape import BAND, CIRCLE, INLET, OTHER, POLYGON
-from dvqp.kinematics.developed_view import wrap_period
-from dvqp.workspace import ProximityBuffers
+from dvqp.geometry.shapes.shape import UNKNOWN, ShapeKernels
+from dvqp.workspace import ProximityBuffers, struct_type
 from solvers.jit import njit
+from solvers.linking import address_of, indirect
 
 Array = NDArray[np.float64]
 
@@ -38,8 +37,6 @@ class ShapeArrays:
     ----------
     period : float
         ``2πR``, m.
-    code : (J,) int64
-        :data:`CIRCLE`, :data:`BAND`, :data:`POLYGON`, :data:`INLET` or :data:`OTHER`.
     data : (J, 4)
         A circle's ``[l, z, r, 0]``, a band's ``[z_min, z_max, 0, 0]``, a polygon's
         ``[l_ref, 0, 0, 0]``, an inlet's ``[l0, z0, r, R]``.
@@ -60,14 +57,19 @@ class ShapeArrays:
     far : (J,)
         The broad phase (m): an obstacle whose box is farther than this from the box of the
         whole chain gets that distance (a lower bound, no direction) in every row; else a part
-        farther than this from a polygon's or an inlet's box gets the box's distance and
+        farther than this from a ``boxed`` obstacle's box gets the box's distance and
         direction (a circle's or a band's exact distance costs less than a box's), unless
         :func:`~dvqp.geometry.real_links.real_links` finds that the row may matter (``inf``,
         the default: every row exact).
+    point_at, segment_at, rows_at : (J,) int64
+        The addresses of each obstacle's kind's kernels
+        (:class:`~dvqp.geometry.shapes.shape.ShapeKernels`), compiled for this struct; 0: none
+        (a shape of your own, measured in NumPy; ``rows_at``: its rows a call each).
+    boxed, ends : (J,) bool
+        Its kind's :attr:`~dvqp.geometry.shapes.shape.ShapeKernels.boxed` and ``ends``.
     """
 
     period: float
-    code: NDArray[np.int64]
     data: Array
     start: NDArray[np.int64]
     stop: NDArray[np.int64]
@@ -77,103 +79,118 @@ class ShapeArrays:
     refine: Array
     box: Array
     far: Array
+    point_at: NDArray[np.int64]
+    segment_at: NDArray[np.int64]
+    rows_at: NDArray[np.int64]
+    boxed: NDArray[np.bool_]
+    ends: NDArray[np.bool_]
 
     @classmethod
     def of(cls, shapes: Sequence[Shape], period: float) -> ShapeArrays:
-        """Pack ``shapes``: each as it says itself (:meth:`~dvqp.geometry.shapes.Shape.compiled`;
-        a shape of your own :data:`OTHER`)."""
+        """Pack ``shapes``, each as it says itself (:meth:`~dvqp.geometry.shapes.Shape.compiled`;
+        a shape of your own has no kernels), its kind's kernels compiled (or loaded from the
+        cache) for this struct."""
         count = len(shapes)
-        code, data = np.full(count, OTHER, np.int64), np.zeros((count, 4))
+        data, box = np.zeros((count, 4)), np.zeros((count, 4))
         start, stop = np.zeros(count, np.int64), np.zeros(count, np.int64)
+        boxed, ends = np.zeros(count, np.bool_), np.zeros(count, np.bool_)
         vertices: list[Array] = []
-        box, at = np.zeros((count, 4)), 0
-        for j, shape in enumerate(shapes):
-            packed = shape.compiled()
+        compiled, at = [shape.compiled() for shape in shapes], 0
+        for j, packed in enumerate(compiled):
             if packed is None:
                 continue
-            code[j], data[j], box[j] = packed.code, packed.data, packed.box
+            data[j], box[j] = packed.data, packed.box
+            boxed[j], ends[j] = packed.kernels.boxed, packed.kernels.ends
             if packed.samples is not None:
                 start[j], stop[j] = at, at + packed.samples.shape[0]
                 vertices.append(packed.samples)
                 at += packed.samples.shape[0]
-        packed = np.concatenate(vertices) if vertices else np.zeros((0, 2))
-        vl, vz = np.ascontiguousarray(packed[:, 0]), np.ascontiguousarray(packed[:, 1])
-        return cls(
+        samples = np.concatenate(vertices) if vertices else np.zeros((0, 2))
+        arrays = cls(
             float(period),
-            code,
             data,
             start,
             stop,
-            vl,
-            vz,
+            np.ascontiguousarray(samples[:, 0]),
+            np.ascontiguousarray(samples[:, 1]),
             np.array([s.size for s in shapes], float),
             np.full(count, math.inf),
             box,
             np.full(count, math.inf),
+            np.zeros(count, np.int64),
+            np.zeros(count, np.int64),
+            np.zeros(count, np.int64),
+            boxed,
+            ends,
         )
+        arrays._link([None if packed is None else packed.kernels for packed in compiled])
+        return arrays
+
+    @property
+    def compiled(self) -> NDArray[np.bool_]:
+        """(J,) bool: the obstacles the compiled measurement measures (the others are shapes of
+        your own)."""
+        return self.point_at != 0  # type: ignore[no-any-return]
+
+    def _link(self, kernels: Sequence[ShapeKernels | None]) -> None:
+        """Each obstacle's kind's kernel addresses, the kernels compiled for this struct."""
+        kind = struct_type(self)
+        found: dict[int, tuple[int, int, int]] = {}
+        for j, k in enumerate(kernels):
+            if k is None:
+                continue
+            if id(k) not in found:
+                rows = 0 if k.rows is None else address_of(k.rows, (kind, *_ROWS, _near_type()))
+                found[id(k)] = (
+                    address_of(k.point, (kind, *_POINT)),
+                    address_of(k.segment, (kind, *_SEGMENT)),
+                    rows,
+                )
+            self.point_at[j], self.segment_at[j], self.rows_at[j] = found[id(k)]
+
+
+_END = types.UniTuple(types.float64, 3)
+_POINT = (types.int64, types.float64, types.float64)
+"""A point kernel's arguments after ``shapes``: ``j, pl, pz``."""
+_SEGMENT = (types.int64, *(types.float64,) * 4, _END, _END)
+"""A segment kernel's arguments after ``shapes``: ``j, al, az, bl, bz, a_end, b_end``."""
+_ROWS = (types.int64, types.Array(types.float64, 2, "C"))
+"""A rows kernel's arguments between ``shapes`` and ``near``: ``j, chain``."""
+_point_at = indirect(types.UniTuple(types.float64, 3), (None, *_POINT))
+_segment_at = indirect(types.UniTuple(types.float64, 4), (None, *_SEGMENT))
+_rows_at = indirect(types.none, (None, *_ROWS, None))
+_NEAR: list[Any] = []
+
+
+def _near_type() -> Any:
+    """The struct type of :class:`~dvqp.workspace.ProximityBuffers` (made once)."""
+    if not _NEAR:
+        _NEAR.append(struct_type(ProximityBuffers.sized(0, 0, np.zeros((0, 2), np.int64))))
+    return _NEAR[0]
 
 
 @njit
 def shape_point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
-    """``(d, ∂d/∂l, ∂d/∂z)`` of a point to obstacle j."""
-    code, data, period = shapes.code[j], shapes.data[j], shapes.period
-    if code == CIRCLE:
-        return circle_point(data[0], data[1], data[2], pl, pz, period)
-    if code == BAND:
-        d, nz = band_point(data[0], data[1], pz)
-        return d, 0.0, nz
-    a, b = shapes.start[j], shapes.stop[j]
-    if code == INLET:
-        return inlet_point(
-            wrap_period(pl - data[0], period),
-            pz - data[1],
-            data[2],
-            data[3],
-            shapes.vl[a:b],
-            shapes.vz[a:b],
-        )
-    return polygon_point(wrap_period(pl - data[0], period), pz, shapes.vl[a:b], shapes.vz[a:b])
+    """``(d, ∂d/∂l, ∂d/∂z)`` of a point to obstacle j: its kind's ``point`` kernel."""
+    return _point_at(shapes.point_at[j], shapes, j, pl, pz)
 
 
 @njit
 def shape_segment(shapes, j, al, az, bl, bz, a_end, b_end):  # type: ignore[no-untyped-def]
-    """``(d, t, ∂d/∂l, ∂d/∂z)`` of a segment to obstacle j; ``a_end``, ``b_end`` the ends'
-    :func:`shape_point` where known (else :data:`~.shapes.inlet.UNKNOWN`; an inlet's segment
-    then needs no second measurement of them)."""
-    code, data, period = shapes.code[j], shapes.data[j], shapes.period
-    if code == CIRCLE:
-        return circle_segment(data[0], data[1], data[2], al, az, bl, bz, period)
-    if code == BAND:
-        d, t, nz = band_segment(data[0], data[1], az, bz)
-        return d, t, 0.0, nz
-    a, b = shapes.start[j], shapes.stop[j]
-    la = wrap_period(al - data[0], period)
-    lb = la + wrap_period(bl - al, period)
-    if code == INLET:
-        if lb != wrap_period(bl - data[0], period):  # b measured at another period's copy
-            b_end = UNKNOWN
-        return inlet_segment(
-            la,
-            az - data[1],
-            lb,
-            bz - data[1],
-            data[2],
-            data[3],
-            shapes.vl[a:b],
-            shapes.vz[a:b],
-            a_end,
-            b_end,
-        )
-    return polygon_segment(la, az, lb, bz, shapes.vl[a:b], shapes.vz[a:b])
+    """``(d, t, ∂d/∂l, ∂d/∂z)`` of a segment to obstacle j: its kind's ``segment`` kernel;
+    ``a_end``, ``b_end`` the ends' :func:`shape_point` where known (else
+    :data:`~.shapes.shape.UNKNOWN`; a kind that uses them, ``ends``, then measures them
+    once)."""
+    return _segment_at(shapes.segment_at[j], shapes, j, al, az, bl, bz, a_end, b_end)
 
 
-@njit
+@njit(separate=True)
 def point_row(shapes, j, chain, i, near, exact) -> None:  # type: ignore[no-untyped-def]
     """Point i's row to obstacle j: exact, or (unless ``exact``) its box bound if that is
     beyond ``shapes.far[j]`` (so a row not beyond it is exact)."""
     pl, pz = chain[i, 0], chain[i, 1]
     d, nl, nz = -1.0, 0.0, 0.0
-    if not exact and (shapes.code[j] == POLYGON or shapes.code[j] == INLET):
+    if not exact and shapes.boxed[j]:
         d, nl, nz = box_bound(shapes, j, pl, pz, pl, pz)
     if d <= shapes.far[j]:
         d, nl, nz = shape_point(shapes, j, pl, pz)
@@ -190,14 +207,14 @@ def _end(shapes, near, j, i):  # type: ignore[no-untyped-def]
     return near.point_distance[j, i], near.point_normal[j, i, 0], near.point_normal[j, i, 1]
 
 
-@njit
+@njit(separate=True)
 def link_row(shapes, j, chain, i, near, exact) -> None:  # type: ignore[no-untyped-def]
     """Link i's row to obstacle j, as :func:`point_row` (a box bound has ``t = 0``); its ends'
     point rows, written before it, are not measured again where they are exact."""
     a, b = near.ends[i, 0], near.ends[i, 1]
     al, az, bl, bz = chain[a, 0], chain[a, 1], chain[b, 0], chain[b, 1]
     d, t, nl, nz = -1.0, 0.0, 0.0, 0.0
-    if not exact and (shapes.code[j] == POLYGON or shapes.code[j] == INLET):
+    if not exact and shapes.boxed[j]:
         d, nl, nz = box_bound(shapes, j, al, az, bl, bz)
     if d <= shapes.far[j]:
         d, t, nl, nz = shape_segment(
@@ -207,50 +224,31 @@ def link_row(shapes, j, chain, i, near, exact) -> None:  # type: ignore[no-untyp
     near.link_normal[j, i, 0], near.link_normal[j, i, 1] = nl, nz
 
 
-@njit
+@njit(separate=True)
 def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
     """Distances and normals of the points ``chain`` (m; columns l, z, ...) and of the links
     ``near.ends`` between them to every compiled obstacle, into ``near`` (a packed
-    :class:`~dvqp.workspace.ProximityBuffers`); rows of :data:`OTHER` shapes are left alone.
+    :class:`~dvqp.workspace.ProximityBuffers`); rows of shapes of your own are left alone.
     The broad phase: an obstacle whose box is farther than ``shapes.far`` from the chain's is
     skipped (``near.skipped``), its rows left alone, ``near.bound`` the boxes' distance
-    (:func:`obstacle_bound`); a row farther than it from a polygon's or an inlet's box
-    holds the box's distance (:func:`~.real_links.real_links` measures those that matter)."""
+    (:func:`obstacle_bound`); a row farther than it from a ``boxed`` obstacle's box holds the
+    box's distance (:func:`~.real_links.real_links` measures those that matter). A kind with
+    a ``rows`` kernel writes all of an obstacle's rows at once."""
     l0, lo, hi, zlo, zhi = chain_box(chain, near.ends, shapes.period)
-    for j in range(shapes.code.shape[0]):
+    for j in range(shapes.point_at.shape[0]):
         near.skipped[j] = False
-        if shapes.code[j] == OTHER:
+        if shapes.point_at[j] == 0:
             continue
         bound = obstacle_bound(shapes, j, l0, lo, hi, zlo, zhi) if shapes.far[j] < math.inf else 0.0
         if bound > shapes.far[j]:
             near.skipped[j], near.bound[j] = True, bound
-        elif shapes.code[j] == CIRCLE:
-            _circle_rows(shapes, j, chain, near)
+        elif shapes.rows_at[j] != 0:
+            _rows_at(shapes.rows_at[j], shapes, j, chain, near)
         else:
             for i in range(chain.shape[0]):
                 point_row(shapes, j, chain, i, near, False)
             for i in range(near.ends.shape[0]):
                 link_row(shapes, j, chain, i, near, False)
-
-
-@njit(inline="always")
-def _circle_rows(shapes, j, chain, near) -> None:  # type: ignore[no-untyped-def]
-    """Every row of circle j, as :func:`point_row` and :func:`link_row` write them (exact),
-    its data read once: a circle's 13 rows took 0.11 µs so, 1.4–1.6 µs through those two (whose
-    calls, with the packed struct and the other kinds' branches, LLVM does not inline), timed
-    in a loop over the states of a fifty-obstacles run."""
-    cl, cz, r, period = shapes.data[j, 0], shapes.data[j, 1], shapes.data[j, 2], shapes.period
-    distance, normal = near.point_distance, near.point_normal
-    for i in range(chain.shape[0]):
-        d, nl, nz = circle_point(cl, cz, r, chain[i, 0], chain[i, 1], period)
-        distance[j, i], normal[j, i, 0], normal[j, i, 1] = d, nl, nz
-    ends, distance, normal, at = near.ends, near.link_distance, near.link_normal, near.link_t
-    for i in range(ends.shape[0]):
-        a, b = ends[i, 0], ends[i, 1]
-        d, t, nl, nz = circle_segment(
-            cl, cz, r, chain[a, 0], chain[a, 1], chain[b, 0], chain[b, 1], period
-        )
-        distance[j, i], at[j, i], normal[j, i, 0], normal[j, i, 1] = d, t, nl, nz
 
 
 @njit(inline="always")
@@ -266,7 +264,7 @@ def fill(near, j) -> None:  # type: ignore[no-untyped-def]
         near.link_normal[j, i, 0], near.link_normal[j, i, 1] = 0.0, 0.0
 
 
-@njit
+@njit(separate=True)
 def penalties(size, near) -> None:  # type: ignore[no-untyped-def]
     """Every row's penalty ``e = d (d + 2ρ)`` (m²) and ``∇e = 2 (d + ρ) ∇d`` (m), but those of
     an obstacle the broad phase skipped (its repulsion, acting only inside, is 0)."""
@@ -288,16 +286,16 @@ def penalties(size, near) -> None:  # type: ignore[no-untyped-def]
 
 def user_rows(
     shapes: Sequence[Shape],
-    code: NDArray[np.int64],
+    compiled: NDArray[np.bool_],
     chain: Array,
     period: float,
     near: ProximityBuffers,
 ) -> None:
-    """Rows of the shapes of your own (code :data:`OTHER`): their NumPy ``point_distance`` of
+    """Rows of the shapes of your own (not ``compiled``): their NumPy ``point_distance`` of
     the points ``chain`` (m) and ``segment_distance`` of the links ``near.ends``, into
     ``near``."""
     lz, ends = np.ascontiguousarray(chain[:, :2]), near.ends
-    for j in np.flatnonzero(code == OTHER):
+    for j in np.flatnonzero(~compiled):
         shape = shapes[j]
         near.point_distance[j], near.point_normal[j] = shape.point_distance(lz, period)
         if ends.shape[0]:

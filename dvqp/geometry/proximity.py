@@ -172,9 +172,9 @@ def measure(
     real clearances."""
     packed = ShapeArrays.of(shapes, period)
     near = ProximityBuffers.sized(len(shapes), chain.shape[0], ends)
-    points = np.ascontiguousarray(chain, dtype=np.float64)
+    points = np.array(chain, dtype=np.float64, order="C")  # writable: the run's kernel types
     measure_chain(as_struct(packed), points, as_struct(near))
-    user_rows(shapes, packed.code, points, period, near)
+    user_rows(shapes, packed.compiled, points, period, near)
     if real is not None:
         real_links(as_struct(packed), points, *real, as_struct(near))
     penalties(packed.size, as_struct(near))

@@ -7,15 +7,13 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from dvqp.geometry.bend import PRECISION, link_bend, link_point
 from dvqp.geometry.link_pieces import link_clearance
-from dvqp.geometry.measure import OTHER, fill, link_row, point_row
+from dvqp.geometry.measure import fill, link_row, point_row
 from solvers.jit import njit
 
 
-@njit
+@njit(separate=True)
 def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ignore[no-untyped-def]
     """The clearance of every guarded link's real DV image to every obstacle, into ``near``'s
     ``real_*`` rows: the least over the link's pieces of the straight piece's clearance less
@@ -26,7 +24,7 @@ def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ign
     A pair is cut into pieces only where it matters: where the real link may be below
     ``shapes.refine`` (its damper's margin) or be the closest part of the arm to any obstacle
     (or, the probe's holder, of the probe and its holder: both are reported). Elsewhere, and
-    for shapes of your own (:data:`OTHER`), the whole link is one piece: the straight row less
+    for shapes of your own (no kernels), the whole link is one piece: the straight row less
     the link's ``δ`` (in ``near.bends``), a bound below the truth by at most ``2 δ``, above
     the margin and above the arm's closest part. Rows that the broad phase left at their box's
     bound (beyond ``shapes.far``), or not written (an obstacle it skipped), are measured
@@ -36,11 +34,11 @@ def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ign
         a, b = origins[ends[i, 0]], origins[ends[i, 1]]
         bends[i] = radius * abs(link_bend(a[0], a[1], b[0], b[1])[0])
     arm, probe = _closest(shapes, near, tool)
-    if np.isfinite(shapes.far).any():
+    if _any_finite(shapes.far):
         arm, probe = _seed(shapes, chain, near, tool, arm, probe)
         arm, probe = _broad(shapes, chain, near, tool, arm, probe)
     for j in range(near.real_distance.shape[0]):
-        if shapes.code[j] == OTHER or near.skipped[j]:
+        if shapes.point_at[j] == 0 or near.skipped[j]:
             continue
         for i in range(ends.shape[0]):
             d, reported = near.real_distance[j, i], probe if ends[i, 1] == tool else arm
@@ -49,6 +47,16 @@ def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ign
             ):
                 a, b = origins[ends[i, 0]], origins[ends[i, 1]]
                 link_clearance(shapes, j, i, a, b, chain[ends[i, 0], 0], radius, near)
+
+
+@njit(inline="always")
+def _any_finite(values) -> bool:  # type: ignore[no-untyped-def]
+    """Whether any of ``values`` is finite (a loop: ``np.isfinite(...).any()`` compiles
+    numba's ufunc machinery, a second of a cold start)."""
+    for i in range(values.shape[0]):  # noqa: SIM110 (a generator compiles slower)
+        if math.isfinite(values[i]):
+            return True
+    return False
 
 
 @njit
@@ -131,7 +139,9 @@ def _broad(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-de
     matter: a point whose bound is below the arm's (probe's) closest part, a link whose bound
     less its bend is below that, below ``far`` or may need refining (:func:`real_links`)."""
     ends, bends, points, links = near.ends, near.bends, near.point_distance, near.link_distance
-    most = bends.max() if bends.shape[0] else 0.0
+    most = 0.0
+    for i in range(bends.shape[0]):
+        most = max(most, bends[i])
     for j in range(points.shape[0]):
         far = shapes.far[j]
         if far == math.inf or (
@@ -161,7 +171,7 @@ def _broad(shapes, chain, near, tool, arm, probe):  # type: ignore[no-untyped-de
     return arm, probe
 
 
-@njit(inline="always")
+@njit
 def _turn(a, b, ja, jb, t, c):  # type: ignore[no-untyped-def]
     """``∂φ/∂Q_c`` (rad/rad) of the link's point at ``t``, ``φ = atan2(y, x)``:
     ``(x ∂y − y ∂x)/ρ²``; ``ja``, ``jb`` the ends' positional Jacobians (rows x, y, z)."""
@@ -171,7 +181,7 @@ def _turn(a, b, ja, jb, t, c):  # type: ignore[no-untyped-def]
     return (x * dy - y * dx) / (x * x + y * y)
 
 
-@njit
+@njit(separate=True)
 def real_link_gradient(near, origins, frame_jacobians, radius, j, i, out) -> None:  # type: ignore[no-untyped-def]
     """``∂d/∂Q`` (m/rad, (n,)) of link i's real clearance to obstacle j (as :func:`real_links`
     measured it) into ``out``: ``n · ∂p/∂Q`` at the closest point ``p`` of its piece, less the

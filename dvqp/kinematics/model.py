@@ -191,7 +191,7 @@ def _frame_jacobian(model, f, origin, jac) -> None:  # type: ignore[no-untyped-d
         jac[3, c], jac[4, c], jac[5, c] = w0, w1, w2
 
 
-@njit
+@njit(separate=True)
 def kinematics(model, radius, state) -> int:  # type: ignore[no-untyped-def]
     """Frames, frame Jacobians and DV coordinates of ``state.q``, written into ``state``
     (a packed :class:`~dvqp.workspace.StateBuffers`; ``model`` a packed :class:`ModelArrays`,

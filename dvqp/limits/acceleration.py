@@ -99,7 +99,7 @@ def _braking(a: float, dt: float, room: float) -> float:
     return -a * dt + math.sqrt((a * dt) ** 2 + 2.0 * a * max(room, 0.0))
 
 
-@njit
+@njit(separate=True)
 def acceleration_bounds(
     q: Array,
     q_min: Array,

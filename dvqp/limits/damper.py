@@ -177,7 +177,7 @@ def damper_value(
     return min(max(rhs, low), high)
 
 
-@njit
+@njit(separate=True)
 def damper_rows(params, dampers, dt: float, G: Array, h: Array) -> None:  # type: ignore[no-untyped-def]
     """Rows ``r`` of ``G``, ``h`` from damper r's distance (``dampers``, packed
     :class:`~dvqp.workspace.DamperBuffers`; ``params`` a packed :class:`DamperArrays`):
@@ -197,11 +197,10 @@ def damper_rows(params, dampers, dt: float, G: Array, h: Array) -> None:  # type
             h[r] = np.inf
 
 
-@njit
+@njit(separate=True)
 def damper_values(angle, distance: Array, values: Array, start: int) -> None:  # type: ignore[no-untyped-def]
     """The verified values of the damper rows at ``values[start:]``: the distances, or the
     angle ``asin(min(d, 1))`` of an ``angle`` row."""
-    values[start : start + distance.shape[0]] = distance
-    for r in range(distance.shape[0]):
-        if angle[r]:
-            values[start + r] = math.asin(min(distance[r], 1.0))
+    for r in range(distance.shape[0]):  # a loop: a slice assignment compiles numba's
+        # shape-mismatch message (string formatting), 2 s of a cold start
+        values[start + r] = math.asin(min(distance[r], 1.0)) if angle[r] else distance[r]

@@ -149,7 +149,7 @@ def start_broken_lines(found: Sequence[StartBroken]) -> list[str]:
     return lines
 
 
-@njit
+@njit(separate=True)
 def worst_excess(values: Array, floor: Array, tolerance: Array, out: Array) -> int:
     """``out = [floor − value, (floor − value)/tolerance]`` of the value of largest ratio
     (``[−inf, −inf]`` if none); returns its index, or −1. A NaN is the worst (never kept)."""

@@ -189,7 +189,7 @@ def _finite(name: str, value: float) -> float:
     return float(value)
 
 
-@njit
+@njit(separate=True)
 def height_distances(guarded, jacobians, first, count, start, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
     """Heights ``h`` (m) and ``∂h/∂Q`` of the guarded points ``first .. first + count − 1``
     (``guarded`` (k+1, 3), ``jacobians`` (k+1, 3, n)), from row ``start``."""
@@ -219,7 +219,7 @@ def chord_low(guarded, origins, a, b, radius):  # type: ignore[no-untyped-def]
     return h, t, inside, px / max(rho, 1e-300), py / max(rho, 1e-300)
 
 
-@njit
+@njit(separate=True)
 def chord_heights(
     guarded, origins, frame_jacobians, ends, radius, chords, distance, gradient, usable
 ) -> None:  # type: ignore[no-untyped-def]
@@ -236,7 +236,7 @@ def chord_heights(
             gradient[r, q] = ux * jx + uy * jy
 
 
-@njit
+@njit(separate=True)
 def lowest_chords(guarded, origins, ends, k, radius):  # type: ignore[no-untyped-def]
     """``(h, i, h_holder)``: the lowest height (m) of the chords of the guarded links ``ends``
     (L, 2) other than the probe holder (link ``k − 1``): the body links and the carriage link,

@@ -57,7 +57,7 @@ class JointPositionLimit(Limit):
         return None
 
 
-@njit
+@njit(separate=True)
 def position_bounds(q: Array, q_min: Array, q_max: Array, dt: float, lb: Array, ub: Array) -> None:
     """``min((q_min − q)/dt, 0) ≤ Q̇ ≤ max((q_max − q)/dt, 0)``, intersected into ``lb``,
     ``ub`` in place."""
@@ -66,7 +66,7 @@ def position_bounds(q: Array, q_min: Array, q_max: Array, dt: float, lb: Array, 
         ub[i] = min(ub[i], max((q_max[i] - q[i]) / dt, 0.0))
 
 
-@njit
+@njit(separate=True)
 def joint_room(q: Array, q_min: Array, q_max: Array, values: Array, start: int) -> None:
     """The verified values ``[q_max − q, q − q_min]`` (rad, 2n) at ``values[start:]``
     (``inf`` on an unlimited side: never the worst)."""
@@ -108,7 +108,7 @@ class JointVelocityLimit(Limit):
         return None
 
 
-@njit
+@njit(separate=True)
 def velocity_bounds(
     qd_max: NDArray[np.float64], lb: NDArray[np.float64], ub: NDArray[np.float64]
 ) -> None:

@@ -155,7 +155,7 @@ class ObstacleDamper(VelocityDamper):
         )
 
 
-@njit
+@njit(separate=True)
 def obstacle_distances(
     near,
     jacobians,

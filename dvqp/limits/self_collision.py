@@ -108,7 +108,7 @@ class SelfCollision(VelocityDamper):
         )
 
 
-@njit
+@njit(separate=True)
 def pair_distances(o, pairs) -> None:  # type: ignore[no-untyped-def]
     """Distance, unit normal ``c_i − c_j``, ``s`` and ``t`` of the link pairs of the guarded
     points ``o`` (m, 3) into ``pairs`` (a packed PairBuffers): link i's segment
@@ -150,7 +150,7 @@ def pair_distances(o, pairs) -> None:  # type: ignore[no-untyped-def]
         pairs.normal[m, 0], pairs.normal[m, 1], pairs.normal[m, 2] = x / scale, y / scale, z / scale
 
 
-@njit
+@njit(separate=True)
 def self_distances(pairs, jac, start, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
     """Every pair's distance (m) and ``∂d/∂Q`` (see the module docstring) from row ``start``
     (``jac`` the guarded frames' (m, 6, n) Jacobians)."""

@@ -105,7 +105,7 @@ def tilt_cosine(origins, axes, frame_jacobians, m, du) -> float:  # type: ignore
     return u
 
 
-@njit
+@njit(separate=True)
 def tilt_distance(origins, axes, frame_jacobians, m, row, distance, gradient, usable) -> None:  # type: ignore[no-untyped-def]
     """Row ``row``: ``d = sin θ`` of the probe (frame ``m``) and
     ``∂d/∂Q = −(u / max(d, ε)) ∂u/∂Q``."""
@@ -118,7 +118,7 @@ def tilt_distance(origins, axes, frame_jacobians, m, row, distance, gradient, us
     distance[row], usable[row] = d, True
 
 
-@njit
+@njit(separate=True)
 def tilt_angle(origins, axes, m) -> float:  # type: ignore[no-untyped-def]
     """The tilt θ of the probe (guarded frame ``m``) from the radial direction, rad, in
     [0, π]."""

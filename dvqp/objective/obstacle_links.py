@@ -67,7 +67,7 @@ class ObstacleLinks(ObjectiveTerm):
         return None
 
 
-@njit
+@njit(separate=True)
 def obstacle_links(
     penalty: Array,
     penalty_gradient: Array,

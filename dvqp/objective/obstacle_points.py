@@ -65,7 +65,7 @@ class ObstaclePoints(ObjectiveTerm):
         return None
 
 
-@njit
+@njit(separate=True)
 def obstacle_points(
     penalty: Array,
     penalty_gradient: Array,

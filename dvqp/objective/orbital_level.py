@@ -47,7 +47,7 @@ class OrbitalLevel(ObjectiveTerm):
         return None
 
 
-@njit
+@njit(separate=True)
 def orbital_level(
     guarded: Array, jacobians: Array, level: float, k_height: Array, value: Array, gradient: Array
 ) -> None:

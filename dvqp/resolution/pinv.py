@@ -94,7 +94,7 @@ def _solve(factor: Array, x: Array) -> None:
         x[r] = v / factor[r, r]
 
 
-@njit
+@njit(separate=True)
 def pinv_step(A, b, cost, weights, P, dense, damping, info, out) -> int:  # type: ignore[no-untyped-def]
     """``out = M⁻¹g + M⁻¹Aᵀ (A M⁻¹ Aᵀ + μ² I)⁻¹ (b − A M⁻¹ g)`` with ``g = −cost`` and
     ``M = diag(weights)``, or the dense ``P`` if ``dense``. Returns −1, :data:`SINGULAR` (the

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from dvqp.errors import ParameterError
-from dvqp.geometry.measure import OTHER, ShapeArrays
+from dvqp.geometry.measure import ShapeArrays
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.shapes import Shape
 from dvqp.kinematics.robot import Robot
@@ -178,9 +178,9 @@ def lay_out(
     shapes = ShapeArrays.of(layout.shapes, plan.period)
     shapes.refine[:] = layout.refine  # links measured to the last precision below a margin
     if not layout.hooks.active:  # parts of your own may read any row: every row exact
-        boxed = shapes.code != OTHER  # the broad phase: exact rows up to every damper's reach
-        shapes.far[boxed] = layout.far[boxed]
-    layout.hooks.finalize(layout.shapes, shapes.code, layout.params, layout.damper_values)
+        compiled = shapes.compiled  # the broad phase: exact rows up to every damper's reach
+        shapes.far[compiled] = layout.far[compiled]
+    layout.hooks.finalize(layout.shapes, shapes.compiled, layout.params, layout.damper_values)
     fields = [f for f in RecordArrays.__dataclass_fields__ if f != "index"]
     record = (
         RecordArrays.none(n, k)

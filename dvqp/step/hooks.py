@@ -105,17 +105,22 @@ class Hooks:
         return self._later(self.prepared, lambda: self._rows(limit, G, h))
 
     def finalize(
-        self, shapes: Sequence[Shape], code: np.ndarray, params: DamperArrays, damper_values: int
+        self,
+        shapes: Sequence[Shape],
+        compiled: np.ndarray,
+        params: DamperArrays,
+        damper_values: int,
     ) -> None:
-        """Make every hook (the plan is finalised) and the one of shapes of your own."""
+        """Make every hook (the plan is finalised) and the one of shapes of your own (not
+        ``compiled``)."""
         self._params, self._damper_values = params, damper_values
         for stage, make in self._pending:
             stage.append(make())
         self._pending.clear()
-        if np.any(code == 3):  # OTHER: shapes of your own
+        if not np.all(compiled):  # shapes of your own
             plan = self.plan
             self.measured.append(
-                lambda: user_rows(shapes, code, plan.state.guarded, plan.period, plan.proximity)
+                lambda: user_rows(shapes, compiled, plan.state.guarded, plan.period, plan.proximity)
             )
 
     # -- the hooks ------------------------------------------------------------------------

@@ -38,7 +38,7 @@ class ToolTask(Task):
         return None
 
 
-@njit
+@njit(separate=True)
 def tool_rows(
     tool_jacobian: NDArray[np.float64],
     command: NDArray[np.float64],

@@ -3,7 +3,7 @@ packing of many arrays into one numba struct. It imports no domain module of dvq
 
 from dvqp.workspace.buffers import PairBuffers, ProximityBuffers, StateBuffers, link_ends
 from dvqp.workspace.plan import CheckBuffers, DamperBuffers, Kernel, QPBuffers, Slot, StepPlan
-from dvqp.workspace.struct import as_struct
+from dvqp.workspace.struct import as_struct, struct_type
 
 __all__ = [
     "CheckBuffers",
@@ -17,4 +17,5 @@ __all__ = [
     "StepPlan",
     "as_struct",
     "link_ends",
+    "struct_type",
 ]

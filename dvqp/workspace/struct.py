@@ -116,7 +116,8 @@ def as_struct(value: Any) -> Arrays:
     """``value`` (a dataclass instance) as one numba struct of the same fields.
 
     Fields may be arrays (C-contiguous, writable), Python or NumPy numbers and booleans, or
-    dataclasses of the same kind (packed recursively).
+    dataclasses of the same kind (packed recursively: one compiled constructor a struct type;
+    one for a whole tree, handed a tuple of ~150 arrays, took longer to compile than all).
 
     Raises
     ------
@@ -126,20 +127,41 @@ def as_struct(value: Any) -> Arrays:
     names, items = [], []
     for field in dataclasses.fields(value):
         item = getattr(value, field.name)
-        if dataclasses.is_dataclass(item):
-            item = as_struct(item)
-        elif isinstance(item, np.ndarray):
-            if not (item.flags.c_contiguous and item.flags.writeable):
-                raise TypeError(f"{field.name}: a packed array must be C-contiguous, writable")
-        elif not isinstance(item, bool | int | float | np.number | np.bool_):
-            raise TypeError(f"{field.name}: cannot pack a {type(item).__name__}")
         names.append(field.name)
-        items.append(item)
+        items.append(as_struct(item) if dataclasses.is_dataclass(item) else _packable(field, item))
     fields = tuple((name, _type_of(item)) for name, item in zip(names, items, strict=True))
+    return _make(_kind(fields), tuple(items))  # type: ignore[no-any-return]
+
+
+def struct_type(value: Any) -> ArraysType:
+    """The numba type :func:`as_struct` gives ``value``, without packing it (e.g. to compile a
+    kernel for a struct before it exists)."""
+    fields = []
+    for field in dataclasses.fields(value):
+        item = getattr(value, field.name)
+        if dataclasses.is_dataclass(item):
+            fields.append((field.name, struct_type(item)))
+        else:
+            fields.append((field.name, _type_of(_packable(field, item))))
+    return _kind(tuple(fields))
+
+
+def _packable(field: dataclasses.Field[Any], item: Any) -> Any:
+    """``item``, if :func:`as_struct` can pack it (else TypeError)."""
+    if isinstance(item, np.ndarray):
+        if not (item.flags.c_contiguous and item.flags.writeable):
+            raise TypeError(f"{field.name}: a packed array must be C-contiguous, writable")
+    elif not isinstance(item, bool | int | float | np.number | np.bool_):
+        raise TypeError(f"{field.name}: cannot pack a {type(item).__name__}")
+    return item
+
+
+def _kind(fields: tuple[tuple[str, Any], ...]) -> ArraysType:
+    """The struct type of these fields (made once)."""
     kind = _KINDS.get(fields)
     if kind is None:
         kind = _KINDS[fields] = ArraysType(list(fields))
-    return _make(kind, tuple(items))  # type: ignore[no-any-return]
+    return kind
 
 
 _KINDS: dict[tuple[tuple[str, Any], ...], ArraysType] = {}

@@ -67,7 +67,7 @@ report["can_compile"] = {name: d._can_compile for name, d in kernels.items()}
 print(json.dumps(report))
 """
 
-#: The kernels with a declared signature (the others are helpers inlined into them).
+#: The kernels with a declared signature (the others are the helpers they call).
 DECLARED = (
     "solvers._fast.refresh",
     "solvers._fast.stack",
@@ -85,7 +85,9 @@ def test_kernels_compile_at_their_first_call_one_specialisation_each() -> None:
     assert not any(report["import"]["overloads"].values())  # nothing compiled nor loaded
     final = report["osqp"]
     assert all(count <= 1 for count in final["compiled"].values()), final  # 0: from the cache
-    assert set(final["compiled"]) <= set(DECLARED), final  # inlined helpers never compile
     for name, count in final["overloads"].items():  # read-only and writable calls: one each
-        assert count == (1 if name in DECLARED else 0), (name, final)
+        # a declared kernel: its one signature; a helper (the residuals' body, which both
+        # residual kernels call on read-only arrays, and its parts): at most one
+        # specialisation (none where its caller's code, linked in, came from the cache)
+        assert count == 1 if name in DECLARED else count <= 1, (name, final)
         assert report["can_compile"][name] == (name not in DECLARED), name

@@ -10,7 +10,7 @@ import numpy as np
 
 from dvqp import _validate
 from dvqp.errors import ParameterError
-from dvqp.geometry.shapes.shape import BAND, Array, CompiledShape, Shape
+from dvqp.geometry.shapes.shape import Array, CompiledShape, Shape, ShapeKernels
 from dvqp.workspace.wiring import overrides
 from solvers.jit import njit
 
@@ -72,7 +72,7 @@ class Band(Shape):
         if overrides(self, Band, "point_distance", "segment_distance"):
             return None
         low, high = float(self.z_min), float(self.z_max)
-        return CompiledShape(BAND, (low, high, 0.0, 0.0), (-math.inf, math.inf, low, high))
+        return CompiledShape(KERNELS, (low, high, 0.0, 0.0), (-math.inf, math.inf, low, high))
 
     def outline(self) -> Array:
         """``[[nan, z_min], [nan, z_max]]``: a band has edges, not a closed outline."""
@@ -106,3 +106,21 @@ def band_segment(z_min: float, z_max: float, za: float, zb: float) -> tuple[floa
     if best_k == 2 and 0.0 < best_t < 1.0:
         nz = 0.0
     return d, best_t, nz
+
+
+@njit
+def measure_point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
+    """:func:`band_point` of band j of ``shapes`` (``data[j] = [z_min, z_max, 0, 0]``)."""
+    d, nz = band_point(shapes.data[j, 0], shapes.data[j, 1], pz)
+    return d, 0.0, nz
+
+
+@njit
+def measure_segment(shapes, j, al, az, bl, bz, a_end, b_end):  # type: ignore[no-untyped-def]
+    """:func:`band_segment` of band j of ``shapes`` (its ends' distances unused)."""
+    d, t, nz = band_segment(shapes.data[j, 0], shapes.data[j, 1], az, bz)
+    return d, t, 0.0, nz
+
+
+KERNELS = ShapeKernels(measure_point, measure_segment)
+"""How the compiled measurement measures a band."""

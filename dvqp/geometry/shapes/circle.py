@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp import _validate
-from dvqp.geometry.shapes.shape import CIRCLE, Array, CompiledShape, Shape
+from dvqp.geometry.shapes.shape import Array, CompiledShape, Shape, ShapeKernels
 from dvqp.kinematics.developed_view import wrap_period
 from dvqp.workspace.wiring import overrides
 from solvers.jit import njit
@@ -71,7 +71,7 @@ class Circle(Shape):
         if overrides(self, Circle, "point_distance", "segment_distance"):
             return None
         (l, z), r = self.center, self.radius
-        return CompiledShape(CIRCLE, (float(l), float(z), float(r), 0.0), (-r, r, z - r, z + r))
+        return CompiledShape(KERNELS, (float(l), float(z), float(r), 0.0), (-r, r, z - r, z + r))
 
     def outline(self) -> Array:
         """128 points on the circle, closed, m."""
@@ -104,3 +104,42 @@ def circle_segment(cl, cz, radius, al, az, bl, bz, period):  # type: ignore[no-u
     t = min(max((sl * gl + sz * gz) / length2, 0.0), 1.0)
     d, nl, nz = _from_offset(sl - t * gl, sz - t * gz, radius)
     return d, t, nl, nz
+
+
+@njit
+def measure_point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
+    """:func:`circle_point` of circle j of ``shapes`` (``data[j] = [l, z, r, 0]``)."""
+    data = shapes.data
+    return circle_point(data[j, 0], data[j, 1], data[j, 2], pl, pz, shapes.period)
+
+
+@njit
+def measure_segment(shapes, j, al, az, bl, bz, a_end, b_end):  # type: ignore[no-untyped-def]
+    """:func:`circle_segment` of circle j of ``shapes`` (its ends' distances unused)."""
+    data = shapes.data
+    return circle_segment(data[j, 0], data[j, 1], data[j, 2], al, az, bl, bz, shapes.period)
+
+
+@njit
+def measure_rows(shapes, j, chain, near) -> None:  # type: ignore[no-untyped-def]
+    """Every row of circle j, exact, into ``near`` (a packed
+    :class:`~dvqp.workspace.ProximityBuffers`): the points ``chain`` (m) and the links
+    ``near.ends``, its data read once. A circle's 13 rows took 0.11 µs so, 1.4–1.6 µs by a
+    call a row (the packed struct read at each), timed in a loop over the states of a
+    fifty-obstacles run."""
+    cl, cz, r, period = shapes.data[j, 0], shapes.data[j, 1], shapes.data[j, 2], shapes.period
+    distance, normal = near.point_distance, near.point_normal
+    for i in range(chain.shape[0]):
+        d, nl, nz = circle_point(cl, cz, r, chain[i, 0], chain[i, 1], period)
+        distance[j, i], normal[j, i, 0], normal[j, i, 1] = d, nl, nz
+    ends, distance, normal, at = near.ends, near.link_distance, near.link_normal, near.link_t
+    for i in range(ends.shape[0]):
+        a, b = ends[i, 0], ends[i, 1]
+        d, t, nl, nz = circle_segment(
+            cl, cz, r, chain[a, 0], chain[a, 1], chain[b, 0], chain[b, 1], period
+        )
+        distance[j, i], at[j, i], normal[j, i, 0], normal[j, i, 1] = d, t, nl, nz
+
+
+KERNELS = ShapeKernels(measure_point, measure_segment, rows=measure_rows)
+"""How the compiled measurement measures a circle."""

@@ -19,7 +19,8 @@ from numpy.typing import NDArray
 
 from dvqp import _validate
 from dvqp.errors import ParameterError
-from dvqp.geometry.shapes.shape import INLET, Array, CompiledShape, Shape
+from dvqp.geometry.shapes.shape import UNKNOWN, Array, CompiledShape, Shape, ShapeKernels
+from dvqp.kinematics.developed_view import wrap_period
 from dvqp.workspace.wiring import overrides
 from solvers.jit import njit
 
@@ -32,8 +33,6 @@ BRACKET_STEPS = 120
 INV_PHI = (math.sqrt(5.0) - 1.0) / 2.0
 _ON = 1e-14
 """m: a point this close to the outline is on it (its normal: the outline's)."""
-UNKNOWN = (math.nan, 0.0, 0.0)
-"""An end of a segment whose distance the caller does not have."""
 _POINT2 = 1e-18
 """m²: a shorter segment is a point (its nearer end)."""
 
@@ -112,7 +111,7 @@ class Inlet(Shape):
         low, high = local.min(axis=0), local.max(axis=0)
         box = (float(low[0]), float(high[0]), float(low[1] + z), float(high[1] + z))
         data = (float(l), float(z), float(self.radius), float(self.pipe_radius))
-        return CompiledShape(INLET, data, box, local)
+        return CompiledShape(KERNELS, data, box, local)
 
     def outline(self) -> Array:
         """512 points of the exact outline, closed."""
@@ -311,3 +310,46 @@ def inlet_segment(al, az, bl, bz, r, big, sl, sz, a_end, b_end):  # type: ignore
             if d < res[0]:  # touching (d <= _ON): the outline's normal there, ±n
                 res = (d, t, ol / d, oz / d) if d > _ON else (d, t, side * nl, side * nz)
     return res
+
+
+@njit
+def measure_point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
+    """:func:`inlet_point` of inlet j of ``shapes`` (``data[j] = [l0, z0, r, R]``, its
+    outline samples ``vl, vz[start[j]:stop[j]]``, from its centre)."""
+    a, b, data = shapes.start[j], shapes.stop[j], shapes.data
+    return inlet_point(
+        wrap_period(pl - data[j, 0], shapes.period),
+        pz - data[j, 1],
+        data[j, 2],
+        data[j, 3],
+        shapes.vl[a:b],
+        shapes.vz[a:b],
+    )
+
+
+@njit
+def measure_segment(shapes, j, al, az, bl, bz, a_end, b_end):  # type: ignore[no-untyped-def]
+    """:func:`inlet_segment` of inlet j of ``shapes``, with its ends' distances where known
+    (an end measured at another period's copy of the inlet: unknown)."""
+    a, b, data, period = shapes.start[j], shapes.stop[j], shapes.data, shapes.period
+    la = wrap_period(al - data[j, 0], period)
+    lb = la + wrap_period(bl - al, period)
+    if lb != wrap_period(bl - data[j, 0], period):  # b measured at another period's copy
+        b_end = UNKNOWN
+    return inlet_segment(
+        la,
+        az - data[j, 1],
+        lb,
+        bz - data[j, 1],
+        data[j, 2],
+        data[j, 3],
+        shapes.vl[a:b],
+        shapes.vz[a:b],
+        a_end,
+        b_end,
+    )
+
+
+KERNELS = ShapeKernels(measure_point, measure_segment, boxed=True, ends=True)
+"""How the compiled measurement measures an inlet (a part far from its box: the box's
+distance; a segment's ends measured once)."""

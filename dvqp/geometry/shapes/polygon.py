@@ -16,7 +16,8 @@ import numpy as np
 from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry.shapes import polygon_geometry as geo
-from dvqp.geometry.shapes.shape import POLYGON, Array, CompiledShape, Shape
+from dvqp.geometry.shapes.shape import Array, CompiledShape, Shape, ShapeKernels
+from dvqp.kinematics.developed_view import wrap_period
 from dvqp.workspace.wiring import overrides
 from solvers.jit import njit
 
@@ -90,7 +91,7 @@ class Polygon(Shape):
         local = self.local_vertices
         low, high = local.min(axis=0), local.max(axis=0)
         box = (float(low[0]), float(high[0]), float(low[1]), float(high[1]))
-        return CompiledShape(POLYGON, (float(self.l_ref), 0.0, 0.0, 0.0), box, local)
+        return CompiledShape(KERNELS, (float(self.l_ref), 0.0, 0.0, 0.0), box, local)
 
     def outline(self) -> Array:
         """The vertices, closed."""
@@ -226,3 +227,26 @@ def polygon_segment(al: float, az: float, bl: float, bz: float, vl: Array, vz: A
     if res[0] < 0.0 or _crosses(al, az, bl, bz, vl, vz):
         res = _deepest(al, az, bl, bz, vl, vz)
     return res
+
+
+@njit
+def measure_point(shapes, j, pl, pz):  # type: ignore[no-untyped-def]
+    """:func:`polygon_point` of polygon j of ``shapes`` (``data[j] = [l_ref, 0, 0, 0]``, its
+    vertices ``vl, vz[start[j]:stop[j]]``, l from ``l_ref``)."""
+    a, b = shapes.start[j], shapes.stop[j]
+    pl = wrap_period(pl - shapes.data[j, 0], shapes.period)
+    return polygon_point(pl, pz, shapes.vl[a:b], shapes.vz[a:b])
+
+
+@njit
+def measure_segment(shapes, j, al, az, bl, bz, a_end, b_end):  # type: ignore[no-untyped-def]
+    """:func:`polygon_segment` of polygon j of ``shapes`` (its ends' distances unused)."""
+    a, b, period = shapes.start[j], shapes.stop[j], shapes.period
+    la = wrap_period(al - shapes.data[j, 0], period)
+    lb = la + wrap_period(bl - al, period)
+    return polygon_segment(la, az, lb, bz, shapes.vl[a:b], shapes.vz[a:b])
+
+
+KERNELS = ShapeKernels(measure_point, measure_segment, boxed=True)
+"""How the compiled measurement measures a polygon (a part far from its box: the box's
+distance)."""

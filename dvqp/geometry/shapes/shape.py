@@ -9,15 +9,17 @@ theorem). The objective's repulsion uses the penalty ``e = d (d + 2ρ)`` with ``
 ``‖S − p‖² − R²``). Differences in l are wrapped modulo ``2πR`` (``period``).
 
 dvqp's own shapes (circle, inlet, band, polygon) are measured by compiled kernels in their
-modules: each says itself how (:meth:`Shape.compiled`: its kind's code, by which
-:mod:`dvqp.geometry.measure` calls its kernels, and its parameters); a shape of your own
-derives from :class:`Shape` and implements :meth:`Shape.point_distance` and
-:meth:`Shape.segment_distance` in NumPy. A subclass of a built-in shape inherits its compiled
-measurement, unless it replaces those methods.
+modules: each says itself how (:meth:`Shape.compiled`: its kind's kernels, which
+:mod:`dvqp.geometry.measure` calls by their addresses, and its parameters), so that a run
+compiles only the kinds it measures; a shape of your own derives from :class:`Shape` and
+implements :meth:`Shape.point_distance` and :meth:`Shape.segment_distance` in NumPy. A
+subclass of a built-in shape inherits its compiled measurement, unless it replaces those
+methods.
 """
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -27,8 +29,40 @@ from numpy.typing import NDArray
 
 Array = NDArray[np.float64]
 
-CIRCLE, BAND, POLYGON, OTHER, INLET = 0, 1, 2, 3, 4
-"""Codes of the compiled shape kinds; OTHER is a shape of your own (measured in NumPy)."""
+UNKNOWN = (math.nan, 0.0, 0.0)
+"""A segment's end whose distance the caller does not have (:class:`ShapeKernels` ``segment``)."""
+
+
+@dataclass(frozen=True)
+class ShapeKernels:
+    """A shape kind's compiled measurement: ``@njit`` kernels reading obstacle ``j``'s
+    parameters from the packed :class:`~dvqp.geometry.measure.ShapeArrays` ``shapes``.
+
+    Attributes
+    ----------
+    point : dispatcher
+        ``point(shapes, j, pl, pz) -> (d, ∂d/∂l, ∂d/∂z)``: a point's signed distance (m) and
+        normal.
+    segment : dispatcher
+        ``segment(shapes, j, al, az, bl, bz, a_end, b_end) -> (d, t, ∂d/∂l, ∂d/∂z)``: a
+        segment's smallest signed distance, its parameter and the normal there; ``a_end``,
+        ``b_end`` its ends' ``point`` values where known (else
+        :data:`UNKNOWN`), if the kind uses them (``ends``).
+    rows : dispatcher, optional
+        ``rows(shapes, j, chain, near)``: every point's and link's exact row to obstacle j at
+        once, where that is cheaper than a call a row (a circle's).
+    boxed : bool
+        Whether a part far from the obstacle's box may get the box's distance instead (its
+        exact distance costs more than the box's).
+    ends : bool
+        Whether ``segment`` uses its ends' distances (a segment's ends then measured once).
+    """
+
+    point: Any
+    segment: Any
+    rows: Any = None
+    boxed: bool = False
+    ends: bool = False
 
 
 @dataclass(frozen=True)
@@ -37,8 +71,8 @@ class CompiledShape:
 
     Attributes
     ----------
-    code : int
-        Its kind's kernels: :data:`CIRCLE`, :data:`BAND`, :data:`POLYGON` or :data:`INLET`.
+    kernels : ShapeKernels
+        Its kind's kernels.
     data : tuple of 4 floats
         Its parameters (see :class:`~dvqp.geometry.measure.ShapeArrays`).
     box : tuple of 4 floats
@@ -47,7 +81,7 @@ class CompiledShape:
         Its vertices or outline samples in its local frame (m).
     """
 
-    code: int
+    kernels: ShapeKernels
     data: tuple[float, float, float, float]
     box: tuple[float, float, float, float]
     samples: Array | None = None
