@@ -15,8 +15,9 @@ from typing import Any
 import numpy as np
 
 from dvqp._files import output_path
+from dvqp._inputs import NpzArrays
 from dvqp.cli.figures import FIGURE_FORMATS
-from dvqp.errors import DvqpError, one_line
+from dvqp.errors import DvqpError, InputFileError, one_line
 from dvqp.motion.trajectory import Trajectory
 from dvqp.scenes import Scene, environment, load_scene, loads
 from dvqp.view.scene3d import Scene3D, scene_3d
@@ -153,36 +154,43 @@ def trajectory_3d(path: str, traj: Trajectory, scene: Scene, samples: int = 2000
 
 
 def load_trajectory(path: str) -> Trajectory:
-    """A trajectory file, checked enough to be drawn; else a DvqpError
-    ``<path>: cannot read: <reason>`` or ``<path>: not a dvqp trajectory (<reason>)``."""
+    """A trajectory file, checked enough to be drawn (its arrays' declared sizes before any
+    is inflated: :meth:`~dvqp.motion.trajectory.Trajectory.load`).
+
+    Raises
+    ------
+    InputFileError
+        ``<path>: cannot read: <reason>``, ``<path>: not a dvqp trajectory (<reason>)``, or a
+        retimed motion (``dvqp plan --retime``), which is not drawn.
+    """
     try:
         with open(path, "rb") as fh:
             zipped = fh.read(4) == b"PK\x03\x04"
-    except OSError as exc:
-        raise DvqpError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+    except (OSError, ValueError) as exc:
+        raise InputFileError(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}") from exc
     if not zipped:
-        raise DvqpError(f"{path}: not a dvqp trajectory (not an .npz file)")
+        raise InputFileError(path, "not a dvqp trajectory (not an .npz file)")
     try:
         traj = Trajectory.load(path)
-    except DvqpError as exc:  # dvqp reads arrays only, never pickled objects
+    except InputFileError as exc:
         if _retimed(path):
-            raise DvqpError(
-                f"{path}: a retimed motion (dvqp plan --retime): dvqp plot draws "
-                "planned runs; save the run itself (dvqp plan SCENE -o RUN.npz) "
-                "and plot that"
+            raise InputFileError(
+                path,
+                "a retimed motion (dvqp plan --retime): dvqp plot draws planned runs; save the "
+                "run itself (dvqp plan SCENE -o RUN.npz) and plot that",
             ) from exc
-        raise DvqpError(f"{path}: not a dvqp trajectory (not written by 'dvqp plan')") from exc
+        raise
     if not _drawable(traj):
-        raise DvqpError(f"{path}: not a dvqp trajectory (arrays of unexpected shapes)")
+        raise InputFileError(path, "not a dvqp trajectory (arrays of unexpected shapes)")
     return traj
 
 
 def _retimed(path: str) -> bool:
     """The file is a retimed motion's (:meth:`dvqp.retime.Retimed.save`)."""
     try:
-        with np.load(path, allow_pickle=False) as data:
-            return {"rate", "planned_duration", "qddot"} <= set(data.files)
-    except (OSError, ValueError, EOFError):
+        with NpzArrays(path, "a retimed motion") as npz:
+            return {"rate", "planned_duration", "qddot"} <= set(npz.members)
+    except InputFileError:
         return False
 
 

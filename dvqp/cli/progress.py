@@ -17,6 +17,7 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, TextIO
 
+from dvqp._inputs import MEMORY_SHARE, physical_memory
 from dvqp.errors import SceneError, one_line
 from dvqp.motion.jog import jog_step_count
 
@@ -29,8 +30,6 @@ STEP_SECONDS = 1e-4
 25 µs, the slower backends and steps taken by the reference path a few times more."""
 LONG_RUN_SECONDS = 120.0
 """Runs estimated to take longer than this are announced before they start, s."""
-MEMORY_SHARE = 0.8
-"""Runs whose arrays would need more than this share of the machine's memory are refused."""
 
 
 @dataclass(frozen=True)
@@ -145,14 +144,6 @@ def check_size(scenes: Sequence[Scene], runs: int) -> None:
         if estimate.seconds * runs > LONG_RUN_SECONDS:
             note = f"{one_line(scene.source)}: {estimate.describe(runs)}"
             print(f"dvqp: note: {note}", file=sys.stderr)
-
-
-def physical_memory() -> int | None:
-    """The machine's memory, bytes (None where the system does not say)."""
-    try:
-        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (AttributeError, ValueError, OSError):
-        return None
 
 
 def duration(seconds: float) -> str:

@@ -400,7 +400,7 @@ def test_plot_of_a_missing_or_foreign_file_says_so_in_one_line(
     cases = {
         tmp_path / "missing.npz": "cannot read: No such file or directory",
         tmp_path / "small.toml": "not a dvqp trajectory (not an .npz file)",
-        pickled: "not a dvqp trajectory (not written by 'dvqp plan')",
+        pickled: "not a dvqp trajectory (member 't': pickled Python objects are not read)",
         shapes: "not a dvqp trajectory (arrays of unexpected shapes)",
         heights: "not a dvqp trajectory (arrays of unexpected shapes)",
     }
