@@ -56,12 +56,15 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Draw a saved trajectory (or its limits page); 0 once written."""
+    """Draw a saved trajectory (or its limits page, or its 3-D still); 0 once written. The
+    options and the output are checked before the trajectory is read."""
+    _check_options(args)
+    target = output_path(args.output, (".gif",) if args.gif else FIGURE_FORMATS)
     traj = load_trajectory(args.trajectory)
     if args.three_d:
-        return _plot_3d(args, traj)
-    if args.limits or args.scene is not None:
-        return _plot_limits(args, traj)
+        return _plot_3d(args, traj, target)
+    if args.limits:
+        return _plot_limits(args, traj, target)
     drawn_with: dict[str, Any] = {"full": args.full}
     if traj.scene_text:  # draw the stored scene's obstacles, levels and weld
         env = environment(traj.scene_text, f"{args.trajectory} (stored scene)")
@@ -74,17 +77,23 @@ def run(args: argparse.Namespace) -> int:
     from dvqp.cli import plot
 
     draw = plot.animate_trajectory if args.gif else plot.plot_trajectory
-    print(f"wrote {draw(traj, args.output, **drawn_with)}")
+    print(f"wrote {draw(traj, target, **drawn_with)}")
     return 0
 
 
-def _plot_limits(args: argparse.Namespace, traj: Trajectory) -> int:
-    """The limits page of a trajectory, from its stored scene (or ``--scene``)."""
-    if not args.limits or args.gif or args.full:
+def _check_options(args: argparse.Namespace) -> None:
+    """Refuse options that do not go together (a DvqpError)."""
+    if args.three_d:
+        if args.limits or args.gif or args.full:
+            raise DvqpError("--3d takes neither --limits, --gif nor --full")
+    elif (args.limits or args.scene is not None) and (not args.limits or args.gif or args.full):
         raise DvqpError(
             "--scene goes with --limits or --3d; --limits takes neither --gif nor --full"
         )
-    target = output_path(args.output, FIGURE_FORMATS)
+
+
+def _plot_limits(args: argparse.Namespace, traj: Trajectory, target: Path) -> int:
+    """The limits page of a trajectory, from its stored scene (or ``--scene``)."""
     scene = scene_of(args.trajectory, traj, args.scene)
     from dvqp.cli.limit_series import limit_series
     from dvqp.cli.plot_limits import plot_limits
@@ -99,11 +108,8 @@ def _plot_limits(args: argparse.Namespace, traj: Trajectory) -> int:
     return 0
 
 
-def _plot_3d(args: argparse.Namespace, traj: Trajectory) -> int:
+def _plot_3d(args: argparse.Namespace, traj: Trajectory, target: Path) -> int:
     """The still of the 3-D view of a trajectory, with its stored scene (or ``--scene``)."""
-    if args.limits or args.gif or args.full:
-        raise DvqpError("--3d takes neither --limits, --gif nor --full")
-    target = output_path(args.output, FIGURE_FORMATS)
     scene = scene_of(args.trajectory, traj, args.scene)
     view = trajectory_3d(args.trajectory, traj, scene)
     from dvqp.cli.plot3d import plot_3d

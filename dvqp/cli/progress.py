@@ -1,6 +1,7 @@
 """What the command line wraps around a run: :func:`check_size` (refuse a run too big for the
-memory, announce a long one), :class:`ProgressBar`, :func:`interruptible` (Ctrl-C a clean
-stop) and :func:`warnings_summed_up` (the numerical code's warnings in one line).
+memory, announce a long one), :class:`ProgressBar`, :func:`interruptible` (Ctrl-C and
+``SIGTERM`` a clean stop) and :func:`warnings_summed_up` (the numerical code's warnings in one
+line).
 """
 
 from __future__ import annotations
@@ -73,13 +74,25 @@ def bytes_per_step(robot: Robot) -> int:
     return 8 * (5 * n + 9 * k + 35)
 
 
+class Terminated(KeyboardInterrupt):
+    """``SIGTERM`` (what ``timeout``, ``docker stop`` and systemd send), raised where Ctrl-C
+    would be, so that it takes the same way out: files being written are removed, finished
+    ones stay (exit code 143, ``dvqp: terminated``)."""
+
+
+STOPS = {signal.SIGINT: KeyboardInterrupt, signal.SIGTERM: Terminated}
+"""The signals :func:`interruptible` turns into an exception, and the exception."""
+
+
 @contextlib.contextmanager
 def interruptible() -> Iterator[None]:
-    """Ctrl-C raises KeyboardInterrupt here, and ends forked worker processes quietly.
+    """Ctrl-C (``SIGINT``) raises KeyboardInterrupt here, ``SIGTERM`` :class:`Terminated` (a
+    KeyboardInterrupt too): every ``finally`` and ``except BaseException`` runs, so nothing
+    half-written is left behind. Forked worker processes end quietly.
 
-    Forked workers (``compare --jobs``) inherit the handler and exit at once (code 130); an
-    interrupt sent to this process alone (``kill -INT``) is passed on to them. Outside the
-    main thread (where signals are delivered) nothing changes.
+    Forked workers (``compare --jobs``) inherit the handler and exit at once (code 130); a
+    signal sent to this process alone (``kill -INT``, ``kill -TERM``) is passed on to them.
+    Outside the main thread (where signals are delivered) nothing changes.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
@@ -91,14 +104,26 @@ def interruptible() -> Iterator[None]:
             os._exit(130)
         for child in multiprocessing.active_children():
             with contextlib.suppress(OSError, TypeError):
-                os.kill(child.pid, signal.SIGINT)  # type: ignore[arg-type]
-        raise KeyboardInterrupt
+                os.kill(child.pid, signum)  # type: ignore[arg-type]
+        raise STOPS[signal.Signals(signum)]
 
-    previous = signal.signal(signal.SIGINT, handler)
+    previous = {signum: signal.signal(signum, handler) for signum in STOPS}
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for signum, before in previous.items():
+            signal.signal(signum, before)
+
+
+def terminated(exc: BaseException) -> bool:
+    """``exc`` is, or was raised because of, :class:`Terminated` (``SIGTERM``)."""
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, Terminated):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__  # type: ignore[assignment]
+    return False
 
 
 @contextlib.contextmanager

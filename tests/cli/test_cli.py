@@ -440,6 +440,11 @@ LONG = "[[motion.jog]]\nduration = 7500.0\nvelocity = [0.0, 0.0, 0.0, 0.0]"  # 1
 
 
 @pytest.mark.parametrize(
+    ("signum", "code", "said"),
+    [(signal.SIGINT, 130, "dvqp: interrupted"), (signal.SIGTERM, 143, "dvqp: terminated")],
+    ids=["SIGINT", "SIGTERM"],
+)
+@pytest.mark.parametrize(
     "args",
     [
         ["plan", "{scene}", "--backend", "pinv", "-o", "{tmp}/t.npz"],
@@ -460,7 +465,9 @@ LONG = "[[motion.jog]]\nduration = 7500.0\nvelocity = [0.0, 0.0, 0.0, 0.0]"  # 1
 @pytest.mark.skipif(
     not sys.platform.startswith("linux"), reason="workers are forked (inherit the handler) on Linux"
 )
-def test_a_real_sigint_stops_cleanly_with_exit_130(tmp_path: Path, args: list[str]) -> None:
+def test_a_real_sigint_or_sigterm_stops_cleanly_with_one_line(
+    tmp_path: Path, args: list[str], signum: int, code: int, said: str
+) -> None:
     scene = write_scene(tmp_path, motion=LONG)
     write_scene(tmp_path, "two", motion=LONG)
     argv = [a.format(scene=scene, tmp=tmp_path) for a in args]
@@ -474,10 +481,10 @@ def test_a_real_sigint_stops_cleanly_with_exit_130(tmp_path: Path, args: list[st
     note = proc.stderr.readline()  # announced before the run starts
     assert note.startswith(f"dvqp: note: {scene}: about 1.5e+06 steps"), note
     time.sleep(0.3)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(signum)
     out, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130 and out == ""
-    assert err.splitlines()[-1] == "dvqp: interrupted" and "Traceback" not in err
+    assert proc.returncode == code and out == ""
+    assert err.splitlines()[-1] == said and "Traceback" not in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml", "two.toml"]
 
 
