@@ -36,12 +36,13 @@ LONG_RUN_SECONDS = 120.0
 @dataclass(frozen=True)
 class RunEstimate:
     """How big one planned run will be, from its scene alone: ``steps`` (a path's approach to
-    its first waypoint not counted), ``seconds`` at :data:`STEP_SECONDS` a step, and
-    ``nbytes`` of its trajectory's arrays."""
+    its first waypoint not counted), ``seconds`` at :data:`STEP_SECONDS` a step, ``nbytes``
+    of its trajectory's arrays, and the ``motion`` it plans, s (``steps × dt``)."""
 
     steps: int
     seconds: float
     nbytes: int
+    motion: float = 0.0
 
     @classmethod
     def of(cls, scene: Scene) -> RunEstimate:
@@ -50,13 +51,21 @@ class RunEstimate:
             steps = jog_step_count(scene.jog, scene.dt)
         else:
             steps = int(scene.path.step_count(scene.dt)) + 1
-        return cls(steps, steps * STEP_SECONDS, steps * bytes_per_step(scene.robot))
+        nbytes = steps * bytes_per_step(scene.robot)
+        return cls(steps, steps * STEP_SECONDS, nbytes, steps * scene.dt)
 
     def describe(self, runs: int = 1) -> str:
-        """``about 8e+06 steps: roughly 1.3 h and 4.4 GB`` (for ``runs`` runs)."""
+        """``about 5e+06 steps (14 h of motion in steps of 0.01 s): roughly 8.3 min and
+        5.8 GB`` (for ``runs`` runs): what makes a run long is said, so that a slip (a path
+        at 1e-6 m/s) is seen before it runs."""
         runs_text = f" in {runs} runs" if runs > 1 else ""
+        motion = ""
+        if self.motion > 0.0:
+            motion = (
+                f" ({duration(self.motion)} of motion in steps of {self.motion / self.steps:.3g} s)"
+            )
         return (
-            f"about {self.steps:.3g} steps{runs_text}: roughly "
+            f"about {self.steps:.3g} steps{motion}{runs_text}: roughly "
             f"{duration(self.seconds * runs)} and {self.nbytes / 1e9:.2g} GB"
         )
 

@@ -495,8 +495,9 @@ def test_a_run_too_big_for_the_memory_is_refused_before_it_starts(
     scene = write_scene(tmp_path, motion=LONG)
     assert main(["plan", scene, "--backend", "pinv", "-o", str(tmp_path / "t.npz")]) == 2
     assert capsys.readouterr().err == (
-        f"dvqp: {scene}: motion: about 1.5e+06 steps: roughly 2.5 min and 1.7 GB, more than this "
-        "machine's 0.1 GB allow: use a larger dt or a shorter motion\n"
+        f"dvqp: {scene}: motion: about 1.5e+06 steps (2.1 h of motion in steps of 0.005 s): "
+        "roughly 2.5 min and 1.7 GB, more than this machine's 0.1 GB allow: use a larger dt or "
+        "a shorter motion\n"
     )
     assert [p.name for p in tmp_path.iterdir()] == ["small.toml"]
 
