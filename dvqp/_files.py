@@ -1,12 +1,10 @@
-"""Output files and folders: checked before any work, written atomically; C output captured
-(private)."""
+"""Output files and folders: checked before any work, written atomically (private)."""
 
 from __future__ import annotations
 
 import contextlib
 import errno
 import os
-import sys
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -154,29 +152,3 @@ def _finish(tmp: Path, target: Path) -> None:
 
 def _output_error(target: Path, exc: OSError) -> OutputError:
     return OutputError(target, exc.strerror or str(exc) or type(exc).__name__, exc.errno)
-
-
-@contextlib.contextmanager
-def c_output_captured(lines: list[str]) -> Iterator[None]:
-    """Keep what C/C++ code (Pinocchio's URDF parser) writes to the file descriptors 1 and 2
-    off the terminal: its non-empty lines, white space collapsed, are appended to ``lines``
-    when the block ends, also on an error. ``sys.stdout`` and ``sys.stderr`` are flushed
-    first; a descriptor that is not open is left alone."""
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(AttributeError, OSError, ValueError):
-            stream.flush()
-    with tempfile.TemporaryFile() as sink:
-        saved: list[tuple[int, int]] = []
-        try:
-            for fd in (1, 2):
-                with contextlib.suppress(OSError):
-                    saved.append((fd, os.dup(fd)))
-                    os.dup2(sink.fileno(), fd)
-            yield
-        finally:
-            for fd, copy in saved:
-                os.dup2(copy, fd)
-                os.close(copy)
-            sink.seek(0)
-            text = sink.read().decode("utf-8", errors="replace")
-            lines.extend(" ".join(line.split()) for line in text.splitlines() if line.strip())
