@@ -34,7 +34,7 @@ from dvqp.bench.execution import Where, generate_local
 from dvqp.cli import solver_option
 from dvqp.cli.progress import ProgressBar
 from dvqp.cli.report import write_text
-from dvqp.cli.solver_option import solver_options
+from dvqp.cli.solver_option import backend_list, solver_options
 from dvqp.errors import DvqpError, ParameterError
 from dvqp.resolution.registry import PINV, check_name, default_resolvers
 
@@ -169,7 +169,7 @@ def check_options(args: argparse.Namespace) -> Options:
     json_out = output_path(args.json, (".json",)) if args.json is not None else None
     csv_out = output_path(args.csv, (".csv",)) if args.csv is not None else None
     scenes_dir = _scenes_dir(args.save_scenes) if args.save_scenes is not None else None
-    names = [b.strip() for b in args.backends.split(",")] if args.backends else None
+    names = backend_list(args.backends)
     backends = tuple(dict.fromkeys(check_name(b) for b in names or default_resolvers()))
     if args.scheduler is not None:
         if not args.scheduler.strip():

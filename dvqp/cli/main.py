@@ -45,7 +45,7 @@ from dvqp.cli.report import (
     rows_to_csv,
     write_text,
 )
-from dvqp.cli.solver_option import solver_options
+from dvqp.cli.solver_option import backend_list, solver_options
 from dvqp.errors import DvqpError, SingularConfigurationError, one_line
 from dvqp.motion.schedule import TIMINGS
 from dvqp.resolution.registry import (
@@ -214,8 +214,7 @@ def _compare(args: argparse.Namespace) -> int:
     json_out = output_path(args.json, (".json",)) if args.json is not None else None
     csv_out = output_path(args.csv, (".csv",)) if args.csv is not None else None
     plot_out = output_path(args.plot, FIGURE_FORMATS) if args.plot is not None else None
-    names = [b.strip() for b in args.backends.split(",")] if args.backends else None
-    backends = [check_name(name) for name in names or default_resolvers()]
+    backends = [check_name(name) for name in backend_list(args.backends) or default_resolvers()]
     scenes = [load_scene(path) for path in args.scenes]  # every scene valid before any run
     options = solver_options(args.solver_option, backends)
     check_size(scenes, len(backends))
