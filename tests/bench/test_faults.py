@@ -129,6 +129,76 @@ def test_a_scene_that_kills_its_worker_again_is_reported_lost(tmp_path: Path) ->
     assert "1 scene (worker lost or timed out: no figures): bench-s3-0002" in printed
 
 
+RACING = textwrap.dedent("""
+    import os, signal, sys, time
+    from concurrent.futures import ProcessPoolExecutor
+    from dvqp.bench import execution
+    from dvqp.cli import main
+
+    class Racing(ProcessPoolExecutor):
+        # a pool process dies after the last wait and before the next scene is handed over:
+        # the pool is broken by then, and its submit raises BrokenProcessPool
+        handed = 0
+        def submit(self, fn, *args, **kwargs):
+            Racing.handed += fn is execution._run
+            if fn is execution._run and Racing.handed == 5:
+                os.kill(next(iter(self._processes)), signal.SIGKILL)
+                while not self._broken:
+                    time.sleep(0.01)
+            return super().submit(fn, *args, **kwargs)
+
+    execution.ProcessPoolExecutor = Racing
+    sys.exit(main(sys.argv[1:]))
+""")
+
+
+def test_a_worker_killed_between_two_scenes_costs_nothing(tmp_path: Path) -> None:
+    """The window in which a bench exited 1 (a BrokenProcessPool traceback) with its finished
+    results in the .partial file only: a process killed after the bench last waited and
+    before it handed over the next scene."""
+    out = tmp_path / "a.json"
+    proc = start("--count", "8", "--workers", "2", "--json", str(out), script=RACING)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0 and "Traceback" not in err, err
+    doc = json.loads(out.read_text())
+    assert indices(doc) == list(range(8)) and len(doc["results"]) == 16
+    assert not any(r["error"] == "worker lost" for r in doc["results"])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json"]  # no .partial
+
+
+DRAWING_DIES = textwrap.dedent("""
+    import os, signal, sys
+    from dvqp.bench import execution
+    from dvqp.cli import main
+    real, parent = execution.generate_scene, os.getpid()
+    def deadly(seed, index):  # the pool process drawing scene 5 dies (the OOM killer)
+        if index == 5 and os.getpid() != parent:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return real(seed, index)
+    execution.generate_scene = deadly
+    sys.exit(main(sys.argv[1:]))
+""")
+
+
+def test_a_worker_killed_while_drawing_the_scenes_costs_nothing(tmp_path: Path) -> None:
+    out = tmp_path / "a.json"
+    proc = start(
+        "--count",
+        "12",
+        "--workers",
+        "2",
+        "--backends",
+        "pinv",
+        "--json",
+        str(out),
+        script=DRAWING_DIES,
+    )
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0 and "Traceback" not in err, err
+    doc = json.loads(out.read_text())
+    assert indices(doc) == list(range(12))  # the same scenes: drawn here once the pool died
+
+
 def interrupt(proc: subprocess.Popen[str], partial: Path) -> tuple[float, str, list[dict]]:
     """SIGINT to ``proc`` once a scene is in ``partial``: the seconds until it ended, its
     stderr, and the results that were in ``partial`` before."""
