@@ -127,33 +127,33 @@ def test_solver_options_reach_plan_compare_and_bench(
     assert summary["capped_calls"] > 0 and "capped calls" in capsys.readouterr().out
 
 
+def refused_setting(folder: Path, capfd: pytest.CaptureFixture[str], option: str) -> str:
+    """``plan --backend osqp --solver-option OPTION``: exit 2, nothing on the file descriptor
+    1 (C output included), one line on stderr; the line."""
+    pytest.importorskip("osqp")
+    scene = with_solvers(folder, "")
+    assert main(["plan", str(scene), "--backend", "osqp", "--solver-option", option]) == 2
+    out, err = capfd.readouterr()
+    assert out == "" and err.count("\n") == 1
+    return err.rstrip("\n")
+
+
 def test_a_wrongly_typed_setting_is_refused_with_the_whole_message(
     tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:
-    pytest.importorskip("osqp")
-    scene = with_solvers(tmp_path, "")
-    assert (
-        main(["plan", str(scene), "--backend", "osqp", "--solver-option", "osqp.max_iter=abc"]) == 2
-    )
-    out, err = capfd.readouterr()  # what reaches the file descriptors, C output included
-    assert out == "" and err.count("\n") == 1
+    err = refused_setting(tmp_path, capfd, "osqp.max_iter=abc")
     assert err.startswith("dvqp: osqp: settings max_iter refused: osqp: adapter error: TypeError: ")
     # the message pybind11 spreads over lines, whole: the types it takes and what it was given
     assert "The following argument types are supported: 1. (" in err
-    assert "Invoked with: " in err and err.rstrip("\n").endswith("'abc'")
+    assert "Invoked with: " in err and err.endswith("'abc'")
 
 
 def test_a_setting_out_of_its_range_says_osqps_own_reason_on_stderr(
     tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:
-    pytest.importorskip("osqp")
-    scene = with_solvers(tmp_path, "")
-    assert (
-        main(["plan", str(scene), "--backend", "osqp", "--solver-option", "osqp.eps_abs=-1"]) == 2
-    )
-    out, err = capfd.readouterr()  # OSQP prints its reason with printf, to stdout: captured
-    assert out == "" and err == (
+    err = refused_setting(tmp_path, capfd, "osqp.eps_abs=-1")  # OSQP prints it, to stdout
+    assert err == (
         "dvqp: osqp: settings eps_abs refused: ERROR in validate_settings: eps_abs must be "
         "nonnegative; ERROR in osqp_setup: Solver settings validation. (osqp raised "
-        "OSQPException: 2)\n"
+        "OSQPException: 2)"
     )
