@@ -22,6 +22,7 @@ from dvqp._versions import __version__
 from dvqp.errors import (
     BackendError,
     DvqpError,
+    InputFileError,
     LimitViolationError,
     ParameterError,
     RobotFileError,
@@ -50,6 +51,7 @@ __all__ = [
     "Constraint",
     "Distances",
     "DvqpError",
+    "InputFileError",
     "JogSegment",
     "Kernel",
     "KinematicState",

@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from dvqp._files import c_output_captured
 from dvqp.errors import RobotFileError
 from dvqp.kinematics.urdf_check import read_urdf
+from solvers.c_output import c_output_captured
 
 
 def urdf_model(path: str | Path) -> pin.Model:

@@ -20,7 +20,8 @@ from xml.etree.ElementTree import Element, ParseError
 from defusedxml import DefusedXmlException
 from defusedxml.ElementTree import iterparse
 
-from dvqp.errors import RobotFileError
+from dvqp._inputs import read_bounded
+from dvqp.errors import InputFileError, RobotFileError
 
 MAX_BYTES = 1 << 20
 """Largest URDF file read, bytes (1 MiB; the bundled 13-joint arm takes 6 kB)."""
@@ -87,13 +88,9 @@ def read_urdf(path: str | Path) -> UrdfText:
 def _read(path: Path) -> bytes:
     """At most :data:`MAX_BYTES` of the file; refused if it is larger."""
     try:
-        with path.open("rb") as fh:
-            data = fh.read(MAX_BYTES + 1)
-    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
-        raise _Refused(f"cannot read: {getattr(exc, 'strerror', None) or exc}") from None
-    if len(data) > MAX_BYTES:
-        raise _Refused(f"larger than {MAX_BYTES >> 20} MiB: not a robot description")
-    return data
+        return read_bounded(path, MAX_BYTES, "a robot description")
+    except InputFileError as exc:
+        raise _Refused(exc.reason) from None
 
 
 def _parse(data: bytes) -> Element:

@@ -22,8 +22,17 @@ from typing import Any, NamedTuple
 import numpy as np
 
 import solvers
+from dvqp._files import output_folder
+from dvqp._inputs import read_bounded
 from dvqp._versions import __version__
-from dvqp.errors import LimitViolationError, OutputError, ParameterError, UnreachableTargetError
+from dvqp.errors import (
+    InputFileError,
+    LimitViolationError,
+    OutputError,
+    ParameterError,
+    UnreachableTargetError,
+    one_line,
+)
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.registry import PINV, check_name
 from dvqp.run.planning import backend_settings, check_run, plan
@@ -40,8 +49,9 @@ EMPTY = np.zeros(0)
 
 
 class Exported(NamedTuple):
-    """What :func:`export_qps` wrote: the ``folder``, the run's ``trajectory`` and the
-    ``index`` (the contents of ``index.json``)."""
+    """What :func:`export_qps` wrote: the ``folder`` (its real path: ``.``, ``..`` and
+    symbolic links resolved), the run's ``trajectory`` and the ``index`` (the contents of
+    ``index.json``)."""
 
     folder: Path
     trajectory: Trajectory
@@ -62,16 +72,21 @@ def export_qps(
     """Plan ``scene`` on the QP ``backend`` and write each of its backend calls' problems into
     ``folder`` (``<scene>-<step>-<call>.npz``), with the answers and ``index.json``.
 
-    The files are written into a temporary folder beside ``folder``, renamed to it once all
-    are written: an error or an interrupt leaves nothing. A failed run is exported too (its
-    index's ``error`` says why :func:`~dvqp.run.planning.check_run` fails it).
+    ``folder`` is checked before the run (:func:`export_folder`). The files are written into
+    a temporary folder (beside a new ``folder``, inside an existing one) and moved into place
+    once all are written, the index last: an error or an interrupt (Ctrl-C, ``SIGTERM``
+    under :func:`dvqp.cli.progress.interruptible`) leaves nothing behind and an earlier
+    export as it was. A failed run is exported too (its index's ``error`` says why
+    :func:`~dvqp.run.planning.check_run` fails it).
 
     Parameters
     ----------
     scene, backend
         What to run; ``backend`` a QP backend's name (not ``"pinv"``: it solves no QP).
     folder
-        The export's folder: new, empty, or (``force``) an earlier export, replaced.
+        The export's folder: new, empty, or (``force``) an earlier export holding nothing
+        else, whose files are replaced (symbolic links followed: a linked folder is filled,
+        the link kept).
     options
         Settings of the backend, over the scene's ``[solvers.<backend>]`` ones, over the
         settings ``tier``'s (:mod:`solvers.tiers`; the index's ``tier`` and ``settings``).
@@ -83,15 +98,14 @@ def export_qps(
     BackendError
         Unknown backend, or a setting it does not take.
     ParameterError
-        ``backend`` is ``pinv``; ``folder`` is a file, not empty (and not an earlier export
-        with ``force``), or its parent is missing or not writable.
+        ``backend`` is ``pinv``; ``folder`` cannot take the export (:func:`export_folder`).
     OutputError
         The files could not be written (a full disk).
     """
     if check_name(backend) == PINV:
         raise ParameterError("backend", "pinv solves no QP: name a QP backend (see dvqp backends)")
-    target = _target(Path(folder), force)
-    work = _work_folder(target)
+    real = export_folder(folder, force)
+    work = _work_folder(real)
     try:
         calls = _Calls(work, re.sub(r"[^A-Za-z0-9._-]", "_", scene.name))
         traj = plan(
@@ -105,13 +119,14 @@ def export_qps(
         )
         settings = backend_settings(scene, backend, options, tier)
         index = calls.finish(scene, traj, backend, tier, settings)
-        _put_in_place(work, target)
+        _put_in_place(work, real, Path(folder))
     except BaseException as exc:
-        shutil.rmtree(work, ignore_errors=True)
         if isinstance(exc, OSError) and not isinstance(exc, OutputError):
             raise OutputError(folder, exc.strerror or str(exc), exc.errno) from exc
         raise
-    return Exported(target, traj, index)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)  # moved into place, or left: removed
+    return Exported(real, traj, index)
 
 
 class _Calls:
@@ -231,60 +246,167 @@ def active_rows(problem: solvers.Problem, solution: solvers.Solution) -> dict[st
     return rows
 
 
-def _target(folder: Path, force: bool) -> Path:
-    """``folder`` if an export may be put there: new, empty, or an earlier export (``force``)."""
-    if not str(folder).strip():
-        raise ParameterError("output", "empty folder name")
-    if folder.exists() and not folder.is_dir():
-        raise ParameterError("output", f"{folder}: not a folder")
-    if folder.is_dir() and any(folder.iterdir()):
-        if not force:
-            raise ParameterError(
-                "output", f"{folder}: not empty (--force replaces an earlier export)"
-            )
-        if not _is_export(folder):
-            raise ParameterError(
-                "output",
-                f"{folder}: not empty and not an export of dvqp "
-                f"export-qps (no {INDEX} of one): not replaced",
-            )
-    return folder
+MAX_INDEX_BYTES = 1 << 28
+"""Largest index read to find out what an earlier export wrote (256 MiB: some 500 000
+problems)."""
 
 
-def _is_export(folder: Path) -> bool:
-    """``folder`` holds an index written by :func:`export_qps`."""
+def export_folder(folder: str | Path, force: bool = False) -> Path:
+    """The folder an export to ``folder`` fills, checked before any work (its real path:
+    ``.``, ``..`` and symbolic links resolved, :func:`dvqp._files.output_folder`).
+
+    It is new, or empty, or (``force``) an earlier export that holds nothing but what its
+    index lists: ``--force`` replaces only the files an earlier export wrote.
+
+    Raises
+    ------
+    ParameterError
+        ``output: empty file name``; ``output: <folder>: not a folder``, ``… read-only: not
+        replaced``, ``… not empty (--force replaces an earlier export)``, ``… not an export
+        of dvqp export-qps (…): not replaced``, ``… --force replaces only what an earlier
+        export wrote; it also holds 2 other files: notes.txt, answers/x.npz (move them
+        away)``; a parent that is missing or cannot be written in.
+    """
+    real = output_folder(folder)
+    if not real.is_dir() or not any(real.iterdir()):
+        return real
+    if not force:
+        raise ParameterError("output", f"{folder}: not empty (--force replaces an earlier export)")
+    listed = exported_files(real, folder)
+    other = _other_files(real, listed)
+    if other:
+        shown = ", ".join(other[:5]) + (", …" if len(other) > 5 else "")
+        raise ParameterError(
+            "output",
+            f"{folder}: --force replaces only what an earlier export wrote; it also holds "
+            f"{len(other)} other file{'s' * (len(other) > 1)}: {shown} (move them away)",
+        )
+    return real
+
+
+def exported_files(real: Path, shown: str | Path) -> set[str]:
+    """The files an earlier export in the folder ``real`` wrote, by their path in it (its
+    index, its problems and ``answers/<name>``), from its index.
+
+    Raises
+    ------
+    ParameterError
+        ``output: <shown>: not empty and not an export of dvqp export-qps (<why>): not
+        replaced``: no index, one that cannot be read, is damaged, is not an export's, or
+        lists a file outside the folder.
+    """
     try:
-        return json.loads((folder / INDEX).read_text(encoding="utf-8")).get("format") == FORMAT
-    except (OSError, ValueError, AttributeError):
-        return False
+        if not (real / INDEX).is_file():
+            raise ValueError(f"no {INDEX}")
+        text = read_bounded(real / INDEX, MAX_INDEX_BYTES, "an export's index")
+        index = json.loads(text)
+        if not isinstance(index, dict) or index.get("format") != FORMAT:
+            raise ValueError(f"{INDEX} is not an export's index")
+        files = {INDEX}
+        for entry in index["problems"]:
+            files |= {_plain(entry["file"]), f"{ANSWERS}/{_plain(entry['answer'], ANSWERS)}"}
+    except (InputFileError, ValueError, KeyError, TypeError, RecursionError) as exc:
+        why = exc.reason if isinstance(exc, InputFileError) else _why(exc)
+        raise ParameterError(
+            "output",
+            f"{shown}: not empty and not an export of dvqp export-qps ({why}): not replaced",
+        ) from exc
+    return files
 
 
-def _work_folder(target: Path) -> Path:
-    """A new, empty folder beside ``target``, with the usual mode (``0o777 & ~umask``)."""
-    parent = target.absolute().parent
-    if not parent.is_dir():
-        raise ParameterError("output", f"{parent}: no such directory")
+def _plain(name: object, folder: str = "") -> str:
+    """A file name an index lists (``folder/<name>`` if ``folder``): ``name``; a ValueError
+    if it is not a plain name of a file in the export."""
+    text = str(name) if isinstance(name, str) else ""
+    if folder:
+        head, _, text = text.partition("/")
+        text = text if head == folder else ""
+    if not text or "/" in text or "\\" in text or text in (".", "..") or "\0" in text:
+        raise ValueError(f"{INDEX} lists {one_line(repr(name))}, not a file of the export")
+    return text
+
+
+def _why(exc: BaseException) -> str:
+    """Why an index was not read, in a few words."""
+    if isinstance(exc, json.JSONDecodeError):
+        return f"{INDEX}: not JSON ({exc.msg}, line {exc.lineno})"
+    if isinstance(exc, KeyError | TypeError):
+        return f"{INDEX} is not an export's index"
+    if isinstance(exc, RecursionError):
+        return f"{INDEX}: nested too deeply"
+    return one_line(str(exc))
+
+
+def _other_files(real: Path, listed: set[str]) -> list[str]:
+    """What the folder ``real`` holds beyond the files ``listed`` and an ``answers`` folder:
+    paths in it, a folder's with a trailing ``/``."""
+    answers = real / ANSWERS
+    ours = answers.is_dir() and not answers.is_symlink()
+    other = [n for n in _unlisted(real, listed) if not (ours and n == f"{ANSWERS}/")]
+    if ours:
+        inner = {n.partition("/")[2] for n in listed if n.startswith(f"{ANSWERS}/")}
+        other += [f"{ANSWERS}/{n}" for n in _unlisted(answers, inner)]
+    return sorted(other)
+
+
+def _unlisted(folder: Path, listed: set[str]) -> list[str]:
+    """The entries of ``folder`` that are not regular files named in ``listed``."""
+    return [
+        entry.name + ("/" if entry.is_dir() else "")
+        for entry in folder.iterdir()
+        if entry.name not in listed or entry.is_symlink() or not entry.is_file()
+    ]
+
+
+def _work_folder(real: Path) -> Path:
+    """A new, empty folder for the files of an export to ``real``, with the usual mode
+    (``0o777 & ~umask``): inside ``real`` if it exists, else beside it."""
+    where, prefix = (real, ".dvqp-export.") if real.is_dir() else (real.parent, f".{real.name}.")
     try:
-        work = Path(tempfile.mkdtemp(dir=parent, prefix=f".{target.absolute().name}."))
+        work = Path(tempfile.mkdtemp(dir=where, prefix=prefix))
     except OSError as exc:
-        raise ParameterError("output", f"{parent}: cannot write here ({exc.strerror})") from exc
+        raise ParameterError("output", f"{where}: cannot write here ({exc.strerror})") from exc
     umask = os.umask(0)
     os.umask(umask)
     os.chmod(work, 0o777 & ~umask)
     return work
 
 
-def _put_in_place(work: Path, target: Path) -> None:
-    """Rename ``work`` to ``target``; an earlier export there is removed once it is done."""
-    if not (target.is_dir() and any(target.iterdir())):
-        os.replace(work, target)  # a missing or empty folder: replaced at once
+def _put_in_place(work: Path, real: Path, shown: Path) -> None:
+    """Move the export written in ``work`` to ``real``: renamed to it if it is new; into it
+    if it exists (the folder itself kept: its mode, a link to it, a shell in it), after the
+    files of an earlier export there, its index first, were moved out of the way. The new
+    index comes last. Any failure moves everything back: the earlier export as it was."""
+    if not real.is_dir():
+        os.rename(work, real)
         return
-    old = Path(tempfile.mkdtemp(dir=target.absolute().parent, prefix=".old."))
-    os.replace(target, old / "export")
+    trash = Path(tempfile.mkdtemp(dir=real, prefix=".dvqp-old."))
+    done: list[tuple[Path, Path]] = []  # (from, to) of every move made, to undo
     try:
-        os.replace(work, target)
+        old = exported_files(real, shown) if (real / INDEX).exists() else set()
+        (trash / ANSWERS).mkdir()
+        for name in sorted(old, key=lambda n: (n != INDEX, n)):
+            if os.path.lexists(real / name):
+                _move(real / name, trash / name, done)
+        if (real / ANSWERS).is_dir() and not (real / ANSWERS).is_symlink():
+            _move(real / ANSWERS, trash / f"{ANSWERS}.left", done)  # empty, or not ours
+            if any((trash / f"{ANSWERS}.left").iterdir()):
+                raise ParameterError("output", f"{shown}: {ANSWERS}/ gained files during the run")
+        for entry in sorted(work.iterdir(), key=lambda e: (e.name == INDEX, e.name)):
+            if os.path.lexists(real / entry.name):
+                raise ParameterError(
+                    "output", f"{shown}: {entry.name} appeared during the run: not replaced"
+                )
+            _move(entry, real / entry.name, done)
     except BaseException:
-        os.replace(old / "export", target)
+        for source, target in reversed(done):
+            os.rename(target, source)
         raise
     finally:
-        shutil.rmtree(old, ignore_errors=True)
+        shutil.rmtree(trash, ignore_errors=True)
+
+
+def _move(source: Path, target: Path, done: list[tuple[Path, Path]]) -> None:
+    """Rename ``source`` to ``target`` and note it in ``done``."""
+    os.rename(source, target)
+    done.append((source, target))

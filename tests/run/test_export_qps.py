@@ -7,6 +7,11 @@ damper stops the probe, so 32 strict problems are infeasible and their relaxed p
 from __future__ import annotations
 
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 import warnings
 from collections import Counter
 from pathlib import Path
@@ -284,3 +289,147 @@ def test_an_export_under_a_tier_is_reproduced_within_the_tiers_tolerance(
                 warnings.simplefilter("ignore")
                 found = qpsolvers.solve_problem(problem, name, **settings)
             assert np.abs(found.x - answer["x"]).max() < tolerance, (e["file"], name)
+
+
+def names_in(folder: Path) -> list[str]:
+    """Every path under ``folder`` (hidden ones too), relative, sorted."""
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*"))
+
+
+def export(scene_file: Path, out: object, *extra: str) -> int:
+    return main(["export-qps", str(scene_file), "-o", str(out), *extra])
+
+
+def test_force_replaces_only_what_the_earlier_export_wrote_or_names_what_it_would_lose(
+    scene_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "qps"
+    assert export(scene_file, out) == 0
+    (out / "notes.txt").write_text("mine")
+    (out / ANSWERS / "mine.npz").write_text("mine too")
+    (out / "plots").mkdir()
+    before = names_in(tmp_path)
+    index = (out / INDEX).read_text()
+    capsys.readouterr()
+    assert export(scene_file, out, "--force", "--backend", "osqp") == 2
+    assert capsys.readouterr().err == (
+        f"dvqp: output: {out}: --force replaces only what an earlier export wrote; it also "
+        "holds 3 other files: answers/mine.npz, notes.txt, plots/ (move them away)\n"
+    )
+    assert names_in(tmp_path) == before and (out / INDEX).read_text() == index
+    for extra in (out / "notes.txt", out / ANSWERS / "mine.npz"):
+        extra.unlink()
+    (out / "plots").rmdir()
+    assert export(scene_file, out, "--force", "--backend", "osqp") == 0
+    assert json.loads((out / INDEX).read_text())["backend"] == "osqp"
+    assert not [n for n in names_in(tmp_path) if "/." in f"/{n}"]  # nothing hidden left
+
+
+def test_force_through_a_link_fills_the_linked_folder_and_keeps_link_and_folder(
+    scene_file: Path, tmp_path: Path
+) -> None:
+    real, link = tmp_path / "qps", tmp_path / "latest"
+    assert export(scene_file, real) == 0
+    real.chmod(0o750)
+    link.symlink_to("qps")
+    inode = real.stat().st_ino
+    assert export(scene_file, link, "--force", "--backend", "osqp") == 0
+    assert link.is_symlink() and os.readlink(link) == "qps"
+    assert real.stat().st_ino == inode and real.stat().st_mode & 0o777 == 0o750
+    assert json.loads((real / INDEX).read_text())["backend"] == "osqp"
+    assert sorted(os.listdir(tmp_path)) == ["latest", "qps"]
+
+
+def test_force_on_a_read_only_export_is_refused_and_leaves_it(
+    scene_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "qps"
+    assert export(scene_file, out) == 0
+    before = names_in(tmp_path)
+    out.chmod(0o555)  # read-only by intent: refused even for the superuser
+    capsys.readouterr()
+    assert export(scene_file, out, "--force") == 2
+    assert capsys.readouterr().err == f"dvqp: output: {out}: read-only: not replaced\n"
+    out.chmod(0o755)
+    assert names_in(tmp_path) == before
+
+
+def test_dot_and_dotdot_name_the_folder_they_resolve_to(
+    scene_file: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    out = tmp_path / "qps"
+    out.mkdir()
+    monkeypatch.chdir(out)
+    assert export(scene_file, ".") == 0  # an empty folder: filled, not replaced
+    assert Path.cwd() == out and (out / INDEX).is_file()  # the shell is still in it
+    assert export(scene_file, ".", "--force", "--backend", "osqp") == 0
+    assert json.loads((out / INDEX).read_text())["backend"] == "osqp"
+    monkeypatch.chdir(tmp_path)
+    assert export(scene_file, f"qps/{ANSWERS}/..", "--force") == 0
+    assert json.loads((out / INDEX).read_text())["backend"] == "daqp"
+    assert capsys.readouterr().out.endswith("of 80 steps to qps (index.json, answers/)\n")
+    assert not [n for n in names_in(tmp_path) if "/." in f"/{n}"]  # no .old, no work folder
+
+
+@pytest.mark.parametrize(
+    ("index", "why"),
+    [
+        ('{"format": "dvqp export-qps 1", "problems": [', "index.json: not JSON ("),
+        (
+            '{"format": "dvqp export-qps 1", "problems": '
+            '[{"file": "../x", "answer": "answers/y"}]}',
+            "index.json lists '../x', not a file of the export",
+        ),
+        ('{"format": "other"}', "index.json is not an export's index"),
+        ("[" * 100_000, "index.json: "),
+    ],
+    ids=["truncated", "a file outside", "another format", "nested deeply"],
+)
+def test_a_damaged_or_hostile_index_is_never_trusted_by_force(
+    scene_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], index: str, why: str
+) -> None:
+    out = tmp_path / "qps"
+    out.mkdir()
+    (out / INDEX).write_text(index)
+    (tmp_path / "x").write_text("outside")
+    before = names_in(tmp_path)
+    assert export(scene_file, out, "--force") == 2
+    err = capsys.readouterr().err
+    assert err.startswith(
+        f"dvqp: output: {out}: not empty and not an export of dvqp export-qps ({why}"
+    )
+    assert err.endswith("): not replaced\n") and err.count("\n") == 1
+    assert names_in(tmp_path) == before
+
+
+def started(folder: Path, pattern: str, files: int = 10, timeout: float = 120.0) -> None:
+    """Wait until a folder matching ``pattern`` in ``folder`` holds ``files`` files."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if any(len(os.listdir(w)) >= files for w in folder.glob(pattern)):
+            return
+        time.sleep(0.05)
+    raise AssertionError(f"no {pattern} with {files} files in {folder} after {timeout} s")
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="signals as on Linux")
+@pytest.mark.parametrize("earlier", [False, True], ids=["new folder", "over an earlier export"])
+def test_sigterm_during_an_export_leaves_nothing_behind(
+    scene_file: Path, tmp_path: Path, earlier: bool
+) -> None:
+    long = tmp_path / "long.toml"
+    long.write_text(SCENE.replace("duration = 0.2", "duration = 60.0"), encoding="utf-8")
+    out = tmp_path / "qps"
+    if earlier:
+        assert export(scene_file, out) == 0
+    before = names_in(tmp_path)
+    argv = [sys.executable, "-m", "dvqp", "export-qps", str(long), "-o", str(out), "--force"]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    started(out if earlier else tmp_path, ".dvqp-export.*" if earlier else ".qps.*")
+    proc.send_signal(signal.SIGTERM)  # what timeout, docker stop and systemd send
+    printed, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143 and printed == "" and err == "dvqp: terminated\n"
+    assert names_in(tmp_path) == before  # the earlier export as it was, no work folder
