@@ -14,7 +14,7 @@ from typing import Any
 from dvqp.cli import solver_option
 from dvqp.cli.progress import ProgressBar, check_size
 from dvqp.cli.solver_option import solver_options
-from dvqp.run.qp_export import INDEX, export_qps
+from dvqp.run.qp_export import INDEX, TEST_SET, export_qps
 from dvqp.scenes import load_scene
 
 
@@ -59,7 +59,7 @@ def run(args: argparse.Namespace) -> int:
     )
     print(
         f"wrote {len(index['problems'])} QPs ({counted or 'none'}) of {index['steps']} steps "
-        f"to {args.output} ({INDEX}, answers/)"
+        f"to {args.output} ({INDEX}, answers/, {TEST_SET})"
     )
     if index["error"]:
         print(f"dvqp: {index['error']}", file=sys.stderr)
