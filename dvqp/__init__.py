@@ -42,7 +42,7 @@ from dvqp.run.qp_export import export_qps
 from dvqp.scenes import Scene, load_scene
 from dvqp.step import Stepper
 from dvqp.tasks import Task, TaskRows, ToolTask
-from dvqp.workspace import Kernel, StepPlan
+from dvqp.workspace import Kernel, PartNames, StepPlan
 
 __all__ = [
     "BackendError",
@@ -60,6 +60,7 @@ __all__ = [
     "Obstacle",
     "ObstacleSet",
     "ParameterError",
+    "PartNames",
     "PseudoinverseResolver",
     "QPResolver",
     "Resolver",
