@@ -60,6 +60,13 @@ def test_the_panda_plans_safely_on_every_step_and_holds_its_forearm_at_the_margi
     at = KinematicState.compute(s.robot, traj.q[worst], s.pipe_radius)
     _, part, _ = proximity(at, s.obstacles).closest()
     assert part == "panda_link4-panda_link5"  # the forearm
+    assert 0 < sum(status == "relaxed" for status in traj.status) <= 12  # README: 5 on DAQP
+
+
+def test_the_baseline_takes_the_forearm_in_and_breaks_the_acceleration_limit() -> None:
+    traj = run("panda", "pinv")
+    assert 0.0 < float(np.min(traj.min_clearance)) < 0.01 - 0.003  # README: 3.8 mm in
+    assert float(np.abs(traj.qddot).max()) > 20.0  # 28.9 rad/s² against the scene's 10
 
 
 def test_the_report_names_the_urdfs_links_and_frames(
