@@ -43,7 +43,7 @@ from dvqp.run.qp_export import export_qps
 from dvqp.scenes import Scene, load_scene
 from dvqp.step import Stepper
 from dvqp.tasks import Task, TaskRows, ToolTask
-from dvqp.workspace import Kernel, StepPlan
+from dvqp.workspace import Kernel, PartNames, StepPlan
 
 __all__ = [
     "BackendError",
@@ -62,6 +62,7 @@ __all__ = [
     "Obstacle",
     "ObstacleSet",
     "ParameterError",
+    "PartNames",
     "PseudoinverseResolver",
     "QPResolver",
     "Resolver",

@@ -111,7 +111,9 @@ def make_backend(name: str, **options: Any) -> Backend:
     name : str
         One of :func:`available_backends`.
     **options
-        ``tolerance=`` and solver settings, forwarded to the adapter.
+        ``tolerance=``, ``solver_defaults=`` (start from the solver's factory defaults, not
+        the adapter's own: :mod:`solvers.tiers`) and solver settings, forwarded to the
+        adapter.
 
     Returns
     -------
@@ -127,8 +129,9 @@ def make_backend(name: str, **options: Any) -> Backend:
     if factory is None:
         raise UnknownBackendError(name, available_backends())
     backend = factory(**options)
-    if set(options) - {"tolerance"}:
-        _try_settings(backend, sorted(options))
+    settings = sorted(set(options) - {"tolerance", "solver_defaults"})
+    if settings:
+        _try_settings(backend, settings)
     return backend
 
 

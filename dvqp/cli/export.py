@@ -15,7 +15,7 @@ from typing import Any
 from dvqp.cli import solver_option
 from dvqp.cli.progress import ProgressBar, check_size
 from dvqp.cli.solver_option import solver_options
-from dvqp.run.qp_export import INDEX, export_folder, export_qps
+from dvqp.run.qp_export import INDEX, TEST_SET, export_folder, export_qps
 from dvqp.scenes import load_scene
 
 
@@ -61,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
     )
     print(
         f"wrote {len(index['problems'])} QPs ({counted or 'none'}) of {index['steps']} steps "
-        f"to {_shown(args.output, exported.folder)} ({INDEX}, answers/)"
+        f"to {_shown(args.output, exported.folder)} ({INDEX}, answers/, {TEST_SET})"
     )
     if index["error"]:
         print(f"dvqp: {index['error']}", file=sys.stderr)

@@ -36,9 +36,11 @@ def add_argument(parser: argparse.ArgumentParser) -> None:
         "--settings",
         choices=TIERS,
         default=TIERS[0],
-        help="accuracy tier of every QP backend, as qpbenchmark's: its solver "
-        "settings and the tolerance answers are checked to (default: default; "
-        "see docs/cli.md)",
+        help="accuracy tier of every QP backend: its solver settings and the tolerance "
+        "answers are checked to. default: dvqp's own (tighter than the solvers' "
+        "defaults); high_accuracy, mid_accuracy, low_accuracy: qpbenchmark's tiers, "
+        "exactly; solver_defaults: qpbenchmark's default tier, each solver's own "
+        "defaults (see docs/cli.md)",
     )
 
 

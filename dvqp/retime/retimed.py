@@ -180,7 +180,7 @@ def retime(scene: RunScene, q: ArrayLike, t: ArrayLike, rate: float = DEFAULT_RA
         samples.q,
         samples.qdot,
         samples.qddot,
-        joint_names=tuple(robot.model.names[1:]),
+        joint_names=robot.joint_names,
         rate=float(rate),
         planned_duration=float(t[-1] - t[0]),
         velocity_use=float(np.max(np.abs(samples.qdot) / robot.qd_max)),

@@ -1,10 +1,12 @@
 """Every QP of a run as a file of ``qpsolvers.Problem``'s own format, with dvqp's answer.
 
 :func:`export_qps` plans a scene on a QP backend and writes one file per backend call of the
-run (``qpsolvers.Problem.save``: an ``.npz`` of ``P, q, G, h, A, b, lb, ub``, the problem
-exactly as the backend got it), the answer dvqp accepted beside it (``answers/``) and an index
-(``index.json``: scene, step, kind, active rows, warm-start pair). The folder appears whole or
-not at all. Layout and fields: ``docs/qp-export.md``.
+run (``qpsolvers.Problem.save``: an ``.npz`` of ``P, q, G, h, A, b, lb, ub``, the problem as
+the backend got it less the inequality rows that do not apply, ``0 · x ≤ +inf``), the answer
+dvqp accepted beside it (``answers/``), an index (``index.json``: scene, step, kind, the rows
+kept, active rows, warm-start pair) and qpbenchmark's test set of the folder
+(``dvqp_qps.py``). The folder appears whole or not at all. Layout and fields:
+``docs/qp-export.md``.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
 import solvers
 from dvqp._files import output_folder
@@ -42,8 +45,14 @@ INDEX = "index.json"
 """The index file of an export."""
 ANSWERS = "answers"
 """The sub-folder of the answers, one file per problem, of the same name."""
-FORMAT = "dvqp export-qps 1"
-"""The index's ``format``: how :func:`export_qps` knows a folder it may replace."""
+FORMAT = "dvqp export-qps 2"
+"""The index's ``format``: how :func:`export_qps` knows a folder it may replace (2: only the
+rows that apply, ``rows`` and ``fixed_inequalities``; 1 kept every row)."""
+FORMATS = ("dvqp export-qps 1", FORMAT)
+"""The formats of the exports :func:`export_qps` may replace."""
+TEST_SET = "dvqp_qps.py"
+"""qpbenchmark's test set of the export, copied into it (its class: ``DvqpQps``)."""
+TEST_SET_SOURCE = Path(__file__).with_name("qpbenchmark_set") / TEST_SET
 
 EMPTY = np.zeros(0)
 
@@ -70,7 +79,8 @@ def export_qps(
     notice: Callable[[str], None] | None = None,
 ) -> Exported:
     """Plan ``scene`` on the QP ``backend`` and write each of its backend calls' problems into
-    ``folder`` (``<scene>-<step>-<call>.npz``), with the answers and ``index.json``.
+    ``folder`` (``<scene>-<step>-<call>.npz``, the rows that apply), with the answers,
+    ``index.json`` and qpbenchmark's test set (``dvqp_qps.py``).
 
     ``folder`` is checked before the run (:func:`export_folder`). The files are written into
     a temporary folder (beside a new ``folder``, inside an existing one) and moved into place
@@ -119,6 +129,7 @@ def export_qps(
         )
         settings = backend_settings(scene, backend, options, tier)
         index = calls.finish(scene, traj, backend, tier, settings)
+        shutil.copyfile(TEST_SET_SOURCE, work / TEST_SET)
         _put_in_place(work, real, Path(folder))
     except BaseException as exc:
         if isinstance(exc, OSError) and not isinstance(exc, OutputError):
@@ -141,6 +152,8 @@ class _Calls:
         self.warm: dict[str, str | None] = {}
         self.tolerance: float | None = None
         """The residual check's absolute tolerance of the backend (None: no call)."""
+        self.fixed_rows = 0
+        """Rows of ``G`` in the run's fixed structure (every problem of a run has them)."""
 
     def __call__(
         self, step: int, kind: str, problem: solvers.Problem, solution: solvers.Solution
@@ -150,10 +163,11 @@ class _Calls:
         call = self.per_step[step]
         self.per_step[step] += 1
         name = f"{self.stem}-{step:05d}-{call}.npz"
-        p = problem
+        p, rows = applying(problem)
         qpsolvers.Problem(p.P, p.q, p.G, p.h, p.A, p.b, p.lb, p.ub).save(str(self.folder / name))
         found = bool(solution.found and solution.x is not None)
         self.tolerance = solution.tolerance
+        z = None if solution.z is None else solution.z[rows]
         self.entries.append(
             {
                 "file": name,
@@ -165,22 +179,24 @@ class _Calls:
                 "variables": p.n,
                 "equalities": p.n_eq,
                 "inequalities": p.n_in,
+                "rows": rows.tolist(),
                 "found": found,
                 "refusal": "" if found else solution.refusal,
                 "solver_status": str(solution.status),
                 "iterations": None if solution.iterations is None else int(solution.iterations),
                 "retried": bool(solution.retried),
                 "warm_start": self.warm.get(kind),
-                **active_rows(p, solution),
+                **active_rows(p, solution.x if found else None, z, solution.z_box, self.tolerance),
             }
         )
         s = solution  # x and the multipliers (empty: absent, or the call refused)
         self.answers.append(
             {
                 key: EMPTY if value is None or not found else np.array(value)
-                for key, value in (("x", s.x), ("y", s.y), ("z", s.z), ("z_box", s.z_box))
+                for key, value in (("x", s.x), ("y", s.y), ("z", z), ("z_box", s.z_box))
             }
         )
+        self.fixed_rows = problem.n_in
         self.warm[kind] = name if found else None  # a refused call resets its backend: cold
 
     def finish(
@@ -217,6 +233,7 @@ class _Calls:
             "brake_start": traj.brake_start,
             "error": error,
             "tolerance": self.tolerance,
+            "fixed_inequalities": self.fixed_rows,
             "no_backend_call": sorted(set(range(traj.n_steps)) - set(self.per_step)),
             "problems": self.entries,
         }
@@ -225,20 +242,40 @@ class _Calls:
         return index
 
 
-def active_rows(problem: solvers.Problem, solution: solvers.Solution) -> dict[str, list[int]]:
-    """The rows active at an accepted answer, as indices: ``active_inequalities`` (rows of
-    ``G`` whose slack ``h − G x`` is within the solution's tolerance or whose multiplier
-    exceeds it), ``active_lower`` and ``active_upper`` (variables at a bound within the
-    tolerance, or whose bound multiplier has that sign beyond it); all empty if refused."""
-    rows: dict[str, list[int]] = {"active_inequalities": [], "active_lower": [], "active_upper": []}
-    x, tol = solution.x, solution.tolerance
-    if not solution.found or x is None:
-        return rows
+def applying(problem: solvers.Problem) -> tuple[solvers.Problem, NDArray[np.intp]]:
+    """``problem`` with only its inequality rows that apply (finite ``h``; none: no ``G``), and
+    the indices of those rows in ``problem``'s ``G``, shape (p',).
+
+    A row ``0 · x ≤ +inf`` can never be active, but a checker that forms ``hᵀz`` (qpsolvers'
+    duality gap, hence qpbenchmark's) gets ``inf · 0 = NaN`` from it."""
+    if problem.G is None or problem.h is None:
+        return problem, np.zeros(0, dtype=np.intp)
+    rows = np.flatnonzero(np.isfinite(problem.h))
+    G, h = (problem.G[rows], problem.h[rows]) if rows.size else (None, None)
     p = problem
-    zb = np.zeros(p.n) if solution.z_box is None else solution.z_box
-    if p.G is not None:
-        z = np.zeros(p.n_in) if solution.z is None else solution.z
-        rows["active_inequalities"] = np.flatnonzero((p.h - p.G @ x <= tol) | (z > tol)).tolist()
+    return solvers.Problem(p.P, p.q, p.A, p.b, G, h, p.lb, p.ub), rows
+
+
+def active_rows(
+    problem: solvers.Problem,
+    x: NDArray[np.float64] | None,
+    z: NDArray[np.float64] | None,
+    z_box: NDArray[np.float64] | None,
+    tolerance: float,
+) -> dict[str, list[int]]:
+    """The rows active at the accepted answer ``x`` (None: refused) with multipliers ``z``,
+    ``z_box``, as indices: ``active_inequalities`` (rows of ``G`` whose slack ``h − G x`` is
+    within ``tolerance`` or whose multiplier exceeds it), ``active_lower`` and
+    ``active_upper`` (variables at a bound within it, or whose bound multiplier has that sign
+    beyond it); all empty if refused."""
+    rows: dict[str, list[int]] = {"active_inequalities": [], "active_lower": [], "active_upper": []}
+    if x is None:
+        return rows
+    p, tol = problem, tolerance
+    zb = np.zeros(p.n) if z_box is None else z_box
+    if p.G is not None and p.h is not None:
+        zg = np.zeros(p.n_in) if z is None else z
+        rows["active_inequalities"] = np.flatnonzero((p.h - p.G @ x <= tol) | (zg > tol)).tolist()
     if p.lb is not None:
         rows["active_lower"] = np.flatnonzero((x - p.lb <= tol) | (zb < -tol)).tolist()
     if p.ub is not None:
@@ -286,7 +323,8 @@ def export_folder(folder: str | Path, force: bool = False) -> Path:
 
 def exported_files(real: Path, shown: str | Path) -> set[str]:
     """The files an earlier export in the folder ``real`` wrote, by their path in it (its
-    index, its problems and ``answers/<name>``), from its index.
+    index, its problems, ``answers/<name>`` and, from format 2 on, qpbenchmark's test set),
+    from its index.
 
     Raises
     ------
@@ -300,9 +338,9 @@ def exported_files(real: Path, shown: str | Path) -> set[str]:
             raise ValueError(f"no {INDEX}")
         text = read_bounded(real / INDEX, MAX_INDEX_BYTES, "an export's index")
         index = json.loads(text)
-        if not isinstance(index, dict) or index.get("format") != FORMAT:
+        if not isinstance(index, dict) or index.get("format") not in FORMATS:
             raise ValueError(f"{INDEX} is not an export's index")
-        files = {INDEX}
+        files = {INDEX, TEST_SET} if index["format"] == FORMAT else {INDEX}
         for entry in index["problems"]:
             files |= {_plain(entry["file"]), f"{ANSWERS}/{_plain(entry['answer'], ANSWERS)}"}
     except (InputFileError, ValueError, KeyError, TypeError, RecursionError) as exc:

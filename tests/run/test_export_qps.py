@@ -83,12 +83,19 @@ def scene_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="module")
 def exported(scene_file: Path, tmp_path_factory: pytest.TempPathFactory):
-    """The export, and every backend call of the same run as a watcher of plan saw it."""
+    """The export, every backend call of the same run as a watcher of plan saw it, and each
+    call's inequality rows (``G``, ``h``: every fixed row of the run)."""
     scene = dvqp.load_scene(scene_file)
     seen: list[tuple[int, str, bool]] = []
-    dvqp.plan(scene, "daqp", watch=lambda step, kind, p, s: seen.append((step, kind, s.found)))
+    rows: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def watch(step: int, kind: str, p: solvers.Problem, s: solvers.Solution) -> None:
+        seen.append((step, kind, s.found))
+        rows.append((np.array(p.G), np.array(p.h)))
+
+    dvqp.plan(scene, "daqp", watch=watch)
     folder = tmp_path_factory.mktemp("export") / "qps"
-    return dvqp.export_qps(scene, "daqp", folder), seen
+    return dvqp.export_qps(scene, "daqp", folder), seen, rows
 
 
 def load(folder: Path, entry: dict) -> tuple[qpsolvers.Problem, dict[str, np.ndarray]]:
@@ -97,7 +104,7 @@ def load(folder: Path, entry: dict) -> tuple[qpsolvers.Problem, dict[str, np.nda
 
 
 def test_every_backend_call_is_one_file_named_by_its_step_and_call(exported) -> None:
-    export, seen = exported
+    export, seen, _ = exported
     problems = export.index["problems"]
     names, calls = [], Counter()
     for step, _, _ in seen:  # the names from the calls the watcher saw, in order
@@ -118,7 +125,7 @@ def test_every_backend_call_is_one_file_named_by_its_step_and_call(exported) -> 
 
 
 def test_the_index_matches_the_run(exported) -> None:
-    export, _ = exported
+    export = exported[0]
     index, traj = export.index, export.trajectory
     assert json.loads((export.folder / INDEX).read_text()) == index
     assert (index["scene"], index["backend"], index["steps"]) == ("clamp-ahead", "daqp", 80)
@@ -135,6 +142,24 @@ def test_the_index_matches_the_run(exported) -> None:
             assert strict["refusal"] == "infeasible" and e["step_status"] == "relaxed"
 
 
+def test_a_file_keeps_the_rows_that_apply_and_the_index_maps_them_to_the_runs_rows(
+    exported,
+) -> None:
+    export, _, rows = exported
+    index = export.index
+    assert index["fixed_inequalities"] == rows[0][1].shape[0] == 36
+    dropped = 0
+    for e, (G, h) in zip(index["problems"], rows, strict=True):
+        p = qpsolvers.Problem.load(str(export.folder / e["file"]))
+        kept = np.array(e["rows"], dtype=int)
+        assert np.array_equal(kept, np.flatnonzero(np.isfinite(h))), e["file"]
+        assert e["inequalities"] == kept.size == (0 if p.G is None else p.G.shape[0])
+        if kept.size:  # bitwise the run's rows, the variables of the call's kind
+            assert np.array_equal(p.G, G[kept]) and np.array_equal(p.h, h[kept])
+        dropped += h.size - kept.size
+    assert dropped > 1000  # most damper rows are far from their limit: 0 x <= +inf
+
+
 def test_each_warm_start_is_the_previous_accepted_call_of_the_same_kind(exported) -> None:
     problems = exported[0].index["problems"]
     for i, e in enumerate(problems):
@@ -147,7 +172,7 @@ def test_each_warm_start_is_the_previous_accepted_call_of_the_same_kind(exported
 def test_the_active_rows_alone_give_the_stored_answer(exported) -> None:
     """Solving with the active rows as equalities (an equality-constrained QP, by its KKT
     system) and the others dropped gives the stored x: the active set is the right one."""
-    export, _ = exported
+    export = exported[0]
     checked = 0
     for e in export.index["problems"]:
         if not e["found"]:
@@ -156,8 +181,10 @@ def test_the_active_rows_alone_give_the_stored_answer(exported) -> None:
         p, answer = load(export.folder, e)
         n = p.q.shape[0]
         eye = np.eye(n)
-        rows = [p.A, p.G[e["active_inequalities"]], eye[e["active_lower"]], eye[e["active_upper"]]]
-        rhs = [p.b, p.h[e["active_inequalities"]], p.lb[e["active_lower"]], p.ub[e["active_upper"]]]
+        active = e["active_inequalities"]
+        G, h = (p.G[active], p.h[active]) if active else (np.zeros((0, n)), np.zeros(0))
+        rows = [p.A, G, eye[e["active_lower"]], eye[e["active_upper"]]]
+        rhs = [p.b, h, p.lb[e["active_lower"]], p.ub[e["active_upper"]]]
         C, d = np.vstack(rows), np.concatenate(rhs)
         kkt = np.block([[p.P, C.T], [C, np.zeros((C.shape[0], C.shape[0]))]])
         x = np.linalg.lstsq(kkt, np.concatenate([-p.q, d]), rcond=None)[0][:n]
@@ -167,7 +194,7 @@ def test_the_active_rows_alone_give_the_stored_answer(exported) -> None:
 
 
 def test_qpsolvers_loads_each_file_and_osqp_and_daqp_reproduce_the_answer(exported) -> None:
-    export, _ = exported
+    export = exported[0]
     worst = {"osqp": 0.0, "daqp": 0.0}
     for e in export.index["problems"]:
         problem, answer = load(export.folder, e)
@@ -181,8 +208,29 @@ def test_qpsolvers_loads_each_file_and_osqp_and_daqp_reproduce_the_answer(export
     assert max(worst.values()) < X_TOLERANCE, worst
 
 
+def test_daqp_through_qpsolvers_gives_an_optimal_solution_by_qpsolvers_own_check(
+    exported,
+) -> None:
+    """qpsolvers' ``Solution.is_optimal`` (primal and dual residuals and the duality gap
+    ``|xᵀPx + qᵀx + bᵀy + hᵀz + …|``, which a row with ``h = +inf`` made NaN) holds for every
+    problem dvqp answered; the others are infeasible for DAQP too."""
+    export = exported[0]
+    optimal = 0
+    for e in export.index["problems"]:
+        problem, _ = load(export.folder, e)
+        assert problem.h is None or np.all(np.isfinite(problem.h)), e["file"]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            solution = qpsolvers.solve_problem(problem, "daqp")
+        assert solution.found == e["found"], e["file"]
+        if e["found"]:
+            assert np.isfinite(solution.duality_gap()) and solution.is_optimal(1e-9), e["file"]
+            optimal += 1
+    assert optimal == len(export.index["problems"]) - 32 == 79
+
+
 def test_the_stored_answer_passes_solvers_residual_check_on_the_file(exported) -> None:
-    export, _ = exported
+    export = exported[0]
     tolerance = export.index["tolerance"]
     for e in export.index["problems"]:
         p, answer = load(export.folder, e)
