@@ -418,7 +418,9 @@ def test_dot_and_dotdot_name_the_folder_they_resolve_to(
     monkeypatch.chdir(tmp_path)
     assert export(scene_file, f"qps/{ANSWERS}/..", "--force") == 0
     assert json.loads((out / INDEX).read_text())["backend"] == "daqp"
-    assert capsys.readouterr().out.endswith("of 80 steps to qps (index.json, answers/)\n")
+    assert capsys.readouterr().out.endswith(
+        "of 80 steps to qps (index.json, answers/, dvqp_qps.py)\n"
+    )
     assert not [n for n in names_in(tmp_path) if "/." in f"/{n}"]  # no .old, no work folder
 
 
