@@ -1,4 +1,5 @@
-"""The paper's baseline (eq. 18): pseudoinverse plus null-space projection of ``∇w``.
+"""The paper's baseline (eq. 18): pseudoinverse plus null-space projection of ``∇w``, nested
+over the levels of the tasks' priorities.
 
 It uses the same tasks and objective as the QP and ignores the limits. Weighted least-norm form
 with a positive diagonal ``W`` (``W = I`` gives eq. 18)::
@@ -10,6 +11,19 @@ which is ``W⁻¹ g + J̄_W⁺ (ẋ − J̄ W⁻¹ g)``. With ``μ = 0`` this is
 ``½ Q̇ᵀ W Q̇ − gᵀ Q̇`` subject to ``J̄ Q̇ = ẋ``: the QP without inequalities. With soft tasks
 the metric becomes ``M = W + H`` (dense) and ``g`` takes their ``−c``; ``μ > 0`` (the damped,
 singularity-robust inverse) is then refused.
+
+Tasks at several priorities (levels ``A_k Q̇ = b_k``, 1 first) are nested: each level in the
+null space of those above, ``∇w`` last in the null space of them all. With ``Q = M⁻¹`` (the
+metric's inverse on what is still free) and ``Q̇ = 0`` at first, for each level::
+
+    S_k = A_k Q A_kᵀ + μ² I
+    Q̇  += Q A_kᵀ S_k⁻¹ (b_k − A_k Q̇)            level k's task in the null space above
+    Q  −= Q A_kᵀ S_k⁻¹ A_k Q                     what level k leaves free
+
+then ``Q̇ += Q g``. ``Q`` stays ``N M⁻¹`` with ``N`` the M-orthogonal projector on the levels'
+common null space (``μ = 0``), so when no limit is active each level's answer is the QP's:
+every level is met (its ``A_k Q`` of full row rank, else the undamped inverse refuses it) and
+``Q̇`` minimises the cost among those that meet them. With one level it is the formula above.
 """
 
 from __future__ import annotations
@@ -95,52 +109,73 @@ def _solve(factor: Array, x: Array) -> None:
 
 
 @njit(separate=True)
-def pinv_step(A, b, cost, weights, P, dense, damping, info, out) -> int:  # type: ignore[no-untyped-def]
-    """``out = M⁻¹g + M⁻¹Aᵀ (A M⁻¹ Aᵀ + μ² I)⁻¹ (b − A M⁻¹ g)`` with ``g = −cost`` and
-    ``M = diag(weights)``, or the dense ``P`` if ``dense``. Returns −1, :data:`SINGULAR` (the
-    Gram matrix not safely positive definite; ``info`` its pivots' extreme squares) or
+def pinv_step(A, b, levels, cost, weights, P, dense, damping, info, out) -> int:  # type: ignore[no-untyped-def]
+    """``out``: the nested step of the module docstring over the levels ``A[levels[k] :
+    levels[k+1]]`` (``levels`` (L + 1,)), with ``g = −cost`` and ``M = diag(weights)``, or the
+    dense ``P`` if ``dense``. Returns −1, :data:`SINGULAR` (a level's Gram matrix ``S_k`` not
+    safely positive definite; ``info`` its pivots' extreme squares and the level k) or
     :data:`NOT_DEFINITE` (the metric)."""
-    m, n = A.shape
-    mj, mg = np.empty((n, m)), np.empty(n)  # M⁻¹ Aᵀ, M⁻¹ g
-    for c in range(n):
-        mg[c] = -cost[c]
-        for r in range(m):
-            mj[c, r] = A[r, c]
+    n = A.shape[1]
+    Q = np.zeros((n, n))  # M⁻¹, then what the levels leave free
     if dense:
         factor = P.copy()
         if not _cholesky(factor, info):
             return NOT_DEFINITE
-        _solve(factor, mg)
         column = np.empty(n)
-        for r in range(m):
-            for c in range(n):
-                column[c] = mj[c, r]
+        for c in range(n):
+            for r in range(n):
+                column[r] = 1.0 if r == c else 0.0
             _solve(factor, column)
-            for c in range(n):
-                mj[c, r] = column[c]
+            for r in range(n):
+                Q[r, c] = column[r]
     else:
         for c in range(n):
-            mg[c] /= weights[c]
-            for r in range(m):
-                mj[c, r] /= weights[c]
-    gram, rhs = np.empty((m, m)), np.empty(m)
-    for r in range(m):
-        v = b[r]
+            Q[c, c] = 1.0 / weights[c]
+    x = np.zeros(n)
+    for level in range(levels.shape[0] - 1):
+        first, m = levels[level], levels[level + 1] - levels[level]
+        if m == 0:
+            continue
+        qa, gram, rhs = np.empty((n, m)), np.empty((m, m)), np.empty(m)  # Q A_kᵀ, S_k
         for c in range(n):
-            v -= A[r, c] * mg[c]
-        rhs[r] = v
-        for s in range(m):
-            acc = 0.0
-            for c in range(n):
-                acc += A[r, c] * mj[c, s]
-            gram[r, s] = acc
-        gram[r, r] += damping * damping
-    if not _cholesky(gram, info) or (damping == 0.0 and info[0] <= SINGULAR_RCOND * info[1]):
-        return SINGULAR
-    _solve(gram, rhs)
-    for c in range(n):
-        v = mg[c]
+            for r in range(m):
+                acc = 0.0
+                for j in range(n):
+                    acc += Q[c, j] * A[first + r, j]
+                qa[c, r] = acc
         for r in range(m):
-            v += mj[c, r] * rhs[r]
+            v = b[first + r]
+            for c in range(n):
+                v -= A[first + r, c] * x[c]
+            rhs[r] = v
+            for t in range(m):
+                acc = 0.0
+                for c in range(n):
+                    acc += A[first + r, c] * qa[c, t]
+                gram[r, t] = acc
+            gram[r, r] += damping * damping
+        if not _cholesky(gram, info) or (damping == 0.0 and info[0] <= SINGULAR_RCOND * info[1]):
+            info[2] = level
+            return SINGULAR
+        _solve(gram, rhs)
+        for c in range(n):
+            v = 0.0
+            for r in range(m):
+                v += qa[c, r] * rhs[r]
+            x[c] += v
+        column = np.empty(m)
+        for c in range(n):  # Q −= Q A_kᵀ S_k⁻¹ (Q A_kᵀ)ᵀ, column by column
+            for r in range(m):
+                column[r] = qa[c, r]
+            _solve(gram, column)
+            for i in range(n):
+                v = 0.0
+                for r in range(m):
+                    v += qa[i, r] * column[r]
+                Q[i, c] -= v
+    for c in range(n):
+        v = x[c]
+        for j in range(n):
+            v -= Q[c, j] * cost[j]
         out[c] = v
     return -1

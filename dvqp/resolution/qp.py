@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 
 import solvers
 from dvqp.errors import BackendError
+from dvqp.resolution.levels import Levels
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 from dvqp.workspace import QPBuffers
@@ -122,17 +123,26 @@ class QPSolver:
         The problem's arrays, rewritten in place every step.
     task_weight
         ``ρ`` of the relaxed problem's slack.
+    breaks, weights
+        The first row of each level of ``A`` and the number of rows ((L + 1,); None: one
+        level), and each row's weight within its level ((m,); None: all 1).
     """
 
     def __init__(
-        self, factory: Callable[[], solvers.Backend], qp: QPBuffers, task_weight: float
+        self,
+        factory: Callable[[], solvers.Backend],
+        qp: QPBuffers,
+        task_weight: float,
+        breaks: NDArray[np.int64] | None = None,
+        weights: NDArray[np.float64] | None = None,
     ) -> None:
         self.qp = qp
         n, m, p = qp.cost.shape[0], qp.b.shape[0], qp.h.shape[0]
         G, h = (qp.G, qp.h) if p else (None, None)
         self.strict = solvers.Problem.trusted(qp.P, qp.cost, qp.A, qp.b, G, h, qp.lb, qp.ub)
+        weights = np.ones(m) if weights is None else np.asarray(weights, dtype=float)
         P_r = np.zeros((n + m, n + m))
-        P_r[n:, n:] = np.diag(np.full(m, task_weight))
+        P_r[n:, n:] = np.diag(task_weight * weights)
         A_r = np.zeros((m, n + m))
         A_r[:, n:] = -np.eye(m)
         G_r = np.zeros((p, n + m)) if p else None
@@ -149,6 +159,12 @@ class QPSolver:
         )
         self.backends = factory(), factory()
         self.factory, self.task_weight = factory, task_weight
+        self.levels = (
+            Levels(factory, qp, breaks, weights, task_weight)
+            if breaks is not None and len(breaks) > 2
+            else None
+        )
+        """The levels of a step with hard tasks at several priorities (None: one level)."""
         self.feedforward = np.zeros(m)
         """The hard tasks' nominal motion this step, in their units per s, shape (m,): part
         of ``b``; when it is not zero, a step whose strict problem has no accepted answer slows
@@ -179,6 +195,12 @@ class QPSolver:
         qp = self.qp
         if rest and not (np.any(qp.lb > 0.0) or np.any(qp.ub < 0.0) or np.any(qp.h < 0.0)):
             return Answer(np.zeros_like(qp.cost), "optimal", 0, 0.0)
+        if self.levels is not None:
+            slow = self._slow_down if not rest and np.any(self.feedforward) else None
+            out = self.levels.solve(self._count, slow)
+            if out.x is not None:
+                return Answer(out.x, out.status, out.iterations, out.solver_time, out.rate)
+            return self._brake(out.message, out.iterations, out.solver_time, out.rate)
         strict, relaxed = self.backends
         solution = strict.solve(self.strict)
         self._count("strict", self.strict, solution)
@@ -194,9 +216,15 @@ class QPSolver:
         if solution.found and solution.x is not None:
             x = solution.x[: qp.cost.shape[0]]
             return Answer(x, status, solution.iterations, spent, rate)
+        return self._brake(solution.message, solution.iterations, spent, rate)
+
+    def _brake(self, message: str, iterations: int | None, spent: float, rate: float) -> Answer:
+        """No accepted answer: the velocity closest to rest within the joint bounds
+        (``"braking"``), or a failure if those cross."""
+        qp = self.qp
         if np.any(qp.lb > qp.ub):
-            return Answer(None, f"failed: {solution.message}", solution.iterations, spent, 0.0)
-        return Answer(np.clip(0.0, qp.lb, qp.ub), "braking", solution.iterations, spent, rate)
+            return Answer(None, f"failed: {message}", iterations, spent, 0.0)
+        return Answer(np.clip(0.0, qp.lb, qp.ub), "braking", iterations, spent, rate)
 
     def _slow_down(self) -> tuple[solvers.Solution, float]:
         """Solve the time-scaled problem; leave in ``b`` the task the answer meets (or, if it
@@ -265,3 +293,5 @@ class QPSolver:
         for backend in (*self.backends, self._pacer):
             if backend is not None:
                 backend.reset()
+        if self.levels is not None:
+            self.levels.reset()

@@ -100,8 +100,15 @@ class Stepper(Verification):
         plan = self.layout.plan
         self.struct = as_struct(self.arrays)
         assert plan.qp is not None and plan.checks is not None
+        tasks = self.layout.tasks
         self.solver = (
-            QPSolver(dropping(resolver.factory), plan.qp, spec.task_weight)
+            QPSolver(
+                dropping(resolver.factory),
+                plan.qp,
+                spec.task_weight,
+                tasks.levels,
+                self.layout.row_weights,
+            )
             if isinstance(resolver, QPResolver)
             else None
         )
@@ -115,6 +122,9 @@ class Stepper(Verification):
         """(2,): ``[value, ratio]`` of the loaded state's worst excess."""
         self.motion = self.arrays.motion
         """(2,): ``[‖A x − b‖∞, max |dt x|]`` of the last :meth:`move`."""
+        self.level_error = tasks.level_error
+        """(L,): each level's ``‖A_k x − b_k‖∞`` of the last :meth:`move` (task units per s),
+        levels by priority (1 first)."""
         self.limits: tuple[Limit, ...] = spec.limits
         self._observers = [
             lim
@@ -230,8 +240,8 @@ class Stepper(Verification):
         v = self.solver.feedforward
         v[:] = 0.0
         if feedforward is not None:
-            for start in self.layout.measures.tool_rows:
-                v[start : start + 4] = feedforward
+            for start, count, *components in self.layout.tasks.tool:
+                v[start : start + count] = feedforward[components[:count]]
 
     def prepare(self, command: Array, dt: float) -> int:
         """Write the problem of a step from the loaded state for ``command`` (4,) over ``dt``
@@ -259,10 +269,17 @@ class Stepper(Verification):
     def _pinv_error(self, status: int) -> SingularConfigurationError:
         if status == stages.INDEFINITE_METRIC:
             return SingularConfigurationError("the soft tasks' metric is not positive definite")
-        lo, hi = self.arrays.pinv.info
+        lo, hi, level = self.arrays.pinv.info
+        names = self.resolver.spec.level_names
+        which = (
+            f" of level {int(level) + 1} ({names[int(level)]}) in the null space of the levels "
+            "above"
+            if len(names) > 1
+            else ""
+        )
         return SingularConfigurationError(
-            f"task Jacobian is (nearly) rank deficient (Cholesky pivots from {lo:.3g} to "
-            f"{hi:.3g}); use a damped inverse"
+            f"task Jacobian{which} is (nearly) rank deficient (Cholesky pivots from {lo:.3g} "
+            f"to {hi:.3g}); use a damped inverse"
         )
 
     def record_into(self, samples: Mapping[str, np.ndarray]) -> None:
