@@ -118,6 +118,7 @@ def limit_series(scene: Scene, traj: Trajectory) -> LimitPage:
         else:
             curves += _damper(traj.t, values, c.safe, c.tolerance, block, scene)
     curves += _rates(traj, stepper, dt)
+    curves += _levels(traj)
     order = ["clearance", "self distance", "height", "tilt"]
     curves.sort(key=lambda c: order.index(c.panel) if c.panel in order else len(order))
     return LimitPage(tuple(curves), _marks(traj), dt)
@@ -200,6 +201,25 @@ def _rates(traj: Trajectory, stepper: Stepper, dt: float) -> list[Curve]:
             if np.isfinite(limit[i])
         ]
     return curves
+
+
+LEVEL_PANELS = ("task level error (m)", "task level error (rad)")
+"""The panels of a run with more than one level: each level's error over time (its tasks'
+:meth:`~dvqp.Task.deviation`), lengths and angles, against 0."""
+
+
+def _levels(traj: Trajectory) -> list[Curve]:
+    """Each level's worst length and angle error at every sample (a run with more than one
+    level; none else), bound 0 (kept exactly)."""
+    d, measured = traj.level_deviation, traj.level_measured
+    if len(traj.levels) < 2 or d.shape[:2] != (traj.t.shape[0], len(traj.levels)):
+        return []
+    return [
+        Curve(panel, f"level {k + 1}: {name}", traj.t, d[:, k, u], 0.0, 0.0, unit, upper=True)
+        for u, (panel, unit) in enumerate(zip(LEVEL_PANELS, ("m", "rad"), strict=True))
+        for k, name in enumerate(traj.levels)
+        if measured[k, u]
+    ]
 
 
 def _marks(traj: Trajectory) -> dict[str, Array]:

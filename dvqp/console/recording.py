@@ -116,7 +116,13 @@ class Recording:
     def trajectory(self, pipe_radius: float, backend: str, scene_text: str) -> Trajectory:
         """The record as a full :class:`Trajectory` (``dvqp plot`` reads its ``.npz``)."""
         first = self.samples[0]
-        recorder = TrajectoryRecorder(len(self.steps), first.q.shape[0], first.points.shape[0])
+        levels = max(
+            (len(m.step.level_error) for m, _, _ in self.steps if m.step.level_error is not None),
+            default=1,
+        )
+        recorder = TrajectoryRecorder(
+            len(self.steps), first.q.shape[0], first.points.shape[0], levels=levels
+        )
         for name in SAMPLED:
             recorder.arrays[name][:] = [getattr(sample, name) for sample in self.samples]
         for k, (moved, _, took) in enumerate(self.steps):

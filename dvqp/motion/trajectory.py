@@ -51,6 +51,9 @@ DIAGNOSTICS = (
     "holder_height",
     "rail",
     "path_time",
+    "level_error",
+    "level_deviation",
+    "level_measured",
 )
 """Arrays added since dvqp 0.2; a file written before one was added lacks it (loaded empty)."""
 
@@ -148,6 +151,19 @@ class Trajectory:
         :attr:`dvqp.resolution.qp.QPSolver.accuracy`): ``solves``,
         ``unanswered`` and the shifted geometric means ``primal_residual``, ``dual_residual``,
         ``duality_gap`` (empty: the baseline, or an older file).
+    levels : tuple of str
+        The levels of the hard tasks, by priority (1 first): what each holds (``"tool h,
+        alpha"``; empty: an older file).
+    level_error : ndarray, shape (N, L) or (0, 0)
+        Each level's residual ``‖A_k Q̇ − b_k‖∞`` per step (task units per s, m/s or rad/s;
+        ``inf`` for a failed step): 0 to the solver's tolerance where the level was kept
+        exactly, larger where it gave way. With one level, ``task_error``.
+    level_deviation : ndarray, shape (N+1, L, 2) or (0, 0, 2)
+        Each level's worst error per sample against what its tasks hold (the tool against the
+        commanded motion, a point or posture against its target; :meth:`dvqp.Task.deviation`):
+        ``[length (m), angle (rad)]``, 0 where ``level_measured`` is False.
+    level_measured : ndarray of bool, shape (L, 2) or (0, 2)
+        Whether a level's ``level_deviation`` has a length (its tasks hold one) and an angle.
     """
 
     t: NDArray[np.float64]
@@ -183,6 +199,10 @@ class Trajectory:
     brake_start: int = -1
     refusals: dict[str, int] = field(default_factory=dict)
     accuracy: dict[str, float] = field(default_factory=dict)
+    levels: tuple[str, ...] = ()
+    level_error: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 0)))
+    level_deviation: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 0, 2)))
+    level_measured: NDArray[np.bool_] = field(default_factory=lambda: np.zeros((0, 2), dtype=bool))
 
     @classmethod
     def from_samples(
@@ -278,6 +298,7 @@ class Trajectory:
                     brake_start=np.int64(self.brake_start),
                     refusals=np.str_(json.dumps(self.refusals)),
                     accuracy=np.str_(json.dumps(self.accuracy)),
+                    levels=np.str_(json.dumps(list(self.levels))),
                     meta=np.str_(json.dumps({"versions": versions(), **CONVENTIONS})),
                 )
             else:
@@ -324,6 +345,7 @@ class Trajectory:
                     brake_start=int(data["brake_start"]) if "brake_start" in data else -1,
                     refusals=_counts(data, "refusals"),
                     accuracy=_counts(data, "accuracy"),
+                    levels=_names(data, "levels"),
                 )
         except OSError as exc:
             reason = exc.strerror or type(exc).__name__
@@ -332,6 +354,16 @@ class Trajectory:
             # numpy's own text for pickled data suggests loading it unsafely: never pass it on
             reason = "a missing array" if isinstance(exc, KeyError) else "not a dvqp .npz file"
             raise DvqpError(f"{path}: not a dvqp trajectory ({reason})") from exc
+
+
+def _names(data: Any, name: str) -> tuple[str, ...]:
+    """The JSON list of strings ``name`` of a loaded file (``()``: none in it)."""
+    if name not in data:
+        return ()
+    names = json.loads(str(data[name]))
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        raise ValueError(name)
+    return tuple(names)
 
 
 def _counts(data: Any, name: str) -> dict[str, Any]:

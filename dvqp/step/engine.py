@@ -19,13 +19,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 import solvers
-from dvqp.errors import ParameterError, ShapeError, SingularConfigurationError
+from dvqp.errors import ParameterError, ShapeError, SingularConfigurationError, TaskLevelError
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState, singular_frame
 from dvqp.limits import Bounds, Constraint, Limit, VelocityDamper
 from dvqp.objective import Term
 from dvqp.resolution.qp import QPResolver, QPSolver
+from dvqp.resolution.spec import unmeetable
 from dvqp.resolution.step import Resolver
 from dvqp.step import stages
 from dvqp.step.arrays import RecordArrays
@@ -136,6 +137,27 @@ class Stepper(Verification):
         tool and every task held still, λ = 0), a damper holds a drift below its safe value
         instead of pulling it back (right side at least 0), and Q̇ = 0 is taken when it is
         feasible (:meth:`~dvqp.resolution.qp.QPSolver.solve`)."""
+        if tasks.levels.shape[0] > 2:
+            self._check_levels(q0, dt)
+
+    def _check_levels(self, q0: ArrayLike, dt: float) -> None:
+        """Refuse a level that cannot be met even alone at ``q0`` (its rows as the step writes
+        them: :func:`~dvqp.resolution.spec.unmeetable`).
+
+        Raises
+        ------
+        TaskLevelError
+            Such a level.
+        """
+        if not self.load(q0):
+            return  # singular: start() says so
+        self.prepare(np.zeros(4), dt)
+        breaks, A = self.layout.tasks.levels, self.arrays.qp.A
+        names = self.resolver.spec.level_names
+        for level in range(breaks.shape[0] - 1):
+            why = unmeetable(A[breaks[level] : breaks[level + 1]])
+            if why is not None:
+                raise TaskLevelError(level + 1, names[level], why)
 
     def load(self, q: ArrayLike) -> bool:
         """Evaluate the state at ``q`` (rad); False if a guarded frame is on the pipe axis."""
