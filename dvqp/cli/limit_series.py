@@ -73,16 +73,25 @@ class Curve:
 @dataclass(frozen=True)
 class LimitPage:
     """Every curve of a run, in panel order, and its marked steps: ``marks[kind]`` the start
-    times (s) of the steps of each kind of :data:`MARKS` (``"split"``: into substeps)."""
+    times (s) of the steps of each kind of :data:`MARKS` (``"split"``: into substeps); and, for
+    a run with more than one level of hard tasks, each level's error over time (``levels``:
+    curves against 0, not limits: a level gives way where the limits or a level above need it).
+    """
 
     curves: tuple[Curve, ...]
     marks: dict[str, Array]
     dt: float
+    levels: tuple[Curve, ...] = ()
 
     @property
     def panels(self) -> list[str]:
-        """The panels, in order."""
+        """The panels of the limits, in order."""
         return list(dict.fromkeys(c.panel for c in self.curves))
+
+    @property
+    def level_panels(self) -> list[str]:
+        """The panels of the levels' errors (lengths, angles), after the limits'."""
+        return list(dict.fromkeys(c.panel for c in self.levels))
 
 
 def limit_series(scene: Scene, traj: Trajectory) -> LimitPage:
@@ -118,10 +127,9 @@ def limit_series(scene: Scene, traj: Trajectory) -> LimitPage:
         else:
             curves += _damper(traj.t, values, c.safe, c.tolerance, block, scene)
     curves += _rates(traj, stepper, dt)
-    curves += _levels(traj)
     order = ["clearance", "self distance", "height", "tilt"]
     curves.sort(key=lambda c: order.index(c.panel) if c.panel in order else len(order))
-    return LimitPage(tuple(curves), _marks(traj), dt)
+    return LimitPage(tuple(curves), _marks(traj), dt, tuple(_levels(traj)))
 
 
 def _groups(block: Block, scene: Scene) -> list[tuple[str, str, slice | list[int]]]:
