@@ -38,7 +38,7 @@ from numpy.typing import NDArray
 
 import solvers
 from dvqp.errors import BackendError
-from dvqp.resolution.levels import Levels
+from dvqp.resolution.levels import Levels, load_relaxed, relaxed_problem, strict_problem
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 from dvqp.workspace import QPBuffers
@@ -137,26 +137,10 @@ class QPSolver:
         weights: NDArray[np.float64] | None = None,
     ) -> None:
         self.qp = qp
-        n, m, p = qp.cost.shape[0], qp.b.shape[0], qp.h.shape[0]
-        G, h = (qp.G, qp.h) if p else (None, None)
-        self.strict = solvers.Problem.trusted(qp.P, qp.cost, qp.A, qp.b, G, h, qp.lb, qp.ub)
+        m = qp.b.shape[0]
+        self.strict = strict_problem(qp, m, qp.b)
         weights = np.ones(m) if weights is None else np.asarray(weights, dtype=float)
-        P_r = np.zeros((n + m, n + m))
-        P_r[n:, n:] = np.diag(task_weight * weights)
-        A_r = np.zeros((m, n + m))
-        A_r[:, n:] = -np.eye(m)
-        G_r = np.zeros((p, n + m)) if p else None
-        inf = np.full(m, np.inf)
-        self.relaxed = solvers.Problem.trusted(
-            P_r,
-            np.zeros(n + m),
-            A_r,
-            qp.b,
-            G_r,
-            h,
-            np.concatenate([qp.lb, -inf]),
-            np.concatenate([qp.ub, inf]),
-        )
+        self.relaxed = relaxed_problem(qp, 0, m, weights, task_weight, qp.b)
         self.backends = factory(), factory()
         self.factory, self.task_weight = factory, task_weight
         self.levels = (
@@ -209,7 +193,7 @@ class QPSolver:
             solution, rate = self._slow_down()
             spent, status = spent + solution.solver_time, "slowed"
         if not solution.found:
-            self._load_relaxed()
+            load_relaxed(qp, self.relaxed)
             solution = relaxed.solve(self.relaxed)
             self._count("relaxed", self.relaxed, solution)
             spent, status = spent + solution.solver_time, "relaxed"
@@ -276,15 +260,6 @@ class QPSolver:
             self.accuracy.add(solution)
         for watch in self.watchers:
             watch(kind, problem, solution)
-
-    def _load_relaxed(self) -> None:
-        """Copy the strict problem's data into the relaxed one's ``Q̇`` columns."""
-        qp, r = self.qp, self.relaxed
-        n = qp.cost.shape[0]
-        r.P[:n, :n], r.q[:n], r.A[:, :n] = qp.P, qp.cost, qp.A
-        r.lb[:n], r.ub[:n] = qp.lb, qp.ub
-        if r.G is not None:
-            r.G[:, :n] = qp.G
 
     def reset(self) -> None:
         """Forget the backends' warm starts, the refusals and accuracy counted (a run starts)."""
