@@ -20,7 +20,9 @@ from dvqp import (
     Robot,
     Stepper,
     StepSpec,
+    Task,
     TaskLevelError,
+    TaskRows,
     ToolTask,
     jog_commands,
     simulate,
@@ -279,3 +281,32 @@ def test_the_compiled_nested_step_is_the_null_space_oracle(
     dense = np.diag(w)  # the same metric, written out: the dense path
     status = pinv_step(A, b, breaks, -g, w, dense, True, 0.0, info, out)
     np.testing.assert_allclose(out, nested(list(zip(rows, v, strict=True)), g, w), atol=1e-9)
+
+
+class Lean(Task):
+    """A user's hard task in NumPy: joint ``i`` at ``speed`` rad/s."""
+
+    name = "lean"
+
+    def __init__(self, i: int, speed: float, priority: int) -> None:
+        self.i, self.speed, self.priority = i, speed, priority
+
+    def compute(self, state, command, dt):  # type: ignore[no-untyped-def]
+        return TaskRows(np.eye(1, state.n, self.i), np.array([self.speed]))
+
+
+@pytest.mark.parametrize("backend", [b for b in ("daqp", "osqp") if b in BACKENDS])
+def test_a_users_task_joins_a_level_like_a_built_in(robot: Robot, backend: str) -> None:
+    tasks = (*FOUR[:2], Lean(4, 0.05, priority=2), Lean(8, -0.03, priority=3))
+    spec = StepSpec(tasks, objective_with([]), loose(robot))
+    assert spec.level_names == ("tool h, alpha", "tool l, z; lean", "lean")
+    qp = Stepper(robot, PIPE_RADIUS, QPResolver(spec, backend), np.array(Q0), DT)
+    pinv = Stepper(robot, PIPE_RADIUS, PseudoinverseResolver(spec), np.array(Q0), DT)
+    qp.start(np.array(Q0))
+    pinv.start(np.array(Q0))
+    command = np.array([0.01, 0.005, 0.0, 0.02])
+    assert qp.resolve(command, DT).status == "optimal"
+    pinv.resolve(command, DT)
+    np.testing.assert_allclose(qp.x, pinv.x, atol=AGREEMENT[backend])
+    assert qp.x[4] == pytest.approx(0.05, abs=1e-6) and qp.x[8] == pytest.approx(-0.03, abs=1e-6)
+    np.testing.assert_array_equal(qp.layout.tasks.levels, [0, 2, 5, 6])  # rows by level
