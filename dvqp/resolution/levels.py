@@ -22,7 +22,12 @@ with every backend, and each answer is checked from the problem data
 as far down as they can be met together (``rows <= n``: all of them unless a level has more
 rows than the joints left) as one strict QP — when it is accepted, every level in it is met
 exactly and that is the step; else level by level from the first not met: strict, else
-relaxed, and after a level that gave way, the levels below together again.
+relaxed, and after a level that gave way, the levels below together again. Two shortcuts give
+the very answer of the levels one by one in one QP: when the levels together are refused, the
+last of them relaxed with those above held exactly (accepted: those above could be met, and it
+gave way in what they leave free); and a level with more rows than the joints the levels above
+leave (a posture below other tasks), which is never met exactly, relaxed with those above held
+exactly. Refused, the levels are taken one by one.
 
 A level whose relaxed QP has no accepted answer ends the cascade: the step is the answer of
 the level above (which keeps every limit and every level above), the levels from there give
@@ -192,31 +197,47 @@ class Levels:
             top = self.reach
             if top >= settled and top not in tried:
                 tried.add(top)
-                if attempt("strict", *self.strict(top)):
-                    settled = top + 1
-                    continue
-                if slow is not None and settled == 0 and top == self.count - 1:
-                    solution, rate = slow()  # once: σ = 0 is then no better
-                    slow = None
-                    spent += solution.solver_time
-                    if solution.found and solution.x is not None:
-                        x, status = np.array(solution.x[:n]), "slowed"
-                        break
-                    self.fixed[:] = qp.b  # the task of stopping on the path
+                if top + 1 < self.count:  # the next level cannot be met: relaxed, those held
+                    if attempt("relaxed", *self._loaded(top + 1)):
+                        self._hold(top + 1, x)  # type: ignore[arg-type]
+                        status, settled = "relaxed", top + 2
+                        tried.clear()
+                        continue
+                else:
+                    if attempt("strict", *self.strict(top)):
+                        settled = top + 1
+                        continue
+                    if slow is not None and settled == 0:
+                        solution, rate = slow()  # once: σ = 0 is then no better
+                        slow = None
+                        spent += solution.solver_time
+                        if solution.found and solution.x is not None:
+                            x, status = np.array(solution.x[:n]), "slowed"
+                            break
+                        self.fixed[:] = qp.b  # the task of stopping on the path
+                    if top > settled and attempt("relaxed", *self._loaded(top)):
+                        self._hold(top, x)  # type: ignore[arg-type]
+                        status, settled = "relaxed", top + 1  # the last level gave way
+                        continue
             if top > settled and settled not in tried:
                 tried.add(settled)
                 if attempt("strict", *self.strict(settled)):
                     settled += 1
                     continue
-            first, rows = self.breaks[settled], self.breaks[settled + 1]
             if not attempt("relaxed", *self._loaded(settled)):
                 break
-            self.fixed[first:rows] = qp.A[first:rows] @ x  # what it achieved, held from now on
+            self._hold(settled, x)  # type: ignore[arg-type]
             status, settled = "relaxed", settled + 1
             tried.clear()
         if settled < self.count and x is not None:
             status = "relaxed"  # the levels from `settled` give way to those above
         return Outcome(x, status, iterations if counted else None, spent, rate, message)
+
+    def _hold(self, level: int, x: Array) -> None:
+        """Hold ``level`` from now on at what ``x`` achieves (its right side, for the levels
+        below)."""
+        first, rows = self.breaks[level], self.breaks[level + 1]
+        self.fixed[first:rows] = self.qp.A[first:rows] @ x
 
     def _loaded(self, level: int) -> tuple[solvers.Problem, solvers.Backend]:
         problem, backend = self.relaxed(level)
