@@ -250,9 +250,9 @@ def prepare_baseline(s, first, last) -> int:  # type: ignore[no-untyped-def]
     if first <= ROWS <= last and not _rows(s):
         return BAD_COMMAND
     if first <= CLOSE <= last:
-        levels, weights = s.tasks.levels, p.weights
+        levels = s.tasks.levels
         status = pinv_step(
-            qp.A, qp.b, levels, qp.cost, weights, qp.P, p.dense, p.damping, p.info, p.x
+            qp.A, qp.b, levels, qp.cost, p.weights, qp.P, p.dense, p.damping, p.info, p.x
         )
         if status != -1:
             return INDEFINITE_METRIC if status == NOT_DEFINITE else SINGULAR_TASK
@@ -270,22 +270,11 @@ def _rows(s) -> bool:  # type: ignore[no-untyped-def]
     for i in range(t.tool.shape[0]):
         start, count = t.tool[i, 0], t.tool[i, 1]
         tool_rows(st.tool_jacobian, s.command, t.tool[i, 2 : 2 + count], qp.A, qp.b, start)
-    period = 2.0 * math.pi * s.radius
+    period, g, dg = 2.0 * math.pi * s.radius, st.guarded, st.guarded_jacobians
     for i in range(t.point.shape[0]):
         start, count, point = t.point[i, 0], t.point[i, 1], t.point[i, 2]
         components, target, gain = t.point[i, 3 : 3 + count], t.point_target[i], t.point_gain[i]
-        point_rows(
-            st.guarded,
-            st.guarded_jacobians,
-            point,
-            components,
-            target,
-            gain,
-            period,
-            qp.A,
-            qp.b,
-            start,
-        )
+        point_rows(g, dg, point, components, target, gain, period, qp.A, qp.b, start)
     for i in range(t.posture.shape[0]):
         posture_rows(st.q, t.posture_target[i], t.posture_gain[i], qp.A, qp.b, t.posture[i])
     if p.dense:
