@@ -167,16 +167,28 @@ class Levels:
             self._relaxed[level] = problem, self.factory()
         return self._relaxed[level]
 
-    def solve(self, count: Count, slow: Slow | None = None) -> Outcome:
+    @property
+    def together(self) -> bool:
+        """Whether every level may be met together (no more rows than joints): then the first
+        attempt is the strict QP of all the task rows."""
+        return self.reach == self.count - 1
+
+    def solve(
+        self, count: Count, slow: Slow | None = None, refused: solvers.Solution | None = None
+    ) -> Outcome:
         """The step: each level met as well as the limits and the levels above let it (see the
         module docstring). ``count`` is shown every backend call; ``slow``, if given, is tried
         once the levels that may be met together are not (time-scaled path following: the
-        step then slows along the path, or its task becomes stopping on it, ``qp.b``)."""
+        step then slows along the path, or its task becomes stopping on it, ``qp.b``);
+        ``refused``: the levels together (:attr:`together`) were already tried, strict, and
+        had no accepted answer (that call, counted)."""
         qp, n = self.qp, self.qp.cost.shape[0]
         self.fixed[:] = qp.b
         x: Array | None = None
-        status, rate, spent, iterations, message = "optimal", 1.0, 0.0, 0, ""
-        counted = True
+        status, rate, message = "optimal", 1.0, ""
+        spent = 0.0 if refused is None else refused.solver_time
+        iterations = 0 if refused is None else refused.iterations or 0
+        counted = refused is None or refused.iterations is not None
         tried: set[int] = set()  # strict problems refused since the held values last changed
         settled = 0
 
@@ -204,9 +216,10 @@ class Levels:
                         tried.clear()
                         continue
                 else:
-                    if attempt("strict", *self.strict(top)):
+                    if refused is None and attempt("strict", *self.strict(top)):
                         settled = top + 1
                         continue
+                    refused = None
                     if slow is not None and settled == 0:
                         solution, rate = slow()  # once: σ = 0 is then no better
                         slow = None

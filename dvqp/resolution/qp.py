@@ -179,13 +179,20 @@ class QPSolver:
         qp = self.qp
         if rest and not (np.any(qp.lb > 0.0) or np.any(qp.ub < 0.0) or np.any(qp.h < 0.0)):
             return Answer(np.zeros_like(qp.cost), "optimal", 0, 0.0)
-        if self.levels is not None:
+        strict, relaxed = self.backends
+        levels, refused = self.levels, None
+        if levels is not None and levels.together:  # all the task rows, strict: as one level
+            solution = refused = strict.solve(self.strict)
+            self._count("strict", self.strict, solution)
+            if solution.found and solution.x is not None:
+                x = solution.x[: qp.cost.shape[0]]
+                return Answer(x, "optimal", solution.iterations, solution.solver_time)
+        if levels is not None:
             slow = self._slow_down if not rest and np.any(self.feedforward) else None
-            out = self.levels.solve(self._count, slow)
+            out = levels.solve(self._count, slow, refused)
             if out.x is not None:
                 return Answer(out.x, out.status, out.iterations, out.solver_time, out.rate)
             return self._brake(out.message, out.iterations, out.solver_time, out.rate)
-        strict, relaxed = self.backends
         solution = strict.solve(self.strict)
         self._count("strict", self.strict, solution)
         spent, status, rate = solution.solver_time, "optimal", 1.0
