@@ -23,6 +23,7 @@ from dvqp._versions import __version__
 from dvqp.errors import (
     BackendError,
     DvqpError,
+    InputFileError,
     LimitViolationError,
     ParameterError,
     RobotFileError,
@@ -44,7 +45,7 @@ from dvqp.run.qp_export import export_qps
 from dvqp.scenes import Scene, load_scene
 from dvqp.step import Stepper
 from dvqp.tasks import FrameTask, PointTask, PostureTask, Task, TaskRows, ToolTask
-from dvqp.workspace import Kernel, StepPlan
+from dvqp.workspace import Kernel, PartNames, StepPlan
 
 __all__ = [
     "BackendError",
@@ -53,6 +54,7 @@ __all__ = [
     "Distances",
     "DvqpError",
     "FrameTask",
+    "InputFileError",
     "JogSegment",
     "Kernel",
     "KinematicState",
@@ -63,6 +65,7 @@ __all__ = [
     "Obstacle",
     "ObstacleSet",
     "ParameterError",
+    "PartNames",
     "PointTask",
     "PostureTask",
     "PseudoinverseResolver",

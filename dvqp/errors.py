@@ -106,6 +106,18 @@ class RobotFileError(DvqpError, ValueError):
         super().__init__(f"{one_line(path)}: {one_line(reason)}")
 
 
+class InputFileError(DvqpError, ValueError):
+    """A file given to read (a trajectory, an export's index) is refused: ``<path>: <reason>``,
+    ``reason`` why (``cannot read: No such file or directory``, ``not a dvqp trajectory (…)``,
+    ``member 'q': declares 2.1 GB, more than …``). Nothing of a refused file is kept, and no
+    more of it is read or inflated than its declared sizes allow."""
+
+    def __init__(self, path: object, reason: str) -> None:
+        self.path = str(path)
+        self.reason = reason
+        super().__init__(f"{one_line(self.path)}: {one_line(reason)}")
+
+
 class OutputError(DvqpError, OSError):
     """The output file ``path`` could not be written: ``reason`` (``"No space left on
     device"``), with the operating system's ``errno`` if there was one.

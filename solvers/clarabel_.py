@@ -58,6 +58,7 @@ class ClarabelBackend(StatefulBackend):
         "tol_gap_rel": 1e-10,
         "tol_feas": 1e-10,
     }
+    required_settings: ClassVar[dict[str, Any]] = {"verbose": False, "presolve_enable": False}
 
     def __init__(self, *, tolerance: float | None = None, **settings: Any) -> None:
         super().__init__(tolerance=tolerance, **settings)

@@ -34,6 +34,7 @@ from typing import Any
 import numba
 from numba import types
 from numba.core.caching import FunctionCache, IndexDataCacheFile, NullCache
+from numba.core.compiler import Flags
 from numba.core.dispatcher import Dispatcher
 from numba.core.registry import CPUDispatcher
 from numba.core.typing.templates import Signature
@@ -189,6 +190,23 @@ def _cache_for(function: Callable[..., Any]) -> SoftCache | NullCache:
     return cache
 
 
+class _Flags(Flags):  # type: ignore[misc]
+    """numba's compile flags, their values read once per change.
+
+    numba keys its cache of resolved overloads by the flags of the compile under way, and
+    hashes and compares them (``TargetConfig.values()``: every one of ~45 options read through
+    a property) at every overload it resolves: 10-20 % of compiling dvqp's kernels. The values
+    are the same; only reading them is memoised (again whenever the set options change)."""
+
+    __slots__ = ("_memo",)
+
+    def values(self) -> dict[str, Any]:
+        memo = getattr(self, "_memo", None)
+        if memo is None or memo[0] != self._values:
+            memo = self._memo = (dict(self._values), super().values())
+        return memo[1]  # type: ignore[no-any-return]
+
+
 class KernelDispatcher(CPUDispatcher):  # type: ignore[misc]
     """numba's CPU dispatcher, compiled for the plain types of a compiled caller's arguments.
 
@@ -201,6 +219,10 @@ class KernelDispatcher(CPUDispatcher):  # type: ignore[misc]
 
     separate = False
     """Whether compiled callers call it through its symbol (:mod:`solvers.linking`)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._compiler._customize_flags = _Flags  # its compiles' flags, and those they nest
 
     def get_call_template(self, args: tuple[Any, ...], kws: dict[str, Any]) -> Any:
         plain = tuple(types.unliteral(a) for a in args)

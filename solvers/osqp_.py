@@ -60,6 +60,7 @@ class OsqpBackend(StatefulBackend):
         "polishing": True,
         "max_iter": 20000,
     }
+    required_settings: ClassVar[dict[str, Any]] = {"verbose": False}
 
     def __init__(self, *, tolerance: float | None = None, **settings: Any) -> None:
         super().__init__(tolerance=tolerance, **settings)

@@ -58,6 +58,7 @@ class ProxqpBackend(StatefulBackend):
         "max_iter_in": 150,
         "verbose": False,
     }
+    required_settings: ClassVar[dict[str, Any]] = {"verbose": False}
 
     def __init__(self, *, tolerance: float | None = None, **settings: Any) -> None:
         super().__init__(tolerance=tolerance, **settings)

@@ -43,6 +43,11 @@ SETTINGS: dict[str, dict[str, Any]] = {
     "proxqp": {"eps_abs": 1e-9, "eps_rel": 0.0, "max_iter": 2000},  # as proxqp_.py caps it
 }
 
+#: Of :data:`SETTINGS`, those kept whatever the tier (``solver_defaults``): none about accuracy.
+REQUIRED: dict[str, dict[str, Any]] = {
+    "osqp": {"raise_error": False},  # a failed solve as a status, not an exception
+}
+
 #: Primal residual tolerance of the check, per solver (also the accuracy on ``x``
 #: expected). All solvers below reach <= 3e-7 on ``x`` with the settings above on
 #: dvqp-sized problems (n ~ 13-20; measured with qpsolvers 4.13): active-set
@@ -105,8 +110,11 @@ class QpsolversBackend:
         Registry name reported in solutions (default ``'qpsolvers:<solver>'``).
     tolerance : float, optional
         Primal residual tolerance of the check (default from :data:`TOLERANCE`).
+    solver_defaults : bool, optional
+        Start from the solver's factory defaults (with only :data:`REQUIRED`), as qpsolvers
+        leaves them, not from :data:`SETTINGS`: qpbenchmark's tiers (:mod:`solvers.tiers`).
     **settings
-        Solver settings overriding :data:`SETTINGS`.
+        Solver settings overriding :data:`SETTINGS` (or the factory defaults).
     """
 
     def __init__(
@@ -115,13 +123,15 @@ class QpsolversBackend:
         *,
         name: str | None = None,
         tolerance: float | None = None,
+        solver_defaults: bool = False,
         **settings: Any,
     ) -> None:
         self.solver = solver
         self.name = name or f"qpsolvers:{solver}"
         default = TOLERANCE.get(solver, DEFAULT_TOLERANCE)
         self.tolerance = default if tolerance is None else float(tolerance)
-        self.settings: dict[str, Any] = {**SETTINGS.get(solver, {}), **settings}
+        base = (REQUIRED if solver_defaults else SETTINGS).get(solver, {})
+        self.settings: dict[str, Any] = {**base, **settings}
         self._sparse = solver in qpsolvers.sparse_solvers and solver not in qpsolvers.dense_solvers
 
     def __repr__(self) -> str:

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from .c_output import c_output_captured
 from .exceptions import SolverError, UnknownBackendError
 from .problem import Problem
 from .protocol import Backend
@@ -110,7 +111,9 @@ def make_backend(name: str, **options: Any) -> Backend:
     name : str
         One of :func:`available_backends`.
     **options
-        ``tolerance=`` and solver settings, forwarded to the adapter.
+        ``tolerance=``, ``solver_defaults=`` (start from the solver's factory defaults, not
+        the adapter's own: :mod:`solvers.tiers`) and solver settings, forwarded to the
+        adapter.
 
     Returns
     -------
@@ -126,27 +129,34 @@ def make_backend(name: str, **options: Any) -> Backend:
     if factory is None:
         raise UnknownBackendError(name, available_backends())
     backend = factory(**options)
-    if set(options) - {"tolerance"}:
-        _try_settings(backend, sorted(options))
+    settings = sorted(set(options) - {"tolerance", "solver_defaults"})
+    if settings:
+        _try_settings(backend, settings)
     return backend
 
 
 def _try_settings(backend: Backend, names: list[str]) -> None:
     """Solve a one-variable problem with the settings given: a solver that refuses one (a
-    wrong type, a name its wrapper does not read) raises :class:`SolverError` here, not in
-    the middle of a run."""
+    wrong type, a name its wrapper does not read, a value out of its range) raises
+    :class:`SolverError` here, not in the middle of a run. The reason is the whole message,
+    on one line, after what the solver's C library printed (OSQP prints its reason, ``eps_abs
+    must be nonnegative``, and raises ``OSQPException: 2``); nothing reaches the terminal."""
     tiny = Problem(np.eye(1), np.zeros(1), G=-np.eye(1), h=-np.ones(1))  # x >= 1, active
+    printed: list[str] = []
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), c_output_captured(printed):
             warnings.simplefilter("ignore")
             solution = backend.solve(tiny)
     except SolverError as exc:
-        reason = str(exc).splitlines()[0]
+        reason = str(exc)
     else:
         backend.reset()
         if solution.status != "exception":
             return
-        reason = solution.message.splitlines()[0]
+        reason = solution.message
+    reason = " ".join(reason.split())
+    if printed:
+        reason = f"{'; '.join(printed)} ({reason})"
     raise SolverError(f"{backend.name}: settings {', '.join(names)} refused: {reason}")
 
 

@@ -121,8 +121,9 @@ def solve_guarded(
 class StatefulBackend:
     """Set up once, then update data and warm-start while the structure holds.
 
-    Subclass it to add a backend: define ``name``, ``default_tolerance`` and
-    ``default_settings``, and implement :meth:`_setup` (cold: build the solver
+    Subclass it to add a backend: define ``name``, ``default_tolerance``,
+    ``default_settings`` (and ``required_settings``, those of them the adapter needs whatever
+    the tier), and implement :meth:`_setup` (cold: build the solver
     from scratch), :meth:`_update` (warm: push new data into the existing
     solver), both returning a :class:`RawResult` (or a :class:`Solution` they checked
     themselves, see :func:`solve_guarded`), and :meth:`_release`;
@@ -135,19 +136,27 @@ class StatefulBackend:
     ----------
     tolerance : float, optional
         Absolute tolerance of the residual check (default ``default_tolerance``).
+    solver_defaults : bool, optional
+        Start from the solver's own factory defaults (with only :attr:`required_settings`),
+        not from ``default_settings``: qpbenchmark's tiers (:mod:`solvers.tiers`).
     **settings
-        Solver settings, merged over ``default_settings``; unknown names raise
-        :class:`SolverError`.
+        Solver settings, merged over ``default_settings`` (or the factory defaults); unknown
+        names raise :class:`SolverError`.
     """
 
     name: str
     default_tolerance: ClassVar[float]
     default_settings: ClassVar[dict[str, Any]]
+    required_settings: ClassVar[dict[str, Any]] = {}
+    """The settings of ``default_settings`` the adapter needs to work (quiet, data updates),
+    kept with ``solver_defaults``; none of them about accuracy."""
     restarts: ClassVar[bool] = False
     """True if :meth:`_restart` solves cold within the set-up (no new set-up): then a cold
     retry, and the solve after a failed one, restart there instead of setting up again."""
 
-    def __init__(self, *, tolerance: float | None = None, **settings: Any) -> None:
+    def __init__(
+        self, *, tolerance: float | None = None, solver_defaults: bool = False, **settings: Any
+    ) -> None:
         unknown = sorted(set(settings) - self.known_settings())
         if unknown:
             accepted = ", ".join(sorted(self.known_settings()))
@@ -156,7 +165,8 @@ class StatefulBackend:
                 f"(accepted: {accepted})"
             )
         self.tolerance = self.default_tolerance if tolerance is None else float(tolerance)
-        self.settings: dict[str, Any] = {**self.default_settings, **settings}
+        base = self.required_settings if solver_defaults else self.default_settings
+        self.settings: dict[str, Any] = {**base, **settings}
         self._structure: Hashable | None = None
         self._warm = False  # the last solve was accepted: the next may start from its state
 

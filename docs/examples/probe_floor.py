@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from dvqp import Distances, Kernel, KinematicState, StepPlan, VelocityDamper
+from dvqp import Distances, Kernel, KinematicState, PartNames, StepPlan, VelocityDamper
 
 
 class ProbeFloor(VelocityDamper):
@@ -54,9 +54,9 @@ class CompiledProbeFloor(ProbeFloor):
         """``floor``, m."""
         return self.floor
 
-    def labels(self, k: int) -> tuple[str, ...]:
-        """``("probe/floor",)``."""
-        return ("probe/floor",)
+    def labels(self, names: PartNames) -> tuple[str, ...]:
+        """``("probe/floor",)``: the probe's name (``names``: the arm's guarded parts)."""
+        return (f"{names.probe}/floor",)
 
     def kernel(self, plan: StepPlan) -> Kernel:
         """One damper row, written from the tool's DV coordinates at every state."""

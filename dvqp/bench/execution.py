@@ -21,7 +21,7 @@ import os
 import signal
 import time
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures import ALL_COMPLETED, FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass
 from multiprocessing.context import BaseContext
@@ -126,7 +126,10 @@ def generate_local(seed: int, count: int, workers: int) -> list[BenchScene]:
         draw = functools.partial(generate_scene, seed)
         with sigint_deferred():  # the pool forks here
             drawn = pool.map(draw, range(1, count), chunksize=max(1, count // (4 * workers)))
-        scenes += drawn
+        scenes += drawn  # appended as they come, in order: kept if the pool breaks
+    except BrokenProcessPool:  # a process died (the OOM killer): the rest drawn here
+        _kill(pool)
+        return scenes + [generate_scene(seed, i) for i in range(len(scenes), count)]
     except BaseException:
         _kill(pool)
         raise
@@ -200,12 +203,14 @@ def _pool_round(
 ) -> tuple[list[Job], list[Job]]:
     """Run ``jobs`` in a new pool of ``workers`` processes (warmed on ``warm``), each holding
     one job queued behind the one it runs, handing each finished one to ``finished`` and each
-    process's start-up to ``startup`` (by process id), until done or a process dies.
+    process's start-up to ``startup`` (by process id), until done or a process dies (also
+    when it dies between a job's end and the next job's hand-over: the pool then refuses
+    new jobs, and those it holds are waited for, their results kept).
 
     Returns the jobs that were running or queued when a process died (they could not finish:
     the pool fails every job it holds) and those not started yet; both empty when all finished.
     """
-    todo, running, broken = list(reversed(jobs)), {}, []
+    todo, running, broken, dead = list(reversed(jobs)), {}, [], False
     pool = ProcessPoolExecutor(
         max_workers=workers,
         mp_context=pool_context(),
@@ -213,12 +218,15 @@ def _pool_round(
         initargs=(time.time(), warm),
     )
     try:
-        while (todo or running) and not broken:
-            with sigint_deferred():  # the first submit forks the pool's processes
-                while todo and len(running) < 2 * workers:
-                    job = todo.pop()
-                    running[pool.submit(_run, job)] = job
-            wait(running, return_when=FIRST_COMPLETED)
+        while (todo or running) and not (broken or dead):
+            try:
+                with sigint_deferred():  # the first submit forks the pool's processes
+                    while todo and len(running) < 2 * workers:
+                        running[pool.submit(_run, todo[-1])] = todo[-1]
+                        todo.pop()
+            except BrokenProcessPool:  # a process died after the last wait: no new job
+                dead = True
+            wait(running, return_when=ALL_COMPLETED if dead else FIRST_COMPLETED)
             if any(_lost(f) for f in running):
                 wait(running)  # a broken pool fails every job it holds, at once
             for future in [f for f in running if f.done()]:

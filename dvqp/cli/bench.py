@@ -12,12 +12,11 @@ import argparse
 import contextlib
 import math
 import sys
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from dvqp._files import output_path
+from dvqp._files import output_folder, output_path
 from dvqp.bench import (
     BenchInterrupted,
     DaskUnavailableError,
@@ -35,7 +34,7 @@ from dvqp.bench.execution import Where, generate_local
 from dvqp.cli import solver_option
 from dvqp.cli.progress import ProgressBar
 from dvqp.cli.report import write_text
-from dvqp.cli.solver_option import solver_options
+from dvqp.cli.solver_option import backend_list, solver_options
 from dvqp.errors import DvqpError, ParameterError
 from dvqp.resolution.registry import PINV, check_name, default_resolvers
 
@@ -167,11 +166,11 @@ def check_options(args: argparse.Namespace) -> Options:
     seed = _integer("--seed", args.seed, 0)
     workers = _integer("--workers", args.workers, 1)
     timeout = _seconds("--scene-timeout", args.scene_timeout)
-    names = [b.strip() for b in args.backends.split(",")] if args.backends else None
-    backends = tuple(dict.fromkeys(check_name(b) for b in names or default_resolvers()))
     json_out = output_path(args.json, (".json",)) if args.json is not None else None
     csv_out = output_path(args.csv, (".csv",)) if args.csv is not None else None
-    scenes_dir = _scenes_dir(args.save_scenes) if args.save_scenes else None
+    scenes_dir = _scenes_dir(args.save_scenes) if args.save_scenes is not None else None
+    names = backend_list(args.backends)
+    backends = tuple(dict.fromkeys(check_name(b) for b in names or default_resolvers()))
     if args.scheduler is not None:
         if not args.scheduler.strip():
             raise ParameterError("--scheduler", "expected an address or 'local'")
@@ -219,18 +218,7 @@ def _seconds(option: str, text: str) -> float:
 
 
 def _scenes_dir(text: str) -> Path:
-    """The ``--save-scenes`` folder: an existing folder, or one to create in an existing one;
-    writable either way."""
-    folder = Path(text)
-    if folder.exists() and not folder.is_dir():
-        raise ParameterError("--save-scenes", f"{folder}: not a directory")
-    where = folder if folder.is_dir() else folder.parent
-    if not where.is_dir():
-        raise ParameterError("--save-scenes", f"{where}: no such directory")
-    try:
-        tempfile.TemporaryFile(dir=where).close()
-    except OSError as exc:
-        raise ParameterError(
-            "--save-scenes", f"{where}: cannot write here ({exc.strerror})"
-        ) from exc
-    return folder
+    """The ``--save-scenes`` folder (:func:`~dvqp._files.output_folder`): an existing folder
+    that can be written in, or one to create in such a folder; as given."""
+    output_folder(text, "--save-scenes")
+    return Path(text)

@@ -9,12 +9,13 @@ import argparse
 import contextlib
 import sys
 from collections import Counter
+from pathlib import Path
 from typing import Any
 
 from dvqp.cli import solver_option
 from dvqp.cli.progress import ProgressBar, check_size
 from dvqp.cli.solver_option import solver_options
-from dvqp.run.qp_export import INDEX, export_qps
+from dvqp.run.qp_export import INDEX, TEST_SET, export_folder, export_qps
 from dvqp.scenes import load_scene
 
 
@@ -39,6 +40,7 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Export the run's QPs; 0 once written, 1 if the run failed (written all the same)."""
+    export_folder(args.output, args.force)  # before any work: the scene is read after it
     scene = load_scene(args.scene)
     options = solver_options(args.solver_option, [args.backend]).get(args.backend)
     check_size([scene], 1)
@@ -59,9 +61,19 @@ def run(args: argparse.Namespace) -> int:
     )
     print(
         f"wrote {len(index['problems'])} QPs ({counted or 'none'}) of {index['steps']} steps "
-        f"to {args.output} ({INDEX}, answers/)"
+        f"to {_shown(args.output, exported.folder)} ({INDEX}, answers/, {TEST_SET})"
     )
     if index["error"]:
         print(f"dvqp: {index['error']}", file=sys.stderr)
         return 1
     return 0
+
+
+def _shown(given: str, real: Path) -> str:
+    """The folder as given, unless it goes through ``.`` or ``..`` (``qps/answers/..``):
+    then where that leads, from the working folder if it is under it."""
+    parts = given.replace("\\", "/").split("/")
+    if "." not in parts[1:] and ".." not in parts:
+        return given
+    here = Path.cwd()
+    return str(real.relative_to(here)) if real.is_relative_to(here) else str(real)

@@ -173,7 +173,7 @@ def _positions(t: Array, room: Array, tolerance: float, scene: Scene) -> list[Cu
     return [
         Curve(
             "joint position",
-            f"joint{i + 1}",
+            robot.joint_names[i],
             t,
             1.0 - least[:, i] / half[i],
             1.0,
@@ -190,6 +190,7 @@ def _rates(traj: Trajectory, stepper: Stepper, dt: float) -> list[Curve]:
     """Joint speeds ``|q̇|`` and accelerations ``|q̈|`` (per step) as fractions of their
     limits (the step's bounds; none where unlimited or not recorded)."""
     bounds, t, curves = stepper.arrays.bounds, traj.t[:-1], []
+    joints = stepper.robot.joint_names
     rates = [("joint speed", traj.qdot, bounds.qd_max, BOUND_TOLERANCE)]
     if bounds.accelerate and traj.qddot.shape == traj.qdot.shape:
         rates.append(("joint acceleration", traj.qddot, bounds.qdd_max, BOUND_TOLERANCE / dt))
@@ -197,7 +198,7 @@ def _rates(traj: Trajectory, stepper: Stepper, dt: float) -> list[Curve]:
         curves += [
             Curve(
                 panel,
-                f"joint{i + 1}",
+                joints[i],
                 t,
                 np.abs(rate[:, i]) / limit[i],
                 1.0,

@@ -3,11 +3,11 @@
 
 Exit codes: 0 success (``compare`` and ``bench``: the comparison ran, whatever its runs'
 verdicts; ``--check``: and every QP backend's run is ``ok``, the baseline's known limit
-breaks aside); 1 a run failed (failed steps, a
-path's end not reached, a singular configuration); 2 bad input (scene, backend, file names, an
-output that cannot be written), reported as ``dvqp: <message>`` without a traceback and with
-nothing written; 130 interrupted (Ctrl-C), nothing half-written. Warnings of the numerical code
-are summed up in one line.
+breaks aside); 1 a run failed (failed steps, a path's end not reached, a singular
+configuration); 2 bad input (scene, backend, file names, an output that cannot be written),
+reported as ``dvqp: <message>`` without a traceback and with nothing written; 130 interrupted
+(Ctrl-C), 143 terminated (``SIGTERM``), nothing half-written or left behind. Warnings of the
+numerical code are summed up in one line.
 See ``docs/cli.md``.
 """
 
@@ -31,7 +31,13 @@ from dvqp.cli import retime as retime_cli
 from dvqp.cli import view as view_cli
 from dvqp.cli.compiling import announced
 from dvqp.cli.figures import FIGURE_FORMATS
-from dvqp.cli.progress import ProgressBar, check_size, interruptible, warnings_summed_up
+from dvqp.cli.progress import (
+    ProgressBar,
+    check_size,
+    interruptible,
+    terminated,
+    warnings_summed_up,
+)
 from dvqp.cli.report import (
     footer_lines,
     format_summary,
@@ -39,7 +45,7 @@ from dvqp.cli.report import (
     rows_to_csv,
     write_text,
 )
-from dvqp.cli.solver_option import solver_options
+from dvqp.cli.solver_option import backend_list, solver_options
 from dvqp.errors import DvqpError, SingularConfigurationError, one_line
 from dvqp.motion.schedule import TIMINGS
 from dvqp.resolution.registry import (
@@ -69,7 +75,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         with interruptible(), warnings_summed_up() as code:
             code.append(_run(args))
         return code[0]
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (Terminated)
+        if terminated(exc):
+            print("dvqp: terminated", file=sys.stderr)
+            return 143
         print("dvqp: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:  # stdout piped into a reader that stopped early (``| head``)
@@ -93,7 +102,7 @@ def _parser() -> argparse.ArgumentParser:
         prog="dvqp",
         description="Plan, compare and plot arm motions in a pipe's developed view.",
         epilog="exit codes: 0 success (compare, bench: they ran; --check: every run ok), 1 a run "
-        "failed, 2 bad input (nothing written), 130 interrupted",
+        "failed, 2 bad input (nothing written), 130 interrupted, 143 terminated",
     )
     parser.add_argument("--version", action="version", version=f"dvqp {__version__}")
     sub = parser.add_subparsers(title="commands", metavar="COMMAND", dest="command")
@@ -170,9 +179,9 @@ def _positive_int(text: str) -> int:
 
 
 def _plan(args: argparse.Namespace) -> int:
-    scene = load_scene(args.scene)
     formats = retime_cli.FORMATS if args.retime else (".npz", ".csv")
     output = output_path(args.output, formats) if args.output is not None else None
+    scene = load_scene(args.scene)
     rate = retime_cli.checked_rate(args.retime, args.rate)  # before any work, as the backend
     check_name(args.backend)  # unknown backend: exit 2 before any work
     scene_timing(scene, args.timing)  # nor a JOG scene asked to slow along a path
@@ -202,14 +211,13 @@ def _plan(args: argparse.Namespace) -> int:
 
 
 def _compare(args: argparse.Namespace) -> int:
-    names = [b.strip() for b in args.backends.split(",")] if args.backends else None
-    backends = [check_name(name) for name in names or default_resolvers()]
-    scenes = [load_scene(path) for path in args.scenes]  # every scene valid before any run
-    options = solver_options(args.solver_option, backends)
-    check_size(scenes, len(backends))
     json_out = output_path(args.json, (".json",)) if args.json is not None else None
     csv_out = output_path(args.csv, (".csv",)) if args.csv is not None else None
     plot_out = output_path(args.plot, FIGURE_FORMATS) if args.plot is not None else None
+    backends = [check_name(name) for name in backend_list(args.backends) or default_resolvers()]
+    scenes = [load_scene(path) for path in args.scenes]  # every scene valid before any run
+    options = solver_options(args.solver_option, backends)
+    check_size(scenes, len(backends))
     with contextlib.closing(ProgressBar(sys.stderr)) as bar:
         rows = cmp.compare(
             args.scenes,

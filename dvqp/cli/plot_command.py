@@ -15,8 +15,9 @@ from typing import Any
 import numpy as np
 
 from dvqp._files import output_path
+from dvqp._inputs import NpzArrays
 from dvqp.cli.figures import FIGURE_FORMATS
-from dvqp.errors import DvqpError, one_line
+from dvqp.errors import DvqpError, InputFileError, one_line
 from dvqp.motion.trajectory import Trajectory
 from dvqp.scenes import Scene, environment, load_scene, loads
 from dvqp.view.scene3d import Scene3D, scene_3d
@@ -55,12 +56,15 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Draw a saved trajectory (or its limits page); 0 once written."""
+    """Draw a saved trajectory (or its limits page, or its 3-D still); 0 once written. The
+    options and the output are checked before the trajectory is read."""
+    _check_options(args)
+    target = output_path(args.output, (".gif",) if args.gif else FIGURE_FORMATS)
     traj = load_trajectory(args.trajectory)
     if args.three_d:
-        return _plot_3d(args, traj)
-    if args.limits or args.scene is not None:
-        return _plot_limits(args, traj)
+        return _plot_3d(args, traj, target)
+    if args.limits:
+        return _plot_limits(args, traj, target)
     drawn_with: dict[str, Any] = {"full": args.full}
     if traj.scene_text:  # draw the stored scene's obstacles, levels and weld
         env = environment(traj.scene_text, f"{args.trajectory} (stored scene)")
@@ -73,17 +77,23 @@ def run(args: argparse.Namespace) -> int:
     from dvqp.cli import plot
 
     draw = plot.animate_trajectory if args.gif else plot.plot_trajectory
-    print(f"wrote {draw(traj, args.output, **drawn_with)}")
+    print(f"wrote {draw(traj, target, **drawn_with)}")
     return 0
 
 
-def _plot_limits(args: argparse.Namespace, traj: Trajectory) -> int:
-    """The limits page of a trajectory, from its stored scene (or ``--scene``)."""
-    if not args.limits or args.gif or args.full:
+def _check_options(args: argparse.Namespace) -> None:
+    """Refuse options that do not go together (a DvqpError)."""
+    if args.three_d:
+        if args.limits or args.gif or args.full:
+            raise DvqpError("--3d takes neither --limits, --gif nor --full")
+    elif (args.limits or args.scene is not None) and (not args.limits or args.gif or args.full):
         raise DvqpError(
             "--scene goes with --limits or --3d; --limits takes neither --gif nor --full"
         )
-    target = output_path(args.output, FIGURE_FORMATS)
+
+
+def _plot_limits(args: argparse.Namespace, traj: Trajectory, target: Path) -> int:
+    """The limits page of a trajectory, from its stored scene (or ``--scene``)."""
     scene = scene_of(args.trajectory, traj, args.scene)
     from dvqp.cli.limit_series import limit_series
     from dvqp.cli.plot_limits import plot_limits
@@ -98,11 +108,8 @@ def _plot_limits(args: argparse.Namespace, traj: Trajectory) -> int:
     return 0
 
 
-def _plot_3d(args: argparse.Namespace, traj: Trajectory) -> int:
+def _plot_3d(args: argparse.Namespace, traj: Trajectory, target: Path) -> int:
     """The still of the 3-D view of a trajectory, with its stored scene (or ``--scene``)."""
-    if args.limits or args.gif or args.full:
-        raise DvqpError("--3d takes neither --limits, --gif nor --full")
-    target = output_path(args.output, FIGURE_FORMATS)
     scene = scene_of(args.trajectory, traj, args.scene)
     view = trajectory_3d(args.trajectory, traj, scene)
     from dvqp.cli.plot3d import plot_3d
@@ -153,36 +160,43 @@ def trajectory_3d(path: str, traj: Trajectory, scene: Scene, samples: int = 2000
 
 
 def load_trajectory(path: str) -> Trajectory:
-    """A trajectory file, checked enough to be drawn; else a DvqpError
-    ``<path>: cannot read: <reason>`` or ``<path>: not a dvqp trajectory (<reason>)``."""
+    """A trajectory file, checked enough to be drawn (its arrays' declared sizes before any
+    is inflated: :meth:`~dvqp.motion.trajectory.Trajectory.load`).
+
+    Raises
+    ------
+    InputFileError
+        ``<path>: cannot read: <reason>``, ``<path>: not a dvqp trajectory (<reason>)``, or a
+        retimed motion (``dvqp plan --retime``), which is not drawn.
+    """
     try:
         with open(path, "rb") as fh:
             zipped = fh.read(4) == b"PK\x03\x04"
-    except OSError as exc:
-        raise DvqpError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+    except (OSError, ValueError) as exc:
+        raise InputFileError(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}") from exc
     if not zipped:
-        raise DvqpError(f"{path}: not a dvqp trajectory (not an .npz file)")
+        raise InputFileError(path, "not a dvqp trajectory (not an .npz file)")
     try:
         traj = Trajectory.load(path)
-    except DvqpError as exc:  # dvqp reads arrays only, never pickled objects
+    except InputFileError as exc:
         if _retimed(path):
-            raise DvqpError(
-                f"{path}: a retimed motion (dvqp plan --retime): dvqp plot draws "
-                "planned runs; save the run itself (dvqp plan SCENE -o RUN.npz) "
-                "and plot that"
+            raise InputFileError(
+                path,
+                "a retimed motion (dvqp plan --retime): dvqp plot draws planned runs; save the "
+                "run itself (dvqp plan SCENE -o RUN.npz) and plot that",
             ) from exc
-        raise DvqpError(f"{path}: not a dvqp trajectory (not written by 'dvqp plan')") from exc
+        raise
     if not _drawable(traj):
-        raise DvqpError(f"{path}: not a dvqp trajectory (arrays of unexpected shapes)")
+        raise InputFileError(path, "not a dvqp trajectory (arrays of unexpected shapes)")
     return traj
 
 
 def _retimed(path: str) -> bool:
     """The file is a retimed motion's (:meth:`dvqp.retime.Retimed.save`)."""
     try:
-        with np.load(path, allow_pickle=False) as data:
-            return {"rate", "planned_duration", "qddot"} <= set(data.files)
-    except (OSError, ValueError, EOFError):
+        with NpzArrays(path, "a retimed motion") as npz:
+            return {"rate", "planned_duration", "qddot"} <= set(npz.members)
+    except InputFileError:
         return False
 
 

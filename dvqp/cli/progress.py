@@ -1,6 +1,7 @@
 """What the command line wraps around a run: :func:`check_size` (refuse a run too big for the
-memory, announce a long one), :class:`ProgressBar`, :func:`interruptible` (Ctrl-C a clean
-stop) and :func:`warnings_summed_up` (the numerical code's warnings in one line).
+memory, announce a long one), :class:`ProgressBar`, :func:`interruptible` (Ctrl-C and
+``SIGTERM`` a clean stop) and :func:`warnings_summed_up` (the numerical code's warnings in one
+line).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, TextIO
 
+from dvqp._inputs import MEMORY_SHARE, physical_memory
 from dvqp.errors import SceneError, one_line
 from dvqp.motion.jog import jog_step_count
 
@@ -29,19 +31,18 @@ STEP_SECONDS = 1e-4
 25 µs, the slower backends and steps taken by the reference path a few times more."""
 LONG_RUN_SECONDS = 120.0
 """Runs estimated to take longer than this are announced before they start, s."""
-MEMORY_SHARE = 0.8
-"""Runs whose arrays would need more than this share of the machine's memory are refused."""
 
 
 @dataclass(frozen=True)
 class RunEstimate:
     """How big one planned run will be, from its scene alone: ``steps`` (a path's approach to
-    its first waypoint not counted), ``seconds`` at :data:`STEP_SECONDS` a step, and
-    ``nbytes`` of its trajectory's arrays."""
+    its first waypoint not counted), ``seconds`` at :data:`STEP_SECONDS` a step, ``nbytes``
+    of its trajectory's arrays, and the ``motion`` it plans, s (``steps × dt``)."""
 
     steps: int
     seconds: float
     nbytes: int
+    motion: float = 0.0
 
     @classmethod
     def of(cls, scene: Scene) -> RunEstimate:
@@ -50,13 +51,21 @@ class RunEstimate:
             steps = jog_step_count(scene.jog, scene.dt)
         else:
             steps = int(scene.path.step_count(scene.dt)) + 1
-        return cls(steps, steps * STEP_SECONDS, steps * bytes_per_step(scene.robot))
+        nbytes = steps * bytes_per_step(scene.robot)
+        return cls(steps, steps * STEP_SECONDS, nbytes, steps * scene.dt)
 
     def describe(self, runs: int = 1) -> str:
-        """``about 8e+06 steps: roughly 1.3 h and 4.4 GB`` (for ``runs`` runs)."""
+        """``about 5e+06 steps (14 h of motion in steps of 0.01 s): roughly 8.3 min and
+        5.8 GB`` (for ``runs`` runs): what makes a run long is said, so that a slip (a path
+        at 1e-6 m/s) is seen before it runs."""
         runs_text = f" in {runs} runs" if runs > 1 else ""
+        motion = ""
+        if self.motion > 0.0:
+            motion = (
+                f" ({duration(self.motion)} of motion in steps of {self.motion / self.steps:.3g} s)"
+            )
         return (
-            f"about {self.steps:.3g} steps{runs_text}: roughly "
+            f"about {self.steps:.3g} steps{motion}{runs_text}: roughly "
             f"{duration(self.seconds * runs)} and {self.nbytes / 1e9:.2g} GB"
         )
 
@@ -74,13 +83,25 @@ def bytes_per_step(robot: Robot) -> int:
     return 8 * (5 * n + 9 * k + 35)
 
 
+class Terminated(KeyboardInterrupt):
+    """``SIGTERM`` (what ``timeout``, ``docker stop`` and systemd send), raised where Ctrl-C
+    would be, so that it takes the same way out: files being written are removed, finished
+    ones stay (exit code 143, ``dvqp: terminated``)."""
+
+
+STOPS = {signal.SIGINT: KeyboardInterrupt, signal.SIGTERM: Terminated}
+"""The signals :func:`interruptible` turns into an exception, and the exception."""
+
+
 @contextlib.contextmanager
 def interruptible() -> Iterator[None]:
-    """Ctrl-C raises KeyboardInterrupt here, and ends forked worker processes quietly.
+    """Ctrl-C (``SIGINT``) raises KeyboardInterrupt here, ``SIGTERM`` :class:`Terminated` (a
+    KeyboardInterrupt too): every ``finally`` and ``except BaseException`` runs, so nothing
+    half-written is left behind. Forked worker processes end quietly.
 
-    Forked workers (``compare --jobs``) inherit the handler and exit at once (code 130); an
-    interrupt sent to this process alone (``kill -INT``) is passed on to them. Outside the
-    main thread (where signals are delivered) nothing changes.
+    Forked workers (``compare --jobs``) inherit the handler and exit at once (code 130); a
+    signal sent to this process alone (``kill -INT``, ``kill -TERM``) is passed on to them.
+    Outside the main thread (where signals are delivered) nothing changes.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
@@ -92,14 +113,26 @@ def interruptible() -> Iterator[None]:
             os._exit(130)
         for child in multiprocessing.active_children():
             with contextlib.suppress(OSError, TypeError):
-                os.kill(child.pid, signal.SIGINT)  # type: ignore[arg-type]
-        raise KeyboardInterrupt
+                os.kill(child.pid, signum)  # type: ignore[arg-type]
+        raise STOPS[signal.Signals(signum)]
 
-    previous = signal.signal(signal.SIGINT, handler)
+    previous = {signum: signal.signal(signum, handler) for signum in STOPS}
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for signum, before in previous.items():
+            signal.signal(signum, before)
+
+
+def terminated(exc: BaseException) -> bool:
+    """``exc`` is, or was raised because of, :class:`Terminated` (``SIGTERM``)."""
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, Terminated):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__  # type: ignore[assignment]
+    return False
 
 
 @contextlib.contextmanager
@@ -145,14 +178,6 @@ def check_size(scenes: Sequence[Scene], runs: int) -> None:
         if estimate.seconds * runs > LONG_RUN_SECONDS:
             note = f"{one_line(scene.source)}: {estimate.describe(runs)}"
             print(f"dvqp: note: {note}", file=sys.stderr)
-
-
-def physical_memory() -> int | None:
-    """The machine's memory, bytes (None where the system does not say)."""
-    try:
-        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (AttributeError, ValueError, OSError):
-        return None
 
 
 def duration(seconds: float) -> str:

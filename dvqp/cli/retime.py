@@ -37,14 +37,23 @@ def checked_rate(retime: bool, rate: float | None) -> float | None:
 
 def retimed(scene: Scene, traj: Trajectory, rate: float, output: Path | None) -> int:
     """Retime a run that is safe to send, print ``retimed  2.31 s (planned 4.00 s), 1156
-    samples at 500 Hz, limits kept`` (and ``saved  FILE``), save it to ``output``; the exit
-    code: 1 if a retimed sample breaks a limit (the file is still written, to look at)."""
+    samples at 500 Hz, limits kept`` (and ``saved  FILE``), save it to ``output``; a warning
+    line on stderr if the samples miss most of the path (:attr:`Retimed.drops_path`: too low
+    a rate). The exit code: 1 if a retimed sample breaks a limit (the file is still written,
+    to look at)."""
     motion = traj.retimed(scene, rate)
     if output is not None:
         motion.save(output)
     print(f"retimed         {motion.summary()}")
     if output is not None:
         print(f"saved           {output}")
+    if motion.drops_path:
+        print(
+            f"dvqp: warning: {one_line(scene.source)}: retimed at {rate:g} Hz, its "
+            f"{motion.t.shape[0]} samples trace {motion.path_share:.0%} of the planned path "
+            "(a controller going straight from one to the next leaves it): use a higher --rate",
+            file=sys.stderr,
+        )
     if not motion.kept:
         print(f"dvqp: {one_line(scene.source)}: retimed: {motion.summary()}", file=sys.stderr)
         return 1

@@ -1,5 +1,5 @@
-"""``--solver-option NAME.KEY=VALUE`` and ``--settings TIER``: QP backends' settings from the
-command line."""
+"""``--backends LIST``, ``--solver-option NAME.KEY=VALUE`` and ``--settings TIER``: which
+backends run and their settings, from the command line."""
 
 from __future__ import annotations
 
@@ -36,10 +36,33 @@ def add_argument(parser: argparse.ArgumentParser) -> None:
         "--settings",
         choices=TIERS,
         default=TIERS[0],
-        help="accuracy tier of every QP backend, as qpbenchmark's: its solver "
-        "settings and the tolerance answers are checked to (default: default; "
-        "see docs/cli.md)",
+        help="accuracy tier of every QP backend: its solver settings and the tolerance "
+        "answers are checked to. default: dvqp's own (tighter than the solvers' "
+        "defaults); high_accuracy, mid_accuracy, low_accuracy: qpbenchmark's tiers, "
+        "exactly; solver_defaults: qpbenchmark's default tier, each solver's own "
+        "defaults (see docs/cli.md)",
     )
+
+
+def backend_list(text: str | None) -> list[str] | None:
+    """The names ``--backends`` lists (None when it is not given: the default backends).
+
+    Raises
+    ------
+    ParameterError
+        ``--backends: empty list: name at least one backend (dvqp backends lists them)``, or
+        ``--backends: 'pinv,,daqp': an empty name``.
+    """
+    if text is None:
+        return None
+    names = [name.strip() for name in text.split(",")]
+    if not any(names):
+        raise ParameterError(
+            "--backends", "empty list: name at least one backend (dvqp backends lists them)"
+        )
+    if not all(names):
+        raise ParameterError("--backends", f"{text!r}: an empty name")
+    return names
 
 
 def solver_options(values: Sequence[str], backends: Sequence[str]) -> dict[str, dict[str, Any]]:

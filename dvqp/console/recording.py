@@ -17,7 +17,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp.geometry.proximity import link_label, point_label
 from dvqp.motion.recorder import PER_SAMPLE, TrajectoryRecorder
 from dvqp.motion.simulate import dv_error
 from dvqp.motion.trajectory import Trajectory
@@ -55,13 +54,13 @@ class Sample:
     @classmethod
     def of(cls, stepper: Stepper) -> Sample:
         """The state ``stepper`` has loaded (copied)."""
-        a, k = stepper.arrays, stepper.robot.n_points
+        a, k, names = stepper.arrays, stepper.robot.n_points, stepper.robot.part_names
         tilt, apart, clearance, probe, closest, low, holder = (float(v) for v in a.diagnostics)
         where = None
         if closest >= 0:
             m = a.near.point_distance.shape[1]
             obstacle, part = divmod(int(closest), m + a.near.ends.shape[0])
-            name = point_label(part, k) if part < m else link_label(part - m, k)
+            name = names.point(part) if part < m else names.link(part - m)
             where = f"{name}/{stepper.obstacles.labels[obstacle]}"
         excess = stepper.excess_now
         return cls(

@@ -21,7 +21,7 @@ from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.real_links import real_links
 from dvqp.geometry.shapes import Shape
 from dvqp.kinematics.state import KinematicState
-from dvqp.workspace import ProximityBuffers, as_struct, link_ends
+from dvqp.workspace import PartNames, ProximityBuffers, as_struct, link_ends
 
 Array = NDArray[np.float64]
 
@@ -56,8 +56,8 @@ class Proximity:
     """Signed distances of the m guarded points and L guarded links to J obstacles.
 
     Index i < k is body point i+1, i = k the probe, i = k+1 the rail point; link i < k−1 is
-    body link i+1, link k−1 the probe holder, link k the carriage link (see
-    :func:`point_label`, :func:`link_label`).
+    body link i+1, link k−1 the probe holder, link k the carriage link (their names:
+    ``names``).
 
     Attributes
     ----------
@@ -69,18 +69,23 @@ class Proximity:
     real : ShapeDistances
         Of the links' real DV images (``dvqp.geometry.real_links``): distance, normal, link
         parameter ``t`` (no penalty: zeros). The limits keep these, and reports show them.
-    k : int
-        Number of body points.
+    names : PartNames
+        The guarded parts' names.
     """
 
     points: ShapeDistances
     links: ShapeDistances
     real: ShapeDistances
-    k: int
+    names: PartNames
+
+    @property
+    def k(self) -> int:
+        """Number of body points."""
+        return self.names.k
 
     @classmethod
-    def of(cls, near: ProximityBuffers, k: int) -> Proximity:
-        """Views of proximity buffers of k body points."""
+    def of(cls, near: ProximityBuffers, names: PartNames) -> Proximity:
+        """Views of proximity buffers of the guarded parts ``names``."""
         points = ShapeDistances(
             near.point_distance,
             near.point_normal,
@@ -103,7 +108,7 @@ class Proximity:
             np.zeros_like(near.real_normal),
             near.real_at,
         )
-        return cls(points, links, real, int(k))
+        return cls(points, links, real, names)
 
     @property
     def point_clearance(self) -> Array:
@@ -139,24 +144,12 @@ class Proximity:
 
         Raises ValueError with no obstacle.
         """
-        points, links, k = self.point_clearance, self.link_clearance, self.k
+        points, links, names = self.point_clearance, self.link_clearance, self.names
         j, i = np.unravel_index(int(np.argmin(points)), points.shape)
         lj, li = np.unravel_index(int(np.argmin(links)), links.shape)
         if links[lj, li] < points[j, i]:
-            return float(links[lj, li]), link_label(int(li), k), int(lj)
-        return float(points[j, i]), point_label(int(i), k), int(j)
-
-
-def point_label(i: int, k: int) -> str:
-    """Name of guarded point i (0-based) of a body with k points: ``"point3"``, ``"probe"``
-    (i = k) or ``"rail"`` (i = k + 1)."""
-    return f"point{i + 1}" if i < k else ("probe", "rail")[i - k]
-
-
-def link_label(i: int, k: int) -> str:
-    """Name of guarded link i (0-based) of a body with k points: ``"link2"``, ``"holder"``
-    (i = k − 1) or ``"carriage"`` (i = k)."""
-    return f"link{i + 1}" if i < k - 1 else ("holder", "carriage")[i - k + 1]
+            return float(links[lj, li]), names.link(int(li)), int(lj)
+        return float(points[j, i]), names.point(int(i)), int(j)
 
 
 def measure(
@@ -197,7 +190,7 @@ def measure_state(
 
 def proximity(state: KinematicState, obstacles: ObstacleSet | Sequence[Shape]) -> Proximity:
     """The :class:`Proximity` of ``state``'s guarded parts to ``obstacles``."""
-    return Proximity.of(measure_state(state, obstacles), state.k)
+    return Proximity.of(measure_state(state, obstacles), state.part_names)
 
 
 def min_clearance(state: KinematicState, obstacles: ObstacleSet | Sequence[Shape]) -> float:

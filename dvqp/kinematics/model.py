@@ -2,9 +2,11 @@
 
 :class:`ModelArrays` reads a Pinocchio model once (joint placements, axes, parents, the
 guarded frames' placements); :func:`kinematics` evaluates it in one compiled call:
-``oMi = oMi[parent] · jointPlacement · M_j(q_j)`` for revolute and prismatic joints, the frames
-``oMf = oMi[parentJoint] · placement``, their LOCAL_WORLD_ALIGNED Jacobians (``ω × (p − o_j)``
-per supporting revolute joint) and the developed-view map of
+``oMi = oMi[parent] · jointPlacement · M_j(s_j q_i + o_j)`` for revolute and prismatic joints
+(``q_i`` the joint's own coordinate, ``s_j = 1``, ``o_j = 0``; a mimic joint follows its
+master's coordinate ``q_i`` with Pinocchio's ``scaling`` and ``offset``), the frames
+``oMf = oMi[parentJoint] · placement``, their LOCAL_WORLD_ALIGNED Jacobians (``s_j ω × (p − o_j)``
+per supporting revolute joint, added into column ``i``) and the developed-view map of
 :mod:`dvqp.kinematics.developed_view`, written in place into
 :class:`~dvqp.workspace.StateBuffers`. This is dvqp's only implementation of its kinematics;
 the tests hold it to Pinocchio's own to 1e-12.
@@ -43,7 +45,10 @@ class ModelArrays:
     Attributes
     ----------
     parents, kinds, index : (J,) int64
-        Parent joint; 0 revolute, 1 prismatic; ``idx_q``.
+        Parent joint; 0 revolute, 1 prismatic; ``idx_q`` (a mimic joint's: its master's).
+    scale, offset : (J,)
+        The joint's coordinate is ``scale · q[index] + offset`` (1 and 0 but for a mimic
+        joint: Pinocchio's ``scaling`` and ``offset``).
     placements : (J, 4, 4)
         ``jointPlacements``.
     axes : (J, 3)
@@ -63,6 +68,8 @@ class ModelArrays:
     parents: NDArray[np.int64]
     kinds: NDArray[np.int64]
     index: NDArray[np.int64]
+    scale: Array
+    offset: Array
     placements: Array
     axes: Array
     frame_joint: NDArray[np.int64]
@@ -84,8 +91,9 @@ class ModelArrays:
         """
         count = model.njoints
         kinds, axes = np.zeros(count, np.int64), np.zeros((count, 3))
+        scale, offset = np.ones(count), np.zeros(count)
         for j in range(1, count):
-            kinds[j], axes[j] = _motion_of(model.joints[j], model.names[j])
+            kinds[j], axes[j], scale[j], offset[j] = _motion_of(model.joints[j], model.names[j])
         frames = [model.frames[i] for i in frame_ids]
         support = np.zeros((len(frames), count), dtype=np.bool_)
         for f, frame in enumerate(frames):
@@ -97,6 +105,8 @@ class ModelArrays:
             parents=np.array(model.parents, dtype=np.int64),
             kinds=kinds,
             index=np.array([max(model.joints[j].idx_q, 0) for j in range(count)], np.int64),
+            scale=scale,
+            offset=offset,
             placements=np.array([p.homogeneous for p in model.jointPlacements]),
             axes=axes,
             frame_joint=np.array([f.parentJoint for f in frames], dtype=np.int64),
@@ -108,21 +118,45 @@ class ModelArrays:
         )
 
 
-def _motion_of(joint: pin.JointModel, name: str) -> tuple[int, Array]:
-    """``(kind, unit axis)`` of a revolute or prismatic joint; ParameterError otherwise."""
+def _motion_of(joint: pin.JointModel, name: str) -> tuple[int, Array, float, float]:
+    """``(kind, unit axis, scale, offset)`` of a revolute or prismatic joint, or of a mimic
+    joint of one (its motion subspace is ``scaling`` times its own joint's: axis and kind read
+    there); ParameterError otherwise."""
     short = joint.shortname()
     if short in _ALIGNED:
         code, axis = _ALIGNED[short]
-        return code, np.array(axis)
+        return code, np.array(axis), 1.0, 0.0
     if short in _UNALIGNED:
         axis = np.array(joint.extract().axis, dtype=np.float64)
-        return _UNALIGNED[short], axis / np.linalg.norm(axis)
+        return _UNALIGNED[short], axis / np.linalg.norm(axis), 1.0, 0.0
+    if short == "JointModelMimic":
+        return _mimic(joint, name)
     kind = short.removeprefix("JointModel")
     raise ParameterError(
         "model",
         f"joint {name!r} is a {kind} joint: only revolute and "
         "prismatic joints about a fixed axis are supported",
     )
+
+
+def _mimic(joint: pin.JointModel, name: str) -> tuple[int, Array, float, float]:
+    """``(kind, unit axis, scaling, offset)`` of a mimic joint of a revolute or prismatic one
+    (``S = scaling · [v; ω]`` of its own joint's axis); ParameterError otherwise."""
+    mimic = joint.extract()
+    scaling, offset = float(mimic.scaling), float(mimic.offset)
+    data = joint.createData()
+    joint.calc(data, np.zeros(joint.idx_q + 1))
+    motion = np.asarray(data.S, dtype=np.float64).reshape(6)
+    linear, angular = motion[:3], motion[3:]
+    if scaling == 0.0 or not math.isfinite(scaling) or not math.isfinite(offset):
+        raise ParameterError("model", f"mimic joint {name!r}: its multiplier must be finite, not 0")
+    kind = REVOLUTE if np.any(angular) else PRISMATIC
+    axis = (angular if kind == REVOLUTE else linear) / scaling
+    if np.any(linear) == np.any(angular) or not math.isclose(np.linalg.norm(axis), 1.0):
+        raise ParameterError(
+            "model", f"mimic joint {name!r}: only a revolute or prismatic joint can mimic"
+        )
+    return kind, axis / np.linalg.norm(axis), scaling, offset
 
 
 @njit(inline="always")
@@ -163,7 +197,8 @@ def _joints(model, q) -> None:  # type: ignore[no-untyped-def]
         for c in range(4):
             work[0, r, c] = 1.0 if r == c else 0.0
     for j in range(1, count):
-        _motion(model.kinds[j], model.axes[j], q[model.index[j]], motion)
+        value = model.scale[j] * q[model.index[j]] + model.offset[j]
+        _motion(model.kinds[j], model.axes[j], value, motion)
         _compose(work[model.parents[j]], model.placements[j], placed)
         _compose(placed, motion, work[j])
         u = model.axes[j]
@@ -173,22 +208,30 @@ def _joints(model, q) -> None:  # type: ignore[no-untyped-def]
 
 @njit(inline="always")
 def _frame_jacobian(model, f, origin, jac) -> None:  # type: ignore[no-untyped-def]
-    """``[J_v; J_ω]`` (6, n) of the point ``origin`` moved by the joints supporting frame f."""
+    """``[J_v; J_ω]`` (6, n) of the point ``origin`` moved by the joints supporting frame f
+    (a mimic joint's motion, ``scale`` times its own, added into its master's column)."""
     for r in range(6):
         for c in range(jac.shape[1]):
             jac[r, c] = 0.0
     for j in range(1, model.kinds.shape[0]):
         if not model.support[f, j]:
             continue
-        w0, w1, w2 = model.world[j, 0], model.world[j, 1], model.world[j, 2]
+        s = model.scale[j]
+        w0, w1, w2 = s * model.world[j, 0], s * model.world[j, 1], s * model.world[j, 2]
         c = model.index[j]
         if model.kinds[j] == PRISMATIC:
-            jac[0, c], jac[1, c], jac[2, c] = w0, w1, w2
+            jac[0, c] += w0
+            jac[1, c] += w1
+            jac[2, c] += w2
             continue
         o = model.work[j]
         d0, d1, d2 = origin[0] - o[0, 3], origin[1] - o[1, 3], origin[2] - o[2, 3]
-        jac[0, c], jac[1, c], jac[2, c] = w1 * d2 - w2 * d1, w2 * d0 - w0 * d2, w0 * d1 - w1 * d0
-        jac[3, c], jac[4, c], jac[5, c] = w0, w1, w2
+        jac[0, c] += w1 * d2 - w2 * d1
+        jac[1, c] += w2 * d0 - w0 * d2
+        jac[2, c] += w0 * d1 - w1 * d0
+        jac[3, c] += w0
+        jac[4, c] += w1
+        jac[5, c] += w2
 
 
 @njit(separate=True)

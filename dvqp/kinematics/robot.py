@@ -3,7 +3,9 @@
 A :class:`Robot` is built from a DH table (:meth:`Robot.from_dh`), from the paper's 13-DOF
 arm (:meth:`Robot.ndt13`) or from a URDF file (:meth:`Robot.from_urdf`). The method is not
 limited to 13 DOF: any serial chain with ``n`` revolute (or prismatic) joints, ``k`` point
-frames and a tool frame works. The base frame's z axis is the pipe axis.
+frames and a tool frame works; a mimic joint follows its master (it adds no coordinate). The
+pipe's frame is the model's world frame (its z axis the pipe axis); :meth:`Robot.placed` puts
+the arm's base anywhere in it.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from dvqp.errors import ParameterError
 from dvqp.kinematics.dh import DHRow, check_transform, fixed_part, ndt13_table
 from dvqp.kinematics.model import ModelArrays
 from dvqp.kinematics.urdf import urdf_model
+from dvqp.workspace import PartNames
 
 NDT13_POINT_JOINTS = (4, 6, 8, 10, 13)
 """Joints (1-based) whose output frames are the paper's five body points."""
@@ -52,6 +55,9 @@ class Robot:
         Joint velocity limits, rad/s, scalar or shape (n,), > 0.
     name
         A label for reports.
+    names
+        The guarded parts' names in labels and reports (default: dvqp's numbering,
+        ``point1``, ``probe``, ``link1``, ``holder``, …; :meth:`from_urdf`: the frames').
     """
 
     def __init__(
@@ -65,6 +71,7 @@ class Robot:
         q_max: ArrayLike | None = None,
         qd_max: ArrayLike = DEFAULT_QD_MAX,
         name: str = "robot",
+        names: PartNames | None = None,
     ) -> None:
         if model.nq != model.nv:
             raise ParameterError("model", "only joints with nq == nv (revolute, prismatic)")
@@ -73,6 +80,11 @@ class Robot:
             raise ParameterError("points", "need at least two body-point frames")
         self.point_frames, self.tool_frame = tuple(point_frames), tool_frame
         self.rail_frame = rail_frame
+        rail = rail_frame is not None
+        self.part_names = PartNames.numbered(len(point_frames), rail) if names is None else names
+        """The guarded parts' names in labels and reports (:class:`~dvqp.workspace.PartNames`)."""
+        if (self.part_names.k, self.part_names.rail) != (len(point_frames), rail):
+            raise ParameterError("names", "not the names of this arm's body points and rail")
         for fname in self.frame_names:
             if not model.existFrame(fname):
                 known = ", ".join(f.name for f in model.frames)
@@ -102,6 +114,51 @@ class Robot:
         """Names of the guarded frames: the body points, the tool, the rail point (if any)."""
         rail = () if self.rail_frame is None else (self.rail_frame,)
         return (*self.point_frames, self.tool_frame, *rail)
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The names of the n joints that have a coordinate, in the order of ``q`` (a mimic
+        joint has none: it follows its master)."""
+        model = self.model
+        joints = [
+            (model.joints[j].idx_q, model.names[j])
+            for j in range(1, model.njoints)
+            if model.joints[j].nq > 0
+        ]
+        return tuple(name for _, name in sorted(joints))
+
+    def placed(self, base: ArrayLike) -> Robot:
+        """The same arm with its base frame at ``base`` (4, 4) in the pipe's frame: every joint
+        and frame attached to the model's world frame moved by it (the URDF's root link and
+        the first joints), nothing else changed (placing a placed arm moves it again:
+        ``placed(a).placed(b)`` is ``placed(b @ a)``).
+
+        Raises
+        ------
+        ParameterError
+            ``base`` is not a rigid transform.
+        """
+        placement = pin.SE3(check_transform("base", base))
+        model = pin.Model(self.model)
+        for j in range(1, model.njoints):
+            if model.parents[j] == 0:
+                model.jointPlacements[j] = placement * model.jointPlacements[j]
+        for f in range(len(model.frames)):
+            frame = model.frames[f]
+            if frame.parentJoint == 0 and frame.name != "universe":
+                frame.placement = placement * frame.placement
+                model.frames[f] = frame
+        return Robot(
+            model,
+            self.point_frames,
+            self.tool_frame,
+            rail_frame=self.rail_frame,
+            q_min=self.q_min,
+            q_max=self.q_max,
+            qd_max=self.qd_max,
+            name=self.name,
+            names=self.part_names,
+        )
 
     @property
     def has_rail(self) -> bool:
@@ -246,20 +303,31 @@ class Robot:
         tool: str,
         *,
         rail: str | None = None,
+        base: ArrayLike | None = None,
         q_min: ArrayLike | None = None,
         q_max: ArrayLike | None = None,
         qd_max: ArrayLike | None = None,
     ) -> Robot:
         """Load a serial arm from a URDF file; ``points``, ``tool`` and ``rail`` (optional: the
-        rail point, see :class:`Robot`) are frame (link) names.
+        rail point, see :class:`Robot`) are frame (link) names, and name the guarded parts in
+        reports (:meth:`~dvqp.workspace.PartNames.of_frames`).
 
-        The URDF's base frame is the pipe's frame: its z axis is the pipe axis. ``continuous``
-        joints become revolute joints without position limits (``±inf``); ``revolute`` and
-        ``prismatic`` joints keep their limits. Velocity limits default to the URDF's, or
+        The URDF's base frame is the pipe's frame (its z axis the pipe axis) unless ``base``
+        places it (:meth:`placed`). ``continuous`` joints become revolute joints without
+        position limits (``±inf``); ``revolute`` and ``prismatic`` joints keep their limits. A
+        joint with a ``<mimic>`` follows its master, ``multiplier · q + offset``, with no
+        coordinate of its own (Pinocchio's mimic joints): its master's limits are narrowed to
+        keep it within its own. Velocity limits default to the URDF's, or
         :data:`DEFAULT_QD_MAX` where it gives none. The file is checked before Pinocchio's
         parser sees it (:func:`~dvqp.kinematics.urdf_check.read_urdf`: size, one tree of
         links, joint types and counts, names, numbers); what the C++ parser prints is kept off
         the terminal, its first complaint is part of the error.
+
+        Parameters
+        ----------
+        base
+            The URDF's base frame in the pipe's frame, (4, 4) (translation in m); None: the
+            same frame.
 
         Raises
         ------
@@ -267,13 +335,13 @@ class Robot:
             ``<path>: <reason>``: a file the checks refuse, or ``<path>: cannot load URDF:
             <reason>`` one the parser refuses.
         ParameterError
-            ``frames``: no such frame.
+            ``frames``: no such frame; ``base``: not a rigid transform.
         """
         model = urdf_model(path)
         if qd_max is None:
             vel = np.asarray(model.velocityLimit, dtype=float)
             qd_max = np.where(np.isfinite(vel) & (vel > 0), vel, DEFAULT_QD_MAX)
-        return cls(
+        robot = cls(
             model,
             points,
             tool,
@@ -282,4 +350,6 @@ class Robot:
             q_max=q_max,
             qd_max=qd_max,
             name=model.name,
+            names=PartNames.of_frames(points, tool, rail),
         )
+        return robot if base is None else robot.placed(base)

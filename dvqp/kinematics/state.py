@@ -19,7 +19,7 @@ from dvqp import _validate
 from dvqp.errors import SingularConfigurationError
 from dvqp.kinematics.model import kinematics
 from dvqp.kinematics.robot import Robot
-from dvqp.workspace import StateBuffers, as_struct
+from dvqp.workspace import PartNames, StateBuffers, as_struct
 
 
 @dataclass(frozen=True)
@@ -27,7 +27,8 @@ class KinematicState(StateBuffers):
     """Kinematics of one configuration in Cartesian and developed-view coordinates: the fields
     of :class:`~dvqp.workspace.StateBuffers` (``q``, ``origins``, ``axes``,
     ``frame_jacobians``, ``guarded``, ``guarded_jacobians``, ``tool``, ``tool_jacobian``) and
-    the pipe's ``radius`` (m) and the number ``k`` of body points.
+    the pipe's ``radius`` (m), the number ``k`` of body points and the guarded parts' ``names``
+    (None: dvqp's numbering; see :attr:`part_names`).
 
     The guarded points are the k body points, the probe (the tool point, index k) and, if the
     arm has one, the rail point (index k + 1); the guarded links are the k−1 body links, the
@@ -38,6 +39,12 @@ class KinematicState(StateBuffers):
 
     radius: float = 0.0
     k: int = 0
+    names: PartNames | None = None
+
+    @property
+    def part_names(self) -> PartNames:
+        """The guarded parts' names in labels: the robot's, or dvqp's numbering."""
+        return PartNames.numbered(self.k, self.rail) if self.names is None else self.names
 
     @property
     def points(self) -> NDArray[np.float64]:
@@ -60,14 +67,21 @@ class KinematicState(StateBuffers):
         return int(self.guarded.shape[0]) > self.k + 1
 
     @classmethod
-    def view(cls, buffers: StateBuffers, radius: float, k: int | None = None) -> KinematicState:
+    def view(
+        cls,
+        buffers: StateBuffers,
+        radius: float,
+        k: int | None = None,
+        names: PartNames | None = None,
+    ) -> KinematicState:
         """Read-only views of ``buffers`` (k body points; default: every guarded point but the
-        last, the tool): they show whatever state the buffers hold now."""
+        last, the tool; ``names`` their names): they show whatever state the buffers hold
+        now."""
         views = {f.name: getattr(buffers, f.name).view() for f in dataclasses.fields(StateBuffers)}
         for view in views.values():
             view.flags.writeable = False
         points = int(buffers.guarded.shape[0]) - 1 if k is None else int(k)
-        return cls(radius=float(radius), k=points, **views)
+        return cls(radius=float(radius), k=points, names=names, **views)
 
     @classmethod
     def compute(cls, robot: Robot, q: ArrayLike, radius: float) -> KinematicState:
@@ -86,7 +100,7 @@ class KinematicState(StateBuffers):
         singular = kinematics(as_struct(robot.model_arrays()), r, as_struct(buffers))
         if singular != -1:
             raise singular_frame(robot, int(singular), buffers.origins[singular], buffers.q.copy())
-        return cls.view(buffers, r, robot.n_points)
+        return cls.view(buffers, r, robot.n_points, robot.part_names)
 
 
 def singular_frame(

@@ -1,4 +1,5 @@
-"""A serial arm from a URDF file, with ``continuous`` joints as revolute ones without limits."""
+"""A serial arm from a URDF file, with ``continuous`` joints as revolute ones without limits and
+``<mimic>`` joints as Pinocchio's mimic joints (no coordinate of their own)."""
 
 from __future__ import annotations
 
@@ -7,24 +8,27 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from dvqp._files import c_output_captured
 from dvqp.errors import RobotFileError
-from dvqp.kinematics.urdf_check import read_urdf
+from dvqp.kinematics.urdf_check import Mimic, read_urdf
+from solvers.c_output import c_output_captured
 
 
 def urdf_model(path: str | Path) -> pin.Model:
     """The Pinocchio model of the URDF file ``path``, checked first (:func:`read_urdf`), each
-    continuous joint (nq = 2) a revolute one (nq = 1) without limits (errors: see
-    :meth:`dvqp.Robot.from_urdf`)."""
+    continuous joint (nq = 2) a revolute one (nq = 1) without limits, each mimic joint
+    Pinocchio's (its master's limits narrowed to keep it within its own: :func:`_narrowed`)
+    (errors: see :meth:`dvqp.Robot.from_urdf`)."""
     checked = read_urdf(path)
     noise: list[str] = []
     try:
         with c_output_captured(noise):
-            model = pin.buildModelFromXML(checked.text)
+            model = pin.buildModelFromXML(checked.text, mimic=bool(checked.mimics))
     except (RuntimeError, ValueError) as exc:
         detail = f" ({noise[0]})" if noise else ""
         raise RobotFileError(str(path), f"cannot load URDF: {exc}{detail}") from exc
     model = _bounded_revolute(model)
+    for mimic in checked.mimics:
+        _narrowed(model, mimic, str(path))
     if model.nq != checked.actuated:  # the checks and the parser must agree on the joints
         raise RobotFileError(
             str(path),
@@ -32,6 +36,30 @@ def urdf_model(path: str | Path) -> pin.Model:
             f"the file has {checked.actuated} joints that move",
         )
     return model
+
+
+def _narrowed(model: pin.Model, mimic: Mimic, path: str) -> None:
+    """Narrow the position and velocity limits of ``mimic``'s master in ``model`` so that the
+    mimic joint, ``a q + b``, keeps within its own: ``q`` in ``[(lower − b)/a, (upper − b)/a]``
+    (ordered by the sign of ``a``), ``|q̇| ≤ velocity/|a|``."""
+    i = model.joints[model.getJointId(mimic.master)].idx_q
+    a, b = mimic.multiplier, mimic.offset
+    ends = sorted(((mimic.lower - b) / a, (mimic.upper - b) / a))
+    lo = max(float(model.lowerPositionLimit[i]), ends[0])
+    hi = min(float(model.upperPositionLimit[i]), ends[1])
+    if lo > hi:
+        raise RobotFileError(
+            path,
+            f"joint {mimic.joint!r} mimics {mimic.master!r}: no position of "
+            f"{mimic.master!r} keeps both within their limits",
+        )
+    lower, upper = np.array(model.lowerPositionLimit), np.array(model.upperPositionLimit)
+    lower[i], upper[i] = lo, hi
+    model.lowerPositionLimit, model.upperPositionLimit = lower, upper
+    if mimic.velocity > 0.0:
+        speed, velocity = mimic.velocity / abs(a), np.array(model.velocityLimit)
+        velocity[i] = speed if not velocity[i] > 0.0 else min(velocity[i], speed)
+        model.velocityLimit = velocity
 
 
 UNBOUNDED_REVOLUTE = {

@@ -20,7 +20,8 @@ from xml.etree.ElementTree import Element, ParseError
 from defusedxml import DefusedXmlException
 from defusedxml.ElementTree import iterparse
 
-from dvqp.errors import RobotFileError
+from dvqp._inputs import read_bounded
+from dvqp.errors import InputFileError, RobotFileError
 
 MAX_BYTES = 1 << 20
 """Largest URDF file read, bytes (1 MiB; the bundled 13-joint arm takes 6 kB)."""
@@ -40,6 +41,7 @@ NUMBERS = {
     "origin": {"xyz": 3, "rpy": 3},
     "axis": {"xyz": 3},
     "limit": {"lower": 1, "upper": 1, "effort": 1, "velocity": 1},
+    "mimic": {"multiplier": 1, "offset": 1},
     "mass": {"value": 1},
     "inertia": {k: 1 for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")},
 }
@@ -55,13 +57,29 @@ class _Refused(Exception):
 
 
 @dataclass(frozen=True)
+class Mimic:
+    """A joint that follows another: its coordinate is ``multiplier · q + offset``, ``q`` the
+    coordinate of ``master``; its own limits (``lower``, ``upper`` and ``velocity``)."""
+
+    joint: str
+    master: str
+    multiplier: float
+    offset: float
+    lower: float
+    upper: float
+    velocity: float
+
+
+@dataclass(frozen=True)
 class UrdfText:
     """A URDF file that passed the checks: its ``path``, its ``text`` (to hand to the parser,
-    not read again) and its number of ``actuated`` joints (the model's nq)."""
+    not read again), its number of ``actuated`` joints (the model's nq: the revolute,
+    continuous and prismatic joints that mimic none) and its ``mimics``."""
 
     path: str
     text: str
     actuated: int
+    mimics: tuple[Mimic, ...] = ()
 
 
 def read_urdf(path: str | Path) -> UrdfText:
@@ -79,7 +97,7 @@ def read_urdf(path: str | Path) -> UrdfText:
             text = data.decode("utf-8")
         except UnicodeDecodeError as exc:
             raise _Refused(f"not UTF-8 text (byte {exc.start})") from None
-        return UrdfText(str(path), text, _check(_parse(data)))
+        return UrdfText(str(path), text, *_check(_parse(data)))
     except _Refused as exc:
         raise RobotFileError(str(path), str(exc)) from None
 
@@ -87,13 +105,9 @@ def read_urdf(path: str | Path) -> UrdfText:
 def _read(path: Path) -> bytes:
     """At most :data:`MAX_BYTES` of the file; refused if it is larger."""
     try:
-        with path.open("rb") as fh:
-            data = fh.read(MAX_BYTES + 1)
-    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
-        raise _Refused(f"cannot read: {getattr(exc, 'strerror', None) or exc}") from None
-    if len(data) > MAX_BYTES:
-        raise _Refused(f"larger than {MAX_BYTES >> 20} MiB: not a robot description")
-    return data
+        return read_bounded(path, MAX_BYTES, "a robot description")
+    except InputFileError as exc:
+        raise _Refused(exc.reason) from None
 
 
 def _parse(data: bytes) -> Element:
@@ -115,11 +129,12 @@ def _parse(data: bytes) -> Element:
     return root
 
 
-def _check(root: Element) -> int:
-    """Check the robot's names, counts, joints, tree and numbers; its actuated joint count."""
+def _check(root: Element) -> tuple[int, tuple[Mimic, ...]]:
+    """Check the robot's names, counts, joints, tree and numbers; its actuated joint count
+    (mimic joints not counted) and its mimic joints."""
     _name(root.get("name"), "the robot")
     links, joints = root.findall("link"), root.findall("joint")
-    actuated = sum(j.get("type") in ACTUATED for j in joints)
+    actuated = sum(j.get("type") in ACTUATED and j.find("mimic") is None for j in joints)
     if len(links) > MAX_LINKS:
         raise _Refused(f"{len(links)} links: dvqp takes at most {MAX_LINKS}")
     if actuated > MAX_ACTUATED:
@@ -138,7 +153,44 @@ def _check(root: Element) -> int:
     _tree(names, [(joint_names[i], *parents[i]) for i in range(len(joints))])
     for owner, what in [*zip(links, names, strict=True), *zip(joints, joint_names, strict=True)]:
         _numbers(owner, f"{owner.tag} {what!r}")
-    return actuated
+    by_name = dict(zip(joint_names, joints, strict=True))
+    mimics = tuple(_mimic(j, by_name) for j in joints if j.findall("mimic"))
+    return actuated, mimics
+
+
+MIMICKING = ("revolute", "prismatic")
+"""The joint types that may mimic, or be mimicked (Pinocchio's mimic joints: one coordinate)."""
+
+
+def _mimic(joint: Element, joints: dict[str, Element]) -> Mimic:
+    """The ``<mimic>`` of ``joint`` (its numbers already checked): one, of a revolute or
+    prismatic joint, naming another revolute or prismatic joint that mimics none, with a
+    multiplier that is not 0."""
+    name, found = joint.get("name", ""), joint.findall("mimic")
+    if len(found) != 1:
+        raise _Refused(f"joint {name!r} has {len(found)} <mimic> elements, not one")
+    kinds = " or ".join(MIMICKING)
+    if joint.get("type") not in MIMICKING:
+        raise _Refused(f"joint {name!r} is {joint.get('type')} and mimics: only a {kinds} can")
+    element = found[0]
+    master = element.get("joint")
+    if master not in joints or master == name:
+        raise _Refused(f"joint {name!r} mimics {master!r}: not another joint of the file")
+    if joints[master].get("type") not in MIMICKING or joints[master].find("mimic") is not None:
+        raise _Refused(
+            f"joint {name!r} mimics {master!r}, which is not a {kinds} joint that mimics none"
+        )
+    what = f"joint {name!r}"
+    multiplier = (_floats(element, "multiplier", 1, what) or [1.0])[0]
+    if multiplier == 0.0:
+        raise _Refused(f"joint {name!r}: mimic multiplier 0 (a fixed joint is type 'fixed')")
+    limit = joint.find("limit")
+    assert limit is not None  # _joint: a revolute or prismatic joint has one
+    lower, upper, velocity = (
+        (_floats(limit, key, 1, what) or [0.0])[0] for key in ("lower", "upper", "velocity")
+    )
+    offset = (_floats(element, "offset", 1, what) or [0.0])[0]
+    return Mimic(name, master, multiplier, offset, lower, upper, velocity)
 
 
 def _name(name: str | None, what: str) -> str:

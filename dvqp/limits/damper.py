@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.limit import Limit
-from dvqp.workspace import Kernel, StepPlan
+from dvqp.workspace import Kernel, PartNames, StepPlan
 from dvqp.workspace.wiring import StepWiring
 from solvers.jit import njit
 
@@ -144,9 +144,10 @@ class VelocityDamper(Limit):
         """``d_safe`` of the distances of a damper with a kernel (m)."""
         raise NotImplementedError(f"{type(self).__name__} has no safe value")
 
-    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
-        """What each distance is, for reports (``k``: the arm's body points; ``rail``: whether it
-        has a rail point); none by default (a report then numbers them after :attr:`name`)."""
+    def labels(self, names: PartNames) -> tuple[str, ...]:
+        """What each distance is, for reports (``names``: the arm's guarded parts' names,
+        ``names.k`` its body points, ``names.rail`` whether it has a rail point); none by
+        default (a report then numbers them after :attr:`name`)."""
         return ()
 
 

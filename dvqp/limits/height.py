@@ -20,10 +20,9 @@ from typing import ClassVar
 import numpy as np
 
 from dvqp.errors import ParameterError
-from dvqp.geometry.proximity import link_label
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, fresh_rows
-from dvqp.workspace import link_ends
+from dvqp.workspace import PartNames, link_ends
 from dvqp.workspace.wiring import StepWiring, overrides
 from solvers.jit import njit
 
@@ -66,11 +65,12 @@ class SurfaceHeight(VelocityDamper):
         """``h_min``, m."""
         return self.min_height
 
-    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
+    def labels(self, names: PartNames) -> tuple[str, ...]:
         """``"point1/height"``, ... one per body point, then per body link (and the carriage
-        link if ``rail``)."""
-        links = (*(f"link{i + 1}" for i in range(k - 1)), *(("carriage",) if rail else ()))
-        return (*(f"point{i + 1}/height" for i in range(k)), *(f"{a}/height" for a in links))
+        link if the arm has a rail), by their ``names``."""
+        k = names.k
+        links = (*names.links[: k - 1], *names.links[k:])  # the holder has its own limit
+        return (*(f"{p}/height" for p in names.points[:k]), *(f"{a}/height" for a in links))
 
     def series(self, count: int, k: int, rail: bool) -> list[tuple[str, str, slice | list[int]]]:
         """The body points' curve and the link chords'."""
@@ -127,9 +127,9 @@ class ProbeHeight(VelocityDamper):
         """``floor``, m."""
         return self.floor
 
-    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
-        """``("probe/height", "holder/height")``."""
-        return ("probe/height", "holder/height")
+    def labels(self, names: PartNames) -> tuple[str, ...]:
+        """``("probe/height", "holder/height")``, by the parts' ``names``."""
+        return (f"{names.probe}/height", f"{names.holder}/height")
 
     def series(self, count: int, k: int, rail: bool) -> list[tuple[str, str, slice | list[int]]]:
         """The probe's curve and its holder's."""
@@ -158,7 +158,7 @@ def _height_rows(
     guarded, jacobians = state.guarded, state.guarded_jacobians
     height_distances(guarded, jacobians, first, points, 0, distance, gradient, usable)
     table = np.array([(points + c, link) for c, link in enumerate(chords)], dtype=np.int64)
-    ends, labels = link_ends(k, rail), limit.labels(k, rail)
+    ends, labels = link_ends(k, rail), limit.labels(state.part_names)
     chord_heights(
         guarded,
         state.origins,
@@ -178,7 +178,7 @@ def _join_heights(
 ) -> None:
     """Damper rows of guarded points ``first .. first + points − 1``, then of the lowest point
     of each guarded link in ``chords``."""
-    start = step.damper(limit, points + len(chords), limit.labels(step.plan.k, step.plan.rail))
+    start = step.damper(limit, points + len(chords), limit.labels(step.plan.names))
     step.measures["heights"].append((start, first, points))
     step.measures["chords"].extend((start + points + c, link) for c, link in enumerate(chords))
 
@@ -260,4 +260,4 @@ def lowest_link(state: KinematicState) -> tuple[float, str]:
     low, which, _ = lowest_chords(
         np.array(state.guarded), np.array(state.origins), ends, state.k, state.radius
     )
-    return float(low), link_label(int(which), state.k) if which >= 0 else ""
+    return float(low), state.part_names.link(int(which)) if which >= 0 else ""

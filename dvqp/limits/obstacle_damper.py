@@ -15,12 +15,12 @@ import numpy as np
 from dvqp import _validate
 from dvqp.errors import ParameterError
 from dvqp.geometry.obstacle import ObstacleSet
-from dvqp.geometry.proximity import link_label, measure_state, point_label
+from dvqp.geometry.proximity import measure_state
 from dvqp.geometry.real_links import real_link_gradient
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, fresh_rows
 from dvqp.limits.limit import SceneLimits
-from dvqp.workspace import as_struct
+from dvqp.workspace import PartNames, as_struct
 from dvqp.workspace.wiring import StepWiring, overrides
 from solvers.jit import njit
 
@@ -106,7 +106,7 @@ class ObstacleDamper(VelocityDamper):
             gradient,
             usable,
         )
-        labels = self.labels(k, rail)
+        labels = self.labels(state.part_names)
         return Distances(distance, gradient, self.safe, lambda: labels, usable)
 
     def join(self, step: StepWiring) -> None:
@@ -119,7 +119,7 @@ class ObstacleDamper(VelocityDamper):
         count = members.shape[0] * (2 * k + 1 + 2 * rail)
         if count == 0:
             return None
-        start = step.damper(self, count, self.labels(k, rail))
+        start = step.damper(self, count, self.labels(step.plan.names))
         table = step.measures
         table["obstacle_start"].append(start)
         table["obstacle_members"].extend(members.tolist())
@@ -144,14 +144,14 @@ class ObstacleDamper(VelocityDamper):
             for j, name in enumerate(names)
         ]
 
-    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
+    def labels(self, names: PartNames) -> tuple[str, ...]:
         """``"point3/obstacles[0]"`` (or ``"point3/<name>"``), ...: every point then every
-        link, obstacle-major (k body points, and the rail point and carriage link if
-        ``rail``)."""
-        names, parts = self.obstacles.labels, range(k + 1 + rail)
+        link (by their ``names``: the rail point and carriage link too if the arm has a
+        rail), obstacle-major."""
+        obstacles = self.obstacles.labels
         return (
-            *(f"{point_label(i, k)}/{name}" for name in names for i in parts),
-            *(f"{link_label(i, k)}/{name}" for name in names for i in range(k + rail)),
+            *(f"{point}/{name}" for name in obstacles for point in names.points),
+            *(f"{link}/{name}" for name in obstacles for link in names.links),
         )
 
 

@@ -20,10 +20,9 @@ from typing import ClassVar
 import numpy as np
 
 from dvqp import _validate
-from dvqp.geometry.proximity import link_label
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, fresh_rows
-from dvqp.workspace import PairBuffers, as_struct
+from dvqp.workspace import PairBuffers, PartNames, as_struct
 from dvqp.workspace.wiring import StepWiring, overrides
 from solvers.jit import njit
 
@@ -86,7 +85,7 @@ class SelfCollision(VelocityDamper):
         packed = as_struct(pairs)
         pair_distances(np.ascontiguousarray(state.origins), packed)
         self_distances(packed, state.frame_jacobians, 0, distance, gradient, usable)
-        labels = self.labels(state.k, state.rail)
+        labels = self.labels(state.part_names)
         return Distances(distance, gradient, self.safe, lambda: labels, usable)
 
     def join(self, step: StepWiring) -> None:
@@ -96,16 +95,14 @@ class SelfCollision(VelocityDamper):
         plan = step.plan
         count = plan.pairs.i.shape[0]
         if count:
-            step.measures["selves"].append(step.damper(self, count, self.labels(plan.k, plan.rail)))
+            step.measures["selves"].append(step.damper(self, count, self.labels(plan.names)))
         return None
 
-    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
+    def labels(self, names: PartNames) -> tuple[str, ...]:
         """The pairs' names, e.g. ``"link1/link3"``, ``"link2/holder"``, ``"link2/carriage"``
-        (k body points, the carriage link if ``rail``)."""
-        pairs = PairBuffers.allocate(k, rail)
-        return tuple(
-            f"{link_label(a, k)}/{link_label(b, k)}" for a, b in zip(pairs.i, pairs.j, strict=True)
-        )
+        (the links' ``names``)."""
+        pairs = PairBuffers.allocate(names.k, names.rail)
+        return tuple(_pair(names, a, b) for a, b in zip(pairs.i, pairs.j, strict=True))
 
 
 @njit(separate=True)
@@ -176,5 +173,9 @@ def self_distance(state: KinematicState) -> tuple[float, str]:
         return math.inf, ""
     pair_distances(np.array(state.origins), as_struct(pairs))
     m = int(np.argmin(pairs.distance))
-    names = f"{link_label(int(pairs.i[m]), state.k)}/{link_label(int(pairs.j[m]), state.k)}"
-    return float(pairs.distance[m]), names
+    return float(pairs.distance[m]), _pair(state.part_names, pairs.i[m], pairs.j[m])
+
+
+def _pair(names: PartNames, a: int, b: int) -> str:
+    """``"<link a>/<link b>"``."""
+    return f"{names.link(int(a))}/{names.link(int(b))}"

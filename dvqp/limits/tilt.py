@@ -18,6 +18,7 @@ from typing import ClassVar
 from dvqp.errors import ParameterError
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, fresh_rows
+from dvqp.workspace import PartNames
 from dvqp.workspace.wiring import StepWiring, overrides
 from solvers.jit import njit
 
@@ -65,9 +66,9 @@ class TiltLimit(VelocityDamper):
         """``sin θ_min``."""
         return math.sin(self.min_tilt)
 
-    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
-        """``("probe/tilt",)``."""
-        return ("probe/tilt",)
+    def labels(self, names: PartNames) -> tuple[str, ...]:
+        """``("probe/tilt",)``, by the probe's name."""
+        return (f"{names.probe}/tilt",)
 
     def series(self, count: int, k: int, rail: bool) -> list[tuple[str, str, slice | list[int]]]:
         """One curve: the probe axis's angle from the radial."""
@@ -78,7 +79,8 @@ class TiltLimit(VelocityDamper):
         distance, gradient, usable = fresh_rows(1, state.n)
         frames = state.frame_jacobians
         tilt_distance(state.origins, state.axes, frames, state.k, 0, distance, gradient, usable)
-        return Distances(distance, gradient, self.safe, lambda: ("probe/tilt",), usable)
+        labels = self.labels(state.part_names)
+        return Distances(distance, gradient, self.safe, lambda: labels, usable)
 
     def join(self, step: StepWiring) -> None:
         """One row, ``sin θ``, measured by :func:`tilt_distance` (none if ``θ_min = 0``)."""
@@ -86,7 +88,7 @@ class TiltLimit(VelocityDamper):
             return None
         if overrides(self, TiltLimit, "distances", "kernel"):
             return super().join(step)
-        step.measures["tilts"].append(step.damper(self, 1, self.labels(step.plan.k)))
+        step.measures["tilts"].append(step.damper(self, 1, self.labels(step.plan.names)))
         return None
 
 

@@ -18,12 +18,15 @@ from numpy.typing import NDArray
 
 from dvqp.errors import ParameterError
 from dvqp.kinematics.developed_view import wrap, wrap_angle
+from dvqp.motion.deviation import path_deviation
 
 Array = NDArray[np.float64]
 
 MAX_SLOWDOWN = 4.0
 """A time-scaled run takes at most this many times its nominal steps; a path not finished by
 then is reported as not reached (:func:`dvqp.run.planning.check_run`)."""
+
+__all__ = ["MAX_SLOWDOWN", "TIMINGS", "Schedule", "dv_error", "path_deviation"]
 
 TIMINGS = ("fixed", "scaled")
 """How a path's progress is timed: the nominal schedule, or slowed where the limits bind."""
@@ -99,22 +102,3 @@ class Schedule:
         here = self.position(u)
         feedforward = (self.position(u + span) - here) / self.dt
         return feedforward + self.gain * dv_error(here, tool, self.radius), feedforward, span
-
-
-def path_deviation(reference: Array, tool: Array) -> Array:
-    """How far each tool position is from the path, m, shape (M,): the distance in
-    ``(l, z, h)`` from ``tool[:, :3]`` (M, 4) to the polyline through ``reference[:, :3]``
-    (N+1, 4), both with l unwrapped from the same start (as a run and its reference are)."""
-    start, step = reference[:-1, :3], np.diff(reference[:, :3], axis=0)
-    if start.shape[0] == 0:
-        start, step = reference[:1, :3], np.zeros((1, 3))
-    length2 = np.einsum("ij,ij->i", step, step)
-    safe = np.where(length2 > 0.0, length2, 1.0)
-    out = np.empty(tool.shape[0])
-    chunk = max(1, 2**20 // start.shape[0])
-    for s in range(0, tool.shape[0], chunk):
-        p = tool[s : s + chunk, None, :3] - start[None]
-        along = np.clip(np.einsum("bij,ij->bi", p, step) / safe, 0.0, 1.0)
-        p -= along[..., None] * step
-        out[s : s + chunk] = np.sqrt(np.einsum("bij,bij->bi", p, p).min(axis=1))
-    return out

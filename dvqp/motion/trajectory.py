@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import zipfile
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -13,8 +12,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp._files import atomic_file, output_path
+from dvqp._inputs import Member, NpzArrays
 from dvqp._versions import versions
-from dvqp.errors import DvqpError
+from dvqp.errors import InputFileError
 from dvqp.kinematics.developed_view import unwrap
 from dvqp.limits.excess import StartBroken
 
@@ -326,34 +326,104 @@ class Trajectory:
 
     @classmethod
     def load(cls, path: str | Path) -> Trajectory:
-        """Read a trajectory written by :meth:`save` (``.npz``)."""
+        """Read a trajectory written by :meth:`save` (``.npz``).
+
+        Every array's declared shape and size is checked before any is inflated
+        (:func:`check_members`), so a damaged or hostile file costs no more memory than its
+        arrays declare, and those must fit a trajectory of the samples its ``t`` declares.
+
+        Raises
+        ------
+        InputFileError
+            ``<path>: cannot read: <reason>``, or ``<path>: not a dvqp trajectory
+            (<reason>)``: not an ``.npz`` file, damaged, a missing array, an array of a shape
+            or size no trajectory has, pickled objects.
+        """
+        with NpzArrays(path, "a dvqp trajectory") as npz:
+            try:
+                names = check_members(npz.members)
+            except ValueError as exc:
+                raise npz.refused(str(exc)) from exc
+            npz.check_memory(names)
+            data = {name: npz.read(name) for name in names}
         try:
-            with np.load(path, allow_pickle=False) as data:
-                # files written before 0.2 call the tool's DV coordinates "dv"
-                arrays = {
-                    name: data["dv" if name == "tool" and "dv" in data else name] for name in ARRAYS
-                }
-                optional = (*DIAGNOSTICS, "tracking_error")
-                arrays.update({name: data[name] for name in optional if name in data})
-                broken = json.loads(str(data["start_broken"])) if "start_broken" in data else []
-                return cls(
-                    **arrays,
-                    start_broken=tuple(StartBroken(**b) for b in broken),
-                    backend=str(data["backend"]),
-                    pipe_radius=float(data["pipe_radius"]),
-                    scene_text=str(data["scene"]),
-                    brake_start=int(data["brake_start"]) if "brake_start" in data else -1,
-                    refusals=_counts(data, "refusals"),
-                    accuracy=_counts(data, "accuracy"),
-                    levels=_names(data, "levels"),
-                )
-        except OSError as exc:
-            reason = exc.strerror or type(exc).__name__
-            raise DvqpError(f"{path}: cannot read: {reason}") from exc
-        except (KeyError, ValueError, TypeError, EOFError, zipfile.BadZipFile) as exc:
-            # numpy's own text for pickled data suggests loading it unsafely: never pass it on
-            reason = "a missing array" if isinstance(exc, KeyError) else "not a dvqp .npz file"
-            raise DvqpError(f"{path}: not a dvqp trajectory ({reason})") from exc
+            return cls._from_arrays(data)
+        except (KeyError, ValueError, TypeError) as exc:
+            missing = isinstance(exc, KeyError)
+            reason = "not written by 'dvqp plan'" if missing else "not a dvqp .npz file"
+            raise InputFileError(path, f"not a dvqp trajectory ({reason})") from exc
+
+    @classmethod
+    def _from_arrays(cls, data: dict[str, np.ndarray]) -> Trajectory:
+        """The trajectory of a file's arrays (files written before 0.2 call the tool's DV
+        coordinates ``dv``)."""
+        arrays = {name: data["dv" if name == "tool" and "dv" in data else name] for name in ARRAYS}
+        optional = (*DIAGNOSTICS, "tracking_error")
+        arrays.update({name: data[name] for name in optional if name in data})
+        broken = json.loads(str(data["start_broken"])) if "start_broken" in data else []
+        return cls(
+            **arrays,
+            start_broken=tuple(StartBroken(**b) for b in broken),
+            backend=str(data["backend"]),
+            pipe_radius=float(data["pipe_radius"]),
+            scene_text=str(data["scene"]),
+            brake_start=int(data["brake_start"]) if "brake_start" in data else -1,
+            refusals=_counts(data, "refusals"),
+            accuracy=_counts(data, "accuracy"),
+            levels=_names(data, "levels"),
+        )
+
+
+MAX_WIDTH = 4096
+"""Most values a sample (or a step) of a trajectory file's array holds: ``points`` holds 3 a
+body point, so up to 1365 body points."""
+MAX_TEXT = 1 << 24
+"""Most characters of a text a trajectory file holds (its scene's text: a scene file is at
+most 16 MiB, :data:`dvqp.scenes.scene.MAX_BYTES`)."""
+TEXTS = ("backend", "scene", "start_broken", "refusals", "accuracy", "levels", "meta")
+"""A trajectory file's texts (0-d string arrays)."""
+NUMBERS = ("pipe_radius", "brake_start")
+"""A trajectory file's single numbers."""
+PER_LEVEL = ("level_measured",)
+"""A trajectory file's arrays of a row per task level (not per sample): at most
+:data:`MAX_WIDTH` levels."""
+
+
+def check_members(members: dict[str, Member]) -> list[str]:
+    """The members of a trajectory file that :meth:`Trajectory.load` reads, checked before
+    any is inflated: every array's rows are the samples ``t`` declares (or the steps between
+    them, or none), with at most :data:`MAX_WIDTH` numbers a row; texts and numbers are
+    single values, a text at most :data:`MAX_TEXT` characters.
+
+    Raises
+    ------
+    ValueError
+        What is wrong (``member 'q': 20000000 rows for 1000 samples``).
+    """
+    t = members.get("t")
+    if t is None:
+        raise ValueError("not written by 'dvqp plan'")
+    if len(t.shape) != 1 or t.shape[0] < 1:
+        raise ValueError(f"member 't': shape {t.shape}, not (samples,)")
+    samples = t.shape[0]
+    names = [n for n in (*ARRAYS, *DIAGNOSTICS, "tracking_error", "dv") if n in members]
+    for name in names:
+        m = members[name]
+        if name in PER_LEVEL:
+            if len(m.shape) != 2 or m.shape[0] > MAX_WIDTH or m.shape[1] != 2:
+                raise ValueError(f"member {name!r}: shape {m.shape}, not (levels, 2)")
+            continue
+        if not m.shape or m.shape[0] not in (samples, samples - 1, 0):
+            rows = m.shape[0] if m.shape else "no"
+            raise ValueError(f"member {name!r}: {rows} rows for {samples} samples")
+        width = m.width * (m.dtype.itemsize // 4 if m.dtype.kind == "U" else 1)
+        if width > MAX_WIDTH:
+            raise ValueError(f"member {name!r}: {width} values a row (at most {MAX_WIDTH})")
+    for name in (n for n in (*TEXTS, *NUMBERS) if n in members):
+        m = members[name]
+        if m.shape or (name in TEXTS and m.dtype.itemsize > 4 * MAX_TEXT):
+            raise ValueError(f"member {name!r}: not a single value of a trajectory file")
+    return [*names, *(n for n in (*TEXTS, *NUMBERS) if n in members)]
 
 
 def _names(data: Any, name: str) -> tuple[str, ...]:

@@ -98,7 +98,7 @@ def tier_options(name: str, tier: str) -> dict[str, Any]:
     Raises
     ------
     ParameterError
-        ``settings: unknown tier 'x' (tiers: default, high_accuracy, low_accuracy)``.
+        ``settings: unknown tier 'x' (tiers: default, high_accuracy, …)``.
     """
     if tier not in TIERS:
         raise ParameterError("settings", f"unknown tier {tier!r} (tiers: {', '.join(TIERS)})")

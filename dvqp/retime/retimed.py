@@ -33,6 +33,9 @@ Array = NDArray[np.float64]
 
 DEFAULT_RATE = 500.0
 """Hz: the controller rate a motion is sampled at unless told otherwise."""
+MOST_OF_THE_PATH = 0.5
+"""A retimed motion whose samples trace less than this share of the planned path
+(:func:`traced_share`) :attr:`~Retimed.drops_path` (``dvqp plan --retime`` warns)."""
 FORMATS = (".npz", ".csv", ".json")
 """What :meth:`Retimed.save` writes (``.json``: a ROS ``trajectory_msgs/JointTrajectory``)."""
 
@@ -68,6 +71,10 @@ class Retimed:
         The worst exact excess of any limit of the step over the samples and the straight
         motions between them, against ``min(bound, value at the planned start)`` as in the
         planned run (:data:`~dvqp.limits.NO_EXCESS`: nothing to verify).
+    path_share : float
+        How much of the planned path the samples trace (:func:`traced_share`: each joint's
+        travel along them over its planned travel, averaged; 1: all of it). Below
+        :data:`MOST_OF_THE_PATH` the rate is too low for the path (:attr:`drops_path`).
     """
 
     t: Array
@@ -80,6 +87,14 @@ class Retimed:
     velocity_use: float
     acceleration_use: float
     excess: Excess = NO_EXCESS
+    path_share: float = 1.0
+
+    @property
+    def drops_path(self) -> bool:
+        """The samples miss most of the planned path (:attr:`path_share` below
+        :data:`MOST_OF_THE_PATH`): a controller going straight from one to the next would
+        not follow it; a higher rate would."""
+        return self.path_share < MOST_OF_THE_PATH
 
     @property
     def duration(self) -> float:
@@ -165,13 +180,27 @@ def retime(scene: RunScene, q: ArrayLike, t: ArrayLike, rate: float = DEFAULT_RA
         samples.q,
         samples.qdot,
         samples.qddot,
-        joint_names=tuple(robot.model.names[1:]),
+        joint_names=robot.joint_names,
         rate=float(rate),
         planned_duration=float(t[-1] - t[0]),
         velocity_use=float(np.max(np.abs(samples.qdot) / robot.qd_max)),
         acceleration_use=float(np.max(np.abs(samples.qddot) / qdd_max)),
         excess=verified(scene, spec, q[0], samples.q),
+        path_share=traced_share(q, samples.q),
     )
+
+
+def traced_share(planned: Array, samples: Array) -> float:
+    """How much of the planned path the polyline through ``samples`` (M, n) traces: each
+    moving joint's travel (the sum of its steps' sizes) along the samples over its travel
+    along the ``planned`` ones (N+1, n), at most 1, averaged over the joints that move (1 if
+    none does). Samples that skip a joint's back and forth trace little of it."""
+    travel = np.abs(np.diff(planned, axis=0)).sum(axis=0)
+    moving = travel > 0.0
+    if not moving.any():
+        return 1.0
+    traced = np.abs(np.diff(samples, axis=0)).sum(axis=0)
+    return float(np.mean(np.minimum(1.0, traced[moving] / travel[moving])))
 
 
 def verified(scene: RunScene, spec: StepSpec, q0: Array, samples: Array) -> Excess:

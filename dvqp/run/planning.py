@@ -117,8 +117,10 @@ def plan(
         Settings of the QP backend, over the scene's ``[solvers.<backend>]`` ones, over the
         settings ``tier``'s.
     tier
-        ``"default"``, ``"high_accuracy"`` or ``"low_accuracy"``: the QP backend's accuracy
-        settings and the tolerance its answers are checked to (:mod:`solvers.tiers`).
+        The QP backend's accuracy settings and the tolerance its answers are checked to
+        (:mod:`solvers.tiers`): ``"default"`` (dvqp's own, tight), qpbenchmark's
+        ``"high_accuracy"``, ``"mid_accuracy"``, ``"low_accuracy"``, or
+        ``"solver_defaults"`` (qpbenchmark's ``default``: the solvers' factory defaults).
     watch
         Shown every backend call of the run (:func:`dvqp.motion.simulate.simulate`).
     timing

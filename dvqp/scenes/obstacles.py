@@ -14,7 +14,7 @@ import numpy as np
 
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.geometry.shapes import SHAPES
-from dvqp.scenes.fields import Fields, join
+from dvqp.scenes.fields import Fields, is_number, join
 from dvqp.scenes.sections import POSITION, SIZE, WEIGHT
 
 
@@ -49,6 +49,12 @@ def _value(f: Fields, t: dict[str, Any], prefix: str, key: str, kind: str, defau
         return f.number(t, key, prefix, default, within=WEIGHT)
     raw = f.get(t, key, prefix)  # "points"
     field = join(prefix, key)
+    if isinstance(raw, list) and raw and all(is_number(v) for v in raw):
+        odd = " (an odd count: not even pairs)" if len(raw) % 2 else ""
+        f.fail(
+            field,
+            f"expected vertices as pairs [[l, z], ...], got a flat list of {len(raw)} numbers{odd}",
+        )
     if not isinstance(raw, list) or len(raw) < 3:
         f.fail(field, "expected an array of at least 3 vertices [l, z]")
     return np.array(

@@ -1,4 +1,5 @@
-"""Reader of a scene file's ``[robot]`` table: the arm, its limits, q0 and the weights."""
+"""Reader of a scene file's ``[robot]`` table: the arm, where its base is, its limits, q0 and
+the weights."""
 
 from __future__ import annotations
 
@@ -6,7 +7,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+import pinocchio as pin
+from numpy.typing import ArrayLike, NDArray
 
 from dvqp import _validate
 from dvqp.errors import DvqpError, ParameterError
@@ -19,6 +21,11 @@ ANGLE = Bound(-1000.0, 1000.0, "rad")
 """A joint angle or a finite joint limit (``±inf``: no limit)."""
 JOINT_SPEED = Bound(0.0, 1000.0, "rad/s", strict=True)
 JOINT_WEIGHT = Bound(1e-6, 1e6)
+BASE_OFFSET = Bound(-100.0, 100.0, "m")
+"""A coordinate of the base frame's origin in the pipe's frame."""
+BASE_ANGLE = Bound(-10.0, 10.0, "rad")
+"""A roll, pitch or yaw angle of the base frame."""
+BASE_KEYS = ("xyz", "rpy")
 ROBOT_KEYS = (
     "model",
     "link_lengths",
@@ -26,6 +33,7 @@ ROBOT_KEYS = (
     "points",
     "tool",
     "rail",
+    "base",
     "q0",
     "q_min",
     "q_max",
@@ -39,22 +47,47 @@ MODELS = ("ndt13",)
 def robot(
     f: Fields, doc: dict[str, Any], base_dir: Path
 ) -> tuple[Robot, NDArray[np.float64], NDArray[np.float64]]:
-    """The arm, its start configuration (rad) and the diagonal of W, each checked.
+    """The arm (its base placed by ``[robot.base]``), its start configuration (rad) and the
+    diagonal of W, each checked.
 
-    Every per-joint array is checked against the arm's joint count (13, or the URDF file's, the
-    file checked) before the arm is built.
+    Every per-joint array is checked against the arm's joint count (13, or the URDF file's
+    joints that move, mimic joints not counted, the file checked) before the arm is built.
     """
     t = f.table(doc, "robot", "", ROBOT_KEYS)
+    base = _base(f, t)
     n = _joint_count(f, t, base_dir)
     q0 = f.vector(t, "q0", "robot", n, within=ANGLE)
     weights = f.vector(t, "weights", "robot", n, scalar=True, default=1.0, within=JOINT_WEIGHT)
     limits = _limits(f, t, n)
     f.vector(t, "qdd_max", "robot", n, scalar=True, default=1.0, infinite=True)  # bounds: limits
     arm = _arm(f, t, base_dir, limits)
+    if base is not None:
+        arm = arm.placed(base)
     for i, (q, lo, hi) in enumerate(zip(q0, arm.q_min, arm.q_max, strict=True)):
         if not lo - 1e-12 <= q <= hi + 1e-12:
             f.fail(f"robot.q0[{i}]", f"{q:g} rad is outside [q_min, q_max] = [{lo:g}, {hi:g}] rad")
     return arm, _validate.readonly(q0), _validate.readonly(weights)
+
+
+def _base(f: Fields, t: dict[str, Any]) -> NDArray[np.float64] | None:
+    """``[robot.base]``: the arm's base frame in the pipe's frame, (4, 4), from ``xyz`` (m) and
+    ``rpy`` (rad: roll about x, pitch about y, yaw about z, fixed axes, as a URDF origin); None
+    if absent."""
+    if "base" not in t:
+        return None
+    b = f.table(t, "base", "robot", BASE_KEYS)
+    xyz = f.vector(b, "xyz", "robot.base", 3, default=[0.0, 0.0, 0.0], within=BASE_OFFSET)
+    rpy = f.vector(b, "rpy", "robot.base", 3, default=[0.0, 0.0, 0.0], within=BASE_ANGLE)
+    return base_transform(xyz, rpy)
+
+
+def base_transform(xyz: ArrayLike, rpy: ArrayLike) -> NDArray[np.float64]:
+    """The transform (4, 4) of a frame at ``xyz`` (m), turned by ``rpy`` (rad), as a URDF
+    ``<origin>``: ``R = Rz(yaw) Ry(pitch) Rx(roll)``."""
+    out = np.eye(4)
+    out[:3, :3] = pin.rpy.rpyToMatrix(*np.asarray(rpy, dtype=np.float64))
+    out[:3, 3] = np.asarray(xyz, dtype=np.float64)
+    return out
 
 
 def _joint_count(f: Fields, t: dict[str, Any], base_dir: Path) -> int:
@@ -107,6 +140,7 @@ def _arm(f: Fields, t: dict[str, Any], base_dir: Path, limits: dict[str, Any]) -
             tool,
             rail_frame=rail,
             name=loaded.name,
+            names=loaded.part_names,
             **{"qd_max": loaded.qd_max, **given},
         )
 

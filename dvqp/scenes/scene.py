@@ -17,7 +17,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from dvqp.errors import SceneError, one_line
+from dvqp._inputs import read_bounded
+from dvqp.errors import InputFileError, SceneError, one_line
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
 from dvqp.limits import Limit
@@ -53,6 +54,8 @@ TOP_KEYS = (
     "tasks",
 )
 """The keys a scene file may have at its top level."""
+MAX_BYTES = 1 << 24
+"""Largest scene file read, bytes (16 MiB; the bundled scenes take 1 to 3 kB)."""
 
 
 @dataclass(frozen=True)
@@ -131,13 +134,16 @@ def load_scene(path: str | Path) -> Scene:
     Raises
     ------
     SceneError
-        ``<path>: <field>: <reason>`` for an unreadable or invalid file.
+        ``<path>: <field>: <reason>`` for an unreadable or invalid file, or one larger than
+        :data:`MAX_BYTES`.
     """
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, ValueError) as exc:  # ValueError: not UTF-8, a NUL in the name
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise SceneError(str(path), "", f"cannot read: {reason}") from exc
+        data = read_bounded(path, MAX_BYTES, "a scene file")
+        text = data.decode("utf-8").replace("\r\n", "\n").replace("\r", "\n")
+    except InputFileError as exc:
+        raise SceneError(str(path), "", exc.reason) from exc
+    except UnicodeDecodeError as exc:
+        raise SceneError(str(path), "", f"cannot read: {exc}") from exc
     return loads(text, source=str(path), base_dir=Path(path).parent)
 
 

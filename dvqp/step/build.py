@@ -82,7 +82,8 @@ def build(
     parts = (*spec.tasks, *spec.objective.terms, *spec.limits)
     union = [*(shape for part in parts for shape in part.measured), *recorded]
     n, k = robot.n, robot.n_points
-    plan = StepPlan(n, k, radius, len({id(shape) for shape in union}), robot.has_rail)
+    shapes = len({id(shape) for shape in union})
+    plan = StepPlan(n, k, radius, shapes, robot.has_rail, robot.part_names)
     hooks = Hooks(plan, KinematicState.compute(robot, q0, radius), dt)
     step = StepWiring(plan, hooks, union, hooks.start)
     weights: list[float] = []
@@ -129,7 +130,7 @@ def build(
         refine,
         far,
     )
-    _verified(layout, step)
+    _verified(layout, step, robot.joint_names)
     return layout, step.rows_of(recorded)
 
 
@@ -170,15 +171,15 @@ def _bounds(step: StepWiring) -> BoundArrays:
     )
 
 
-def _verified(layout: Layout, step: StepWiring) -> None:
-    """The verified values: the joint room (if a position limit), then every damper row."""
+def _verified(layout: Layout, step: StepWiring, joints: tuple[str, ...]) -> None:
+    """The verified values: the joint room (if a position limit, labelled by the ``joints``'
+    names), then every damper row."""
     plan, n = layout.plan, step.plan.n
     if step.joint_limit is not None:
         slot = plan.verified(2 * n, 0.0, step.joint_limit.tolerance)
         layout.joint_values = slot.start
-        names = tuple(f"joint{i + 1}" for i in range(n))
         layout.blocks.append(
-            Block(step.joint_limit, slot.start, slot.stop, names + names, damper=False)
+            Block(step.joint_limit, slot.start, slot.stop, joints + joints, damper=False)
         )
     if not step.dampers:
         return

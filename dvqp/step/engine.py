@@ -115,7 +115,7 @@ class Stepper(Verification):
         )
         self.hooks = self.layout.hooks
         self._prepare = stages.prepare_baseline if self.arrays.pinv.baseline else stages.prepare
-        self.state = KinematicState.view(plan.state, radius, plan.k)
+        self.state = KinematicState.view(plan.state, radius, plan.k, plan.names)
         self.x = self.arrays.x
         self.record_at = self.arrays.record.index
         """(1,) int64: row of the samples the next concluded state is written to (−1: none)."""

@@ -33,7 +33,7 @@ class Hooks:
 
     def __init__(self, plan: StepPlan, start: KinematicState, dt: float) -> None:
         self.plan, self.start, self.dt = plan, start, dt
-        self.view = KinematicState.view(plan.state, plan.radius, plan.k)
+        self.view = KinematicState.view(plan.state, plan.radius, plan.k, plan.names)
         self.measured: list[Hook] = []
         self.assessed: list[Hook] = []
         self.prepared: list[Hook] = []
@@ -82,12 +82,12 @@ class Hooks:
         if kernel is not None:
             self._kernel(self.assessed, kernel)
             count = self.plan.rows("dampers") - before
-            return before, count, limit.safe, limit.labels(self.plan.k)
+            return before, count, limit.safe, limit.labels(self.plan.names)
         found = limit.distances(self.start)
         count = int(np.asarray(found.value).shape[0])
         slots = self.plan.damper_rows(count)
         self._later(self.assessed, lambda: self._distances(limit, slots, count))
-        labels = found.describe() if found.describe is not None else limit.labels(self.plan.k)
+        labels = found.describe() if found.describe is not None else limit.labels(self.plan.names)
         return before, count, found.safe, labels
 
     def limit(self, limit: Limit) -> None:

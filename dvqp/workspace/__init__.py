@@ -2,6 +2,7 @@
 packing of many arrays into one numba struct. It imports no domain module of dvqp."""
 
 from dvqp.workspace.buffers import PairBuffers, ProximityBuffers, StateBuffers, link_ends
+from dvqp.workspace.parts import PartNames
 from dvqp.workspace.plan import CheckBuffers, DamperBuffers, Kernel, QPBuffers, Slot, StepPlan
 from dvqp.workspace.struct import as_struct, struct_type
 
@@ -10,6 +11,7 @@ __all__ = [
     "DamperBuffers",
     "Kernel",
     "PairBuffers",
+    "PartNames",
     "ProximityBuffers",
     "QPBuffers",
     "Slot",

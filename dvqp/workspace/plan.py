@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from dvqp.errors import ParameterError
 from dvqp.workspace.buffers import PairBuffers, ProximityBuffers, StateBuffers
+from dvqp.workspace.parts import PartNames
 
 Array = NDArray[np.float64]
 
@@ -122,6 +123,8 @@ class StepPlan:
     rail
         Whether the arm has a rail point (a guarded point after the tool, and the carriage
         link from it to body point 1).
+    names
+        The guarded parts' names in labels (default: dvqp's numbering, ``point1``, …).
 
     Attributes
     ----------
@@ -138,9 +141,18 @@ class StepPlan:
     """
 
     def __init__(
-        self, n: int, k: int, radius: float, obstacles: int = 0, rail: bool = False
+        self,
+        n: int,
+        k: int,
+        radius: float,
+        obstacles: int = 0,
+        rail: bool = False,
+        names: PartNames | None = None,
     ) -> None:
         self.n, self.k, self.radius, self.rail = n, k, float(radius), bool(rail)
+        self.names = PartNames.numbered(k, rail) if names is None else names
+        if (self.names.k, self.names.rail) != (k, self.rail):
+            raise ParameterError("names", f"not the names of {k} body points (rail: {rail})")
         self.state = StateBuffers.allocate(n, k, rail)
         self.proximity = ProximityBuffers.allocate(obstacles, k, rail)
         self.pairs = PairBuffers.allocate(k, rail)

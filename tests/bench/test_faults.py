@@ -66,6 +66,20 @@ def indices(doc: dict) -> list[int]:
     return sorted({r["index"] for r in doc["results"]})
 
 
+def finished(proc: subprocess.Popen[str], out: Path) -> tuple[dict, str]:
+    """Wait for the bench ``proc``; check it ended well (exit 0, no traceback); its ``--json``
+    document ``out`` and what it printed."""
+    printed, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0 and "Traceback" not in err, err
+    return json.loads(out.read_text()), printed
+
+
+def none_lost(doc: dict, count: int) -> None:
+    """Every one of the ``count`` scenes ran (two backends each), none reported lost."""
+    assert indices(doc) == list(range(count)) and len(doc["results"]) == 2 * count
+    assert not any(r["error"] == "worker lost" for r in doc["results"])
+
+
 def test_results_are_on_disk_scene_by_scene_even_if_the_bench_is_killed(tmp_path: Path) -> None:
     out = tmp_path / "a.json"
     proc = start("--count", "40", "--json", str(out))
@@ -92,11 +106,8 @@ def test_a_killed_pool_worker_costs_nothing_its_scene_is_run_again(tmp_path: Pat
         time.sleep(0.02)
     assert workers, "no pool process found"
     os.kill(workers[0], signal.SIGKILL)  # as the OOM killer does
-    _, err = proc.communicate(timeout=120)
-    assert proc.returncode == 0 and "Traceback" not in err, err
-    doc = json.loads(out.read_text())
-    assert indices(doc) == list(range(16)) and len(doc["results"]) == 32
-    assert not any(r["error"] == "worker lost" for r in doc["results"])
+    doc, _ = finished(proc, out)
+    none_lost(doc, 16)
     assert doc["interrupted"] is False and doc["summary"]["daqp"]["lost"] == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.csv", "a.json"]  # no .partial
 
@@ -118,15 +129,77 @@ DEADLY = textwrap.dedent("""
 def test_a_scene_that_kills_its_worker_again_is_reported_lost(tmp_path: Path) -> None:
     out = tmp_path / "a.json"
     proc = start("--count", "6", "--workers", "2", "--json", str(out), script=DEADLY)
-    printed, err = proc.communicate(timeout=120)
-    assert proc.returncode == 0 and "Traceback" not in err, err
-    doc = json.loads(out.read_text())
+    doc, printed = finished(proc, out)
     assert indices(doc) == list(range(6)) and len(doc["results"]) == 12
     lost = [(r["index"], r["backend"]) for r in doc["results"] if r["error"] == "worker lost"]
     assert lost == [(2, "pinv"), (2, "daqp")]
     assert all(r["steps"] > 0 for r in doc["results"] if r["index"] != 2)
     assert doc["summary"]["pinv"]["lost"] == doc["summary"]["daqp"]["lost"] == 1
     assert "1 scene (worker lost or timed out: no figures): bench-s3-0002" in printed
+
+
+RACING = textwrap.dedent("""
+    import os, signal, sys, time
+    from concurrent.futures import ProcessPoolExecutor
+    from dvqp.bench import execution
+    from dvqp.cli import main
+
+    class Racing(ProcessPoolExecutor):
+        # a pool process dies after the last wait and before the next scene is handed over:
+        # the pool is broken by then, and its submit raises BrokenProcessPool
+        handed = 0
+        def submit(self, fn, *args, **kwargs):
+            Racing.handed += fn is execution._run
+            if fn is execution._run and Racing.handed == 5:
+                os.kill(next(iter(self._processes)), signal.SIGKILL)
+                while not self._broken:
+                    time.sleep(0.01)
+            return super().submit(fn, *args, **kwargs)
+
+    execution.ProcessPoolExecutor = Racing
+    sys.exit(main(sys.argv[1:]))
+""")
+
+
+def test_a_worker_killed_between_two_scenes_costs_nothing(tmp_path: Path) -> None:
+    """The window in which a bench exited 1 (a BrokenProcessPool traceback) with its finished
+    results in the .partial file only: a process killed after the bench last waited and
+    before it handed over the next scene."""
+    out = tmp_path / "a.json"
+    proc = start("--count", "8", "--workers", "2", "--json", str(out), script=RACING)
+    none_lost(finished(proc, out)[0], 8)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json"]  # no .partial
+
+
+DRAWING_DIES = textwrap.dedent("""
+    import os, signal, sys
+    from dvqp.bench import execution
+    from dvqp.cli import main
+    real, parent = execution.generate_scene, os.getpid()
+    def deadly(seed, index):  # the pool process drawing scene 5 dies (the OOM killer)
+        if index == 5 and os.getpid() != parent:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return real(seed, index)
+    execution.generate_scene = deadly
+    sys.exit(main(sys.argv[1:]))
+""")
+
+
+def test_a_worker_killed_while_drawing_the_scenes_costs_nothing(tmp_path: Path) -> None:
+    out = tmp_path / "a.json"
+    proc = start(
+        "--count",
+        "12",
+        "--workers",
+        "2",
+        "--backends",
+        "pinv",
+        "--json",
+        str(out),
+        script=DRAWING_DIES,
+    )
+    doc, _ = finished(proc, out)
+    assert indices(doc) == list(range(12))  # the same scenes: drawn here once the pool died
 
 
 def interrupt(proc: subprocess.Popen[str], partial: Path) -> tuple[float, str, list[dict]]:

@@ -403,7 +403,7 @@ def test_plot_of_a_missing_or_foreign_file_says_so_in_one_line(
     cases = {
         tmp_path / "missing.npz": "cannot read: No such file or directory",
         tmp_path / "small.toml": "not a dvqp trajectory (not an .npz file)",
-        pickled: "not a dvqp trajectory (not written by 'dvqp plan')",
+        pickled: "not a dvqp trajectory (member 't': pickled Python objects are not read)",
         shapes: "not a dvqp trajectory (arrays of unexpected shapes)",
         heights: "not a dvqp trajectory (arrays of unexpected shapes)",
     }
@@ -443,6 +443,11 @@ LONG = "[[motion.jog]]\nduration = 7500.0\nvelocity = [0.0, 0.0, 0.0, 0.0]"  # 1
 
 
 @pytest.mark.parametrize(
+    ("signum", "code", "said"),
+    [(signal.SIGINT, 130, "dvqp: interrupted"), (signal.SIGTERM, 143, "dvqp: terminated")],
+    ids=["SIGINT", "SIGTERM"],
+)
+@pytest.mark.parametrize(
     "args",
     [
         ["plan", "{scene}", "--backend", "pinv", "-o", "{tmp}/t.npz"],
@@ -463,7 +468,9 @@ LONG = "[[motion.jog]]\nduration = 7500.0\nvelocity = [0.0, 0.0, 0.0, 0.0]"  # 1
 @pytest.mark.skipif(
     not sys.platform.startswith("linux"), reason="workers are forked (inherit the handler) on Linux"
 )
-def test_a_real_sigint_stops_cleanly_with_exit_130(tmp_path: Path, args: list[str]) -> None:
+def test_a_real_sigint_or_sigterm_stops_cleanly_with_one_line(
+    tmp_path: Path, args: list[str], signum: int, code: int, said: str
+) -> None:
     scene = write_scene(tmp_path, motion=LONG)
     write_scene(tmp_path, "two", motion=LONG)
     argv = [a.format(scene=scene, tmp=tmp_path) for a in args]
@@ -477,10 +484,10 @@ def test_a_real_sigint_stops_cleanly_with_exit_130(tmp_path: Path, args: list[st
     note = proc.stderr.readline()  # announced before the run starts
     assert note.startswith(f"dvqp: note: {scene}: about 1.5e+06 steps"), note
     time.sleep(0.3)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(signum)
     out, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130 and out == ""
-    assert err.splitlines()[-1] == "dvqp: interrupted" and "Traceback" not in err
+    assert proc.returncode == code and out == ""
+    assert err.splitlines()[-1] == said and "Traceback" not in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml", "two.toml"]
 
 
@@ -491,8 +498,9 @@ def test_a_run_too_big_for_the_memory_is_refused_before_it_starts(
     scene = write_scene(tmp_path, motion=LONG)
     assert main(["plan", scene, "--backend", "pinv", "-o", str(tmp_path / "t.npz")]) == 2
     assert capsys.readouterr().err == (
-        f"dvqp: {scene}: motion: about 1.5e+06 steps: roughly 2.5 min and 1.7 GB, more than this "
-        "machine's 0.1 GB allow: use a larger dt or a shorter motion\n"
+        f"dvqp: {scene}: motion: about 1.5e+06 steps (2.1 h of motion in steps of 0.005 s): "
+        "roughly 2.5 min and 1.7 GB, more than this machine's 0.1 GB allow: use a larger dt or "
+        "a shorter motion\n"
     )
     assert [p.name for p in tmp_path.iterdir()] == ["small.toml"]
 

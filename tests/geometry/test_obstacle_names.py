@@ -30,7 +30,7 @@ def named(name: str) -> str:
 def damper_labels(scene_text: str) -> tuple[str, ...]:
     scene = loads(scene_text, SRC)
     (damper,) = (lim for lim in scene.limits if isinstance(lim, ObstacleDamper))
-    return damper.labels(scene.robot.n_points)
+    return damper.labels(scene.robot.part_names)
 
 
 def test_without_names_labels_index_the_obstacles_from_0_as_scene_errors_do() -> None:

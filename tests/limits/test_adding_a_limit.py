@@ -20,6 +20,7 @@ from dvqp.errors import SceneError
 from dvqp.limits.damper import Distances, fresh_rows
 from dvqp.limits.registry import SCENE_LIMITS, register_limit, unregister_limit
 from dvqp.scenes.scene import loads
+from dvqp.workspace import PartNames
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENE = ROOT / "scenes" / "paper-two-inlets.toml"
@@ -48,8 +49,8 @@ class ProbeFloor(dvqp.VelocityDamper):
     def safe(self) -> float:
         return self.floor
 
-    def labels(self, k: int, rail: bool = False) -> tuple[str, ...]:
-        return ("probe/floor",)
+    def labels(self, names: PartNames) -> tuple[str, ...]:
+        return (f"{names.probe}/floor",)
 
     def distances(self, state: dvqp.KinematicState) -> Distances:
         distance, gradient, usable = fresh_rows(1, state.n)

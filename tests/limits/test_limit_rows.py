@@ -39,7 +39,7 @@ from dvqp.limits import (
 )
 from dvqp.limits.self_collision import pair_distances
 from dvqp.objective import ObstaclePoints, OrbitalLevel
-from dvqp.workspace import PairBuffers, as_struct
+from dvqp.workspace import PairBuffers, PartNames, as_struct
 from tests import stepping
 from tests.common import LINK_LENGTHS, PIPE_RADIUS
 from tests.limit_fixtures import (
@@ -207,7 +207,7 @@ class Compiled(VelocityDamper):
     def safe(self) -> float:
         return self.z_min
 
-    def labels(self, k: int) -> tuple[str, ...]:
+    def labels(self, names: PartNames) -> tuple[str, ...]:
         return ("tool/z",)
 
     def kernel(self, plan: StepPlan) -> Kernel:

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from dvqp import KinematicState, Robot
+from dvqp import KinematicState, PartNames, Robot
 from dvqp.errors import ParameterError
 from dvqp.limits import SelfCollision, self_distance
 from dvqp.limits.self_collision import pair_distances
@@ -66,7 +66,7 @@ def test_pairs_are_the_non_adjacent_links() -> None:
         (1, 4),
         (2, 4),
     ]
-    assert SelfCollision().labels(5) == (
+    assert SelfCollision().labels(PartNames.numbered(5)) == (
         "link1/link3",
         "link1/link4",
         "link1/holder",
@@ -77,7 +77,7 @@ def test_pairs_are_the_non_adjacent_links() -> None:
     railed = PairBuffers.allocate(5, rail=True)  # the carriage link (5) against all but link1
     pairs = list(zip(railed.i.tolist(), railed.j.tolist(), strict=True))
     assert [p for p in pairs if 5 in p] == [(1, 5), (2, 5), (3, 5), (4, 5)] and len(pairs) == 10
-    assert SelfCollision().labels(5, rail=True)[-1] == "holder/carriage"
+    assert SelfCollision().labels(PartNames.numbered(5, rail=True))[-1] == "holder/carriage"
 
 
 def test_rows_are_minus_the_gradient_of_the_link_distances(robot: Robot) -> None:
@@ -108,7 +108,7 @@ def test_only_pairs_within_the_margin_plus_influence_add_rows(robot: Robot) -> N
 
 
 def test_the_smallest_distance_names_its_pair(robot: Robot) -> None:
-    names = SelfCollision().labels(5, robot.has_rail)
+    names = SelfCollision().labels(robot.part_names)
     for q in random_configurations(4, seed=43, spread=0.8):
         state = KinematicState.compute(robot, q, PIPE_RADIUS)
         d, pair = self_distance(state)
@@ -129,7 +129,7 @@ def test_the_excess_names_the_pair_that_folded_closer_than_at_the_start(robot: R
     over = at_start - at_q
     assert found.value == pytest.approx(over.max(), abs=1e-12) and found.value > 0
     assert found.quantity == "self distance" and found.unit == "m"
-    assert over[SelfCollision().labels(5, rail=True).index(found.label)] == pytest.approx(
+    assert over[SelfCollision().labels(robot.part_names).index(found.label)] == pytest.approx(
         found.value
     )
 

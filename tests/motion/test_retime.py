@@ -15,6 +15,7 @@ from dvqp.errors import RetimingError
 from dvqp.limits import AccelerationLimit
 from dvqp.retime import DEFAULT_RATE, Retimed, retime
 from dvqp.retime.parameterise import sampled
+from dvqp.retime.retimed import traced_share
 from tests import safety
 from tests.runs import BUNDLED, run, scene
 
@@ -216,3 +217,10 @@ def test_samples_of_the_wrong_shape_or_times_that_do_not_increase_are_refused() 
     for q, t in ((planned.q, backwards), (planned.q + np.nan, planned.t)):
         with pytest.raises(ParameterError, match=r"^q, t: must be finite, t increasing"):
             retime(s, q, t)
+
+
+def test_the_share_of_the_path_traced_counts_each_joints_back_and_forth() -> None:
+    there_and_back = np.array([[0.0, 0.0], [1.0, 0.5], [0.0, 1.0]])  # joint 1 out and back
+    assert traced_share(there_and_back, there_and_back) == 1.0
+    assert traced_share(there_and_back, there_and_back[[0, 2]]) == pytest.approx(0.5)  # 0 and 1
+    assert traced_share(there_and_back[:1].repeat(3, axis=0), there_and_back[:1]) == 1.0

@@ -109,3 +109,20 @@ def test_plan_retime_without_toppra_says_how_to_install_it(
     err = capsys.readouterr().err
     assert no_traceback(err) and err.endswith("pip install 'dvqp[retime]'\n")
     assert not (tmp_path / "r.csv").exists()
+
+
+def test_a_rate_too_low_for_the_path_is_warned_of_on_stderr(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "slow.jt.json"
+    assert main(["plan", PAPER, "--retime", "--rate", "0.01", "-o", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert "2 samples at 0.01 Hz, limits kept" in captured.out
+    assert captured.err == (
+        f"dvqp: warning: {PAPER}: retimed at 0.01 Hz, its 2 samples trace 31% of the planned "
+        "path (a controller going straight from one to the next leaves it): use a higher "
+        "--rate\n"
+    )
+    assert len(json.loads(out.read_text(encoding="utf-8"))["points"]) == 2  # written all the same
+    assert main(["plan", PAPER, "--retime", "--rate", "20", "-o", str(out)]) == 0
+    assert capsys.readouterr().err == ""  # 26 samples trace the path

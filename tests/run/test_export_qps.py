@@ -7,6 +7,11 @@ damper stops the probe, so 32 strict problems are infeasible and their relaxed p
 from __future__ import annotations
 
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 import warnings
 from collections import Counter
 from pathlib import Path
@@ -78,12 +83,19 @@ def scene_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="module")
 def exported(scene_file: Path, tmp_path_factory: pytest.TempPathFactory):
-    """The export, and every backend call of the same run as a watcher of plan saw it."""
+    """The export, every backend call of the same run as a watcher of plan saw it, and each
+    call's inequality rows (``G``, ``h``: every fixed row of the run)."""
     scene = dvqp.load_scene(scene_file)
     seen: list[tuple[int, str, bool]] = []
-    dvqp.plan(scene, "daqp", watch=lambda step, kind, p, s: seen.append((step, kind, s.found)))
+    rows: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def watch(step: int, kind: str, p: solvers.Problem, s: solvers.Solution) -> None:
+        seen.append((step, kind, s.found))
+        rows.append((np.array(p.G), np.array(p.h)))
+
+    dvqp.plan(scene, "daqp", watch=watch)
     folder = tmp_path_factory.mktemp("export") / "qps"
-    return dvqp.export_qps(scene, "daqp", folder), seen
+    return dvqp.export_qps(scene, "daqp", folder), seen, rows
 
 
 def load(folder: Path, entry: dict) -> tuple[qpsolvers.Problem, dict[str, np.ndarray]]:
@@ -92,7 +104,7 @@ def load(folder: Path, entry: dict) -> tuple[qpsolvers.Problem, dict[str, np.nda
 
 
 def test_every_backend_call_is_one_file_named_by_its_step_and_call(exported) -> None:
-    export, seen = exported
+    export, seen, _ = exported
     problems = export.index["problems"]
     names, calls = [], Counter()
     for step, _, _ in seen:  # the names from the calls the watcher saw, in order
@@ -113,7 +125,7 @@ def test_every_backend_call_is_one_file_named_by_its_step_and_call(exported) -> 
 
 
 def test_the_index_matches_the_run(exported) -> None:
-    export, _ = exported
+    export = exported[0]
     index, traj = export.index, export.trajectory
     assert json.loads((export.folder / INDEX).read_text()) == index
     assert (index["scene"], index["backend"], index["steps"]) == ("clamp-ahead", "daqp", 80)
@@ -130,6 +142,24 @@ def test_the_index_matches_the_run(exported) -> None:
             assert strict["refusal"] == "infeasible" and e["step_status"] == "relaxed"
 
 
+def test_a_file_keeps_the_rows_that_apply_and_the_index_maps_them_to_the_runs_rows(
+    exported,
+) -> None:
+    export, _, rows = exported
+    index = export.index
+    assert index["fixed_inequalities"] == rows[0][1].shape[0] == 36
+    dropped = 0
+    for e, (G, h) in zip(index["problems"], rows, strict=True):
+        p = qpsolvers.Problem.load(str(export.folder / e["file"]))
+        kept = np.array(e["rows"], dtype=int)
+        assert np.array_equal(kept, np.flatnonzero(np.isfinite(h))), e["file"]
+        assert e["inequalities"] == kept.size == (0 if p.G is None else p.G.shape[0])
+        if kept.size:  # bitwise the run's rows, the variables of the call's kind
+            assert np.array_equal(p.G, G[kept]) and np.array_equal(p.h, h[kept])
+        dropped += h.size - kept.size
+    assert dropped > 1000  # most damper rows are far from their limit: 0 x <= +inf
+
+
 def test_each_warm_start_is_the_previous_accepted_call_of_the_same_kind(exported) -> None:
     problems = exported[0].index["problems"]
     for i, e in enumerate(problems):
@@ -142,7 +172,7 @@ def test_each_warm_start_is_the_previous_accepted_call_of_the_same_kind(exported
 def test_the_active_rows_alone_give_the_stored_answer(exported) -> None:
     """Solving with the active rows as equalities (an equality-constrained QP, by its KKT
     system) and the others dropped gives the stored x: the active set is the right one."""
-    export, _ = exported
+    export = exported[0]
     checked = 0
     for e in export.index["problems"]:
         if not e["found"]:
@@ -151,8 +181,10 @@ def test_the_active_rows_alone_give_the_stored_answer(exported) -> None:
         p, answer = load(export.folder, e)
         n = p.q.shape[0]
         eye = np.eye(n)
-        rows = [p.A, p.G[e["active_inequalities"]], eye[e["active_lower"]], eye[e["active_upper"]]]
-        rhs = [p.b, p.h[e["active_inequalities"]], p.lb[e["active_lower"]], p.ub[e["active_upper"]]]
+        active = e["active_inequalities"]
+        G, h = (p.G[active], p.h[active]) if active else (np.zeros((0, n)), np.zeros(0))
+        rows = [p.A, G, eye[e["active_lower"]], eye[e["active_upper"]]]
+        rhs = [p.b, h, p.lb[e["active_lower"]], p.ub[e["active_upper"]]]
         C, d = np.vstack(rows), np.concatenate(rhs)
         kkt = np.block([[p.P, C.T], [C, np.zeros((C.shape[0], C.shape[0]))]])
         x = np.linalg.lstsq(kkt, np.concatenate([-p.q, d]), rcond=None)[0][:n]
@@ -162,7 +194,7 @@ def test_the_active_rows_alone_give_the_stored_answer(exported) -> None:
 
 
 def test_qpsolvers_loads_each_file_and_osqp_and_daqp_reproduce_the_answer(exported) -> None:
-    export, _ = exported
+    export = exported[0]
     worst = {"osqp": 0.0, "daqp": 0.0}
     for e in export.index["problems"]:
         problem, answer = load(export.folder, e)
@@ -176,8 +208,29 @@ def test_qpsolvers_loads_each_file_and_osqp_and_daqp_reproduce_the_answer(export
     assert max(worst.values()) < X_TOLERANCE, worst
 
 
+def test_daqp_through_qpsolvers_gives_an_optimal_solution_by_qpsolvers_own_check(
+    exported,
+) -> None:
+    """qpsolvers' ``Solution.is_optimal`` (primal and dual residuals and the duality gap
+    ``|xᵀPx + qᵀx + bᵀy + hᵀz + …|``, which a row with ``h = +inf`` made NaN) holds for every
+    problem dvqp answered; the others are infeasible for DAQP too."""
+    export = exported[0]
+    optimal = 0
+    for e in export.index["problems"]:
+        problem, _ = load(export.folder, e)
+        assert problem.h is None or np.all(np.isfinite(problem.h)), e["file"]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            solution = qpsolvers.solve_problem(problem, "daqp")
+        assert solution.found == e["found"], e["file"]
+        if e["found"]:
+            assert np.isfinite(solution.duality_gap()) and solution.is_optimal(1e-9), e["file"]
+            optimal += 1
+    assert optimal == len(export.index["problems"]) - 32 == 79
+
+
 def test_the_stored_answer_passes_solvers_residual_check_on_the_file(exported) -> None:
-    export, _ = exported
+    export = exported[0]
     tolerance = export.index["tolerance"]
     for e in export.index["problems"]:
         p, answer = load(export.folder, e)
@@ -284,3 +337,149 @@ def test_an_export_under_a_tier_is_reproduced_within_the_tiers_tolerance(
                 warnings.simplefilter("ignore")
                 found = qpsolvers.solve_problem(problem, name, **settings)
             assert np.abs(found.x - answer["x"]).max() < tolerance, (e["file"], name)
+
+
+def names_in(folder: Path) -> list[str]:
+    """Every path under ``folder`` (hidden ones too), relative, sorted."""
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*"))
+
+
+def export(scene_file: Path, out: object, *extra: str) -> int:
+    return main(["export-qps", str(scene_file), "-o", str(out), *extra])
+
+
+def test_force_replaces_only_what_the_earlier_export_wrote_or_names_what_it_would_lose(
+    scene_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "qps"
+    assert export(scene_file, out) == 0
+    (out / "notes.txt").write_text("mine")
+    (out / ANSWERS / "mine.npz").write_text("mine too")
+    (out / "plots").mkdir()
+    before = names_in(tmp_path)
+    index = (out / INDEX).read_text()
+    capsys.readouterr()
+    assert export(scene_file, out, "--force", "--backend", "osqp") == 2
+    assert capsys.readouterr().err == (
+        f"dvqp: output: {out}: --force replaces only what an earlier export wrote; it also "
+        "holds 3 other files: answers/mine.npz, notes.txt, plots/ (move them away)\n"
+    )
+    assert names_in(tmp_path) == before and (out / INDEX).read_text() == index
+    for extra in (out / "notes.txt", out / ANSWERS / "mine.npz"):
+        extra.unlink()
+    (out / "plots").rmdir()
+    assert export(scene_file, out, "--force", "--backend", "osqp") == 0
+    assert json.loads((out / INDEX).read_text())["backend"] == "osqp"
+    assert not [n for n in names_in(tmp_path) if "/." in f"/{n}"]  # nothing hidden left
+
+
+def test_force_through_a_link_fills_the_linked_folder_and_keeps_link_and_folder(
+    scene_file: Path, tmp_path: Path
+) -> None:
+    real, link = tmp_path / "qps", tmp_path / "latest"
+    assert export(scene_file, real) == 0
+    real.chmod(0o750)
+    link.symlink_to("qps")
+    inode = real.stat().st_ino
+    assert export(scene_file, link, "--force", "--backend", "osqp") == 0
+    assert link.is_symlink() and os.readlink(link) == "qps"
+    assert real.stat().st_ino == inode and real.stat().st_mode & 0o777 == 0o750
+    assert json.loads((real / INDEX).read_text())["backend"] == "osqp"
+    assert sorted(os.listdir(tmp_path)) == ["latest", "qps"]
+
+
+def test_force_on_a_read_only_export_is_refused_and_leaves_it(
+    scene_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "qps"
+    assert export(scene_file, out) == 0
+    before = names_in(tmp_path)
+    out.chmod(0o555)  # read-only by intent: refused even for the superuser
+    capsys.readouterr()
+    assert export(scene_file, out, "--force") == 2
+    assert capsys.readouterr().err == f"dvqp: output: {out}: read-only: not replaced\n"
+    out.chmod(0o755)
+    assert names_in(tmp_path) == before
+
+
+def test_dot_and_dotdot_name_the_folder_they_resolve_to(
+    scene_file: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    out = tmp_path / "qps"
+    out.mkdir()
+    monkeypatch.chdir(out)
+    assert export(scene_file, ".") == 0  # an empty folder: filled, not replaced
+    assert Path.cwd() == out and (out / INDEX).is_file()  # the shell is still in it
+    assert export(scene_file, ".", "--force", "--backend", "osqp") == 0
+    assert json.loads((out / INDEX).read_text())["backend"] == "osqp"
+    monkeypatch.chdir(tmp_path)
+    assert export(scene_file, f"qps/{ANSWERS}/..", "--force") == 0
+    assert json.loads((out / INDEX).read_text())["backend"] == "daqp"
+    assert capsys.readouterr().out.endswith(
+        "of 80 steps to qps (index.json, answers/, dvqp_qps.py)\n"
+    )
+    assert not [n for n in names_in(tmp_path) if "/." in f"/{n}"]  # no .old, no work folder
+
+
+@pytest.mark.parametrize(
+    ("index", "why"),
+    [
+        ('{"format": "dvqp export-qps 1", "problems": [', "index.json: not JSON ("),
+        (
+            '{"format": "dvqp export-qps 1", "problems": '
+            '[{"file": "../x", "answer": "answers/y"}]}',
+            "index.json lists '../x', not a file of the export",
+        ),
+        ('{"format": "other"}', "index.json is not an export's index"),
+        ("[" * 100_000, "index.json: "),
+    ],
+    ids=["truncated", "a file outside", "another format", "nested deeply"],
+)
+def test_a_damaged_or_hostile_index_is_never_trusted_by_force(
+    scene_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], index: str, why: str
+) -> None:
+    out = tmp_path / "qps"
+    out.mkdir()
+    (out / INDEX).write_text(index)
+    (tmp_path / "x").write_text("outside")
+    before = names_in(tmp_path)
+    assert export(scene_file, out, "--force") == 2
+    err = capsys.readouterr().err
+    assert err.startswith(
+        f"dvqp: output: {out}: not empty and not an export of dvqp export-qps ({why}"
+    )
+    assert err.endswith("): not replaced\n") and err.count("\n") == 1
+    assert names_in(tmp_path) == before
+
+
+def started(folder: Path, pattern: str, files: int = 10, timeout: float = 120.0) -> None:
+    """Wait until a folder matching ``pattern`` in ``folder`` holds ``files`` files."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if any(len(os.listdir(w)) >= files for w in folder.glob(pattern)):
+            return
+        time.sleep(0.05)
+    raise AssertionError(f"no {pattern} with {files} files in {folder} after {timeout} s")
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="signals as on Linux")
+@pytest.mark.parametrize("earlier", [False, True], ids=["new folder", "over an earlier export"])
+def test_sigterm_during_an_export_leaves_nothing_behind(
+    scene_file: Path, tmp_path: Path, earlier: bool
+) -> None:
+    long = tmp_path / "long.toml"
+    long.write_text(SCENE.replace("duration = 0.2", "duration = 60.0"), encoding="utf-8")
+    out = tmp_path / "qps"
+    if earlier:
+        assert export(scene_file, out) == 0
+    before = names_in(tmp_path)
+    argv = [sys.executable, "-m", "dvqp", "export-qps", str(long), "-o", str(out), "--force"]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    started(out if earlier else tmp_path, ".dvqp-export.*" if earlier else ".qps.*")
+    proc.send_signal(signal.SIGTERM)  # what timeout, docker stop and systemd send
+    printed, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143 and printed == "" and err == "dvqp: terminated\n"
+    assert names_in(tmp_path) == before  # the earlier export as it was, no work folder

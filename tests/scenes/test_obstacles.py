@@ -62,6 +62,20 @@ BAD = [
         "obstacles[0].vertices: expected an array of at least 3 vertices [l, z]",
     ),
     (
+        'shape = "polygon"\nvertices = [0.4, 0.6, 0.5, 0.7, 0.45]',
+        "obstacles[0].vertices: expected vertices as pairs [[l, z], ...], got a flat list of 5 "
+        "numbers (an odd count: not even pairs)",
+    ),
+    (
+        'shape = "polygon"\nvertices = [0.4, 0.6, 0.5, 0.7, 0.45, 0.8]',
+        "obstacles[0].vertices: expected vertices as pairs [[l, z], ...], got a flat list of 6 "
+        "numbers",
+    ),
+    (
+        'shape = "polygon"\nvertices = [[0.4, 0.6], [0.5, 0.7], [0.45, 0.8, 0.9]]',
+        "obstacles[0].vertices[2]: expected an array of 2 numbers, got 3 values",
+    ),
+    (
         'shape = "polygon"\nvertices = [[0.4, 0.6], [0.5, 0.7], [0.5, 0.6], [0.4, 0.7]]',
         "obstacles[0].vertices: the polygon's edges cross (it must be simple)",
     ),
@@ -79,7 +93,7 @@ BAD = [
 ]
 
 
-@pytest.mark.parametrize(("table", "message"), BAD, ids=[m.split(":")[1] for _, m in BAD])
+@pytest.mark.parametrize(("table", "message"), BAD, ids=[m.split(": ")[1][:40] for _, m in BAD])
 def test_bad_obstacles_get_one_line_naming_the_field(table: str, message: str) -> None:
     with pytest.raises(SceneError) as info:
         loads(with_obstacles("[[obstacles]]\n" + table + "\n"), SRC)

@@ -125,3 +125,35 @@ def test_solver_options_reach_plan_compare_and_bench(
     )
     summary = json.loads(out.read_text("utf-8"))["summary"]["osqp"]
     assert summary["capped_calls"] > 0 and "capped calls" in capsys.readouterr().out
+
+
+def refused_setting(folder: Path, capfd: pytest.CaptureFixture[str], option: str) -> str:
+    """``plan --backend osqp --solver-option OPTION``: exit 2, nothing on the file descriptor
+    1 (C output included), one line on stderr; the line."""
+    pytest.importorskip("osqp")
+    scene = with_solvers(folder, "")
+    assert main(["plan", str(scene), "--backend", "osqp", "--solver-option", option]) == 2
+    out, err = capfd.readouterr()
+    assert out == "" and err.count("\n") == 1
+    return err.rstrip("\n")
+
+
+def test_a_wrongly_typed_setting_is_refused_with_the_whole_message(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    err = refused_setting(tmp_path, capfd, "osqp.max_iter=abc")
+    assert err.startswith("dvqp: osqp: settings max_iter refused: osqp: adapter error: TypeError: ")
+    # the message pybind11 spreads over lines, whole: the types it takes and what it was given
+    assert "The following argument types are supported: 1. (" in err
+    assert "Invoked with: " in err and err.endswith("'abc'")
+
+
+def test_a_setting_out_of_its_range_says_osqps_own_reason_on_stderr(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    err = refused_setting(tmp_path, capfd, "osqp.eps_abs=-1")  # OSQP prints it, to stdout
+    assert err == (
+        "dvqp: osqp: settings eps_abs refused: ERROR in validate_settings: eps_abs must be "
+        "nonnegative; ERROR in osqp_setup: Solver settings validation. (osqp raised "
+        "OSQPException: 2)"
+    )

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import re
+import signal
 import sys
 import urllib.request
 from pathlib import Path
@@ -107,3 +108,36 @@ def test_the_command_prints_one_url_line_serves_it_and_ends_on_ctrl_c(saved: Pat
             assert page.status == 200
         out, err = interrupted(proc)
     assert proc.returncode == 130 and out == "" and err == "dvqp: interrupted\n"
+
+
+@pytest.mark.parametrize("host", ["0.0.0.0", "::", "192.168.1.20", "viewer.example"])
+def test_an_address_other_than_the_loopback_is_refused_without_insecure(
+    host: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    pytest.importorskip("viser", reason="the view extra is not installed")
+    assert main(["view", str(PAPER), "--host", host, "--port", "0"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err == (
+        f"dvqp: --host {host}: not a loopback address, and the view has no access token: "
+        "anyone who reaches it sees the run (add --insecure to serve it there anyway, on a "
+        "network you trust)\n"
+    )
+
+
+def test_with_insecure_it_serves_on_the_network_and_warns_on_stderr() -> None:
+    pytest.importorskip("viser", reason="the view extra is not installed")
+    argv = [sys.executable, "-m", "dvqp", "view", str(PAPER), "--host", "0.0.0.0", "--port", "0"]
+    with serving([*argv, "--insecure"], ROOT) as proc:
+        line = proc.stdout.readline().rstrip("\n")  # type: ignore[union-attr]
+        found = re.match(r"^http://0\.0\.0\.0:(\d+)/$", line)
+        assert found, line
+        warning = proc.stderr.readline()  # type: ignore[union-attr]
+        assert (
+            warning
+            == f"dvqp: warning: {line} has no access token: anyone who reaches it sees the run\n"
+        )
+        with urllib.request.urlopen(f"http://127.0.0.1:{found[1]}/", timeout=5) as page:
+            assert page.status == 200
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=15)
+    assert proc.returncode == 143 and out == "" and err == "dvqp: terminated\n"
