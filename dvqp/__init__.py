@@ -7,7 +7,8 @@ The pieces, from the bottom up (one subpackage each):
   :class:`KinematicState` every part reads;
 - :mod:`dvqp.geometry` — obstacle shapes and the body's proximity to them;
 - :mod:`dvqp.tasks`, :mod:`dvqp.objective`, :mod:`dvqp.limits` — what a step is made of:
-  tasks (:class:`ToolTask`), the objective ``w(Q)`` (:class:`Objective`), limits, each one
+  tasks (:class:`ToolTask`, :class:`PointTask`, :class:`PostureTask`, :class:`FrameTask`,
+  each at a priority), the objective ``w(Q)`` (:class:`Objective`), limits, each one
   class with its compiled kernel in its module;
 - :mod:`dvqp.resolution` — :class:`StepSpec`, the QP and pseudoinverse resolvers, their names;
 - :mod:`dvqp.step` — the compiled step (:class:`Stepper`) and one verified step (``advance``);
@@ -29,6 +30,7 @@ from dvqp.errors import (
     SceneError,
     ShapeError,
     SingularConfigurationError,
+    TaskLevelError,
     UnreachableTargetError,
 )
 from dvqp.geometry import Obstacle, ObstacleSet
@@ -42,7 +44,7 @@ from dvqp.run.planning import check_run, plan
 from dvqp.run.qp_export import export_qps
 from dvqp.scenes import Scene, load_scene
 from dvqp.step import Stepper
-from dvqp.tasks import Task, TaskRows, ToolTask
+from dvqp.tasks import FrameTask, PointTask, PostureTask, Task, TaskRows, ToolTask
 from dvqp.workspace import Kernel, PartNames, StepPlan
 
 __all__ = [
@@ -51,6 +53,7 @@ __all__ = [
     "Constraint",
     "Distances",
     "DvqpError",
+    "FrameTask",
     "InputFileError",
     "JogSegment",
     "Kernel",
@@ -63,6 +66,8 @@ __all__ = [
     "ObstacleSet",
     "ParameterError",
     "PartNames",
+    "PointTask",
+    "PostureTask",
     "PseudoinverseResolver",
     "QPResolver",
     "Resolver",
@@ -77,6 +82,7 @@ __all__ = [
     "StepSpec",
     "Stepper",
     "Task",
+    "TaskLevelError",
     "TaskRows",
     "Term",
     "ToolPath",

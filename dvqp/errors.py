@@ -44,6 +44,16 @@ class ParameterError(DvqpError, ValueError):
         super().__init__(f"{name}: {reason}")
 
 
+class TaskLevelError(ParameterError):
+    """A level of hard tasks cannot be met even alone, whatever the limits: ``level`` (1 the
+    highest priority's), its tasks' labels ``tasks`` and ``why`` (more rows than joints, or
+    rows dependent at the start). Its ``name`` is ``"tasks"``."""
+
+    def __init__(self, level: int, tasks: str, why: str) -> None:
+        self.level, self.tasks, self.why = level, tasks, why
+        super().__init__("tasks", f"level {level} ({tasks}) cannot be met even alone: {why}")
+
+
 class SingularConfigurationError(DvqpError, ArithmeticError):
     """The developed view or the task Jacobian is singular at this configuration.
 

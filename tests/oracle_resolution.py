@@ -1,7 +1,8 @@
 """Independent oracles for the resolution, step and run tests (none of dvqp's step code).
 
 - :func:`eq18`, :func:`kkt`: the baseline's step as the paper writes it (eq. 18, weighted), and
-  the minimiser of the equality-constrained QP from its KKT system;
+  the minimiser of the equality-constrained QP from its KKT system; :func:`nested`: strict
+  priorities by null-space bases (SVD);
 - :func:`frames`: the guarded frames, their developed-view coordinates and the tool's from
   Pinocchio (not dvqp's compiled kinematics);
 - :func:`point_distances`, :func:`link_distances`: every shape's signed distance in NumPy (a
@@ -66,6 +67,26 @@ def kkt(jac: Array, xdot: Array, g: Array, metric: Array) -> Array:
     n, m = jac.shape[1], jac.shape[0]
     system = np.block([[metric, jac.T], [jac, np.zeros((m, m))]])
     return np.linalg.solve(system, np.concatenate([g, xdot]))[:n]  # type: ignore[no-any-return]
+
+
+def nested(levels: Sequence[tuple[Array, Array]], g: Array, weights: Array) -> Array:
+    """Strict priorities without inequalities, by null-space bases (SVD), not by dvqp's
+    recursion: in ``y = W^½ Q̇`` each level ``(J_k, v_k)`` is solved in least squares within the
+    basis ``Z`` of what the levels above leave free, ``Z`` then shrinks to the part of it that
+    ``J_k`` does not move, and ``W^-½ g`` is added projected on the last ``Z``: the
+    lexicographic minimiser of the levels' residuals, then of ``½ Q̇ᵀWQ̇ − gᵀQ̇``."""
+    root = np.sqrt(np.asarray(weights, dtype=float))
+    n = root.shape[0]
+    y, basis = np.zeros(n), np.eye(n)
+    for jac, v in levels:
+        moved = (jac / root) @ basis  # J W^-½ Z
+        z = np.linalg.lstsq(moved, v - (jac / root) @ y, rcond=1e-12)[0]
+        y = y + basis @ z
+        _, s, vt = np.linalg.svd(moved)
+        rank = int(np.sum(s > 1e-10 * max(s.max(initial=0.0), 1.0)))
+        basis = basis @ vt[rank:].T
+    y = y + basis @ (basis.T @ (g / root))
+    return y / root  # type: ignore[no-any-return]
 
 
 # -- kinematics -------------------------------------------------------------------------------

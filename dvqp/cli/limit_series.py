@@ -73,16 +73,25 @@ class Curve:
 @dataclass(frozen=True)
 class LimitPage:
     """Every curve of a run, in panel order, and its marked steps: ``marks[kind]`` the start
-    times (s) of the steps of each kind of :data:`MARKS` (``"split"``: into substeps)."""
+    times (s) of the steps of each kind of :data:`MARKS` (``"split"``: into substeps); and, for
+    a run with more than one level of hard tasks, each level's error over time (``levels``:
+    curves against 0, not limits: a level gives way where the limits or a level above need it).
+    """
 
     curves: tuple[Curve, ...]
     marks: dict[str, Array]
     dt: float
+    levels: tuple[Curve, ...] = ()
 
     @property
     def panels(self) -> list[str]:
-        """The panels, in order."""
+        """The panels of the limits, in order."""
         return list(dict.fromkeys(c.panel for c in self.curves))
+
+    @property
+    def level_panels(self) -> list[str]:
+        """The panels of the levels' errors (lengths, angles), after the limits'."""
+        return list(dict.fromkeys(c.panel for c in self.levels))
 
 
 def limit_series(scene: Scene, traj: Trajectory) -> LimitPage:
@@ -120,7 +129,7 @@ def limit_series(scene: Scene, traj: Trajectory) -> LimitPage:
     curves += _rates(traj, stepper, dt)
     order = ["clearance", "self distance", "height", "tilt"]
     curves.sort(key=lambda c: order.index(c.panel) if c.panel in order else len(order))
-    return LimitPage(tuple(curves), _marks(traj), dt)
+    return LimitPage(tuple(curves), _marks(traj), dt, tuple(_levels(traj)))
 
 
 def _groups(block: Block, scene: Scene) -> list[tuple[str, str, slice | list[int]]]:
@@ -201,6 +210,25 @@ def _rates(traj: Trajectory, stepper: Stepper, dt: float) -> list[Curve]:
             if np.isfinite(limit[i])
         ]
     return curves
+
+
+LEVEL_PANELS = ("task level error (m)", "task level error (rad)")
+"""The panels of a run with more than one level: each level's error over time (its tasks'
+:meth:`~dvqp.Task.deviation`), lengths and angles, against 0."""
+
+
+def _levels(traj: Trajectory) -> list[Curve]:
+    """Each level's worst length and angle error at every sample (a run with more than one
+    level; none else), bound 0 (kept exactly)."""
+    d, measured = traj.level_deviation, traj.level_measured
+    if len(traj.levels) < 2 or d.shape[:2] != (traj.t.shape[0], len(traj.levels)):
+        return []
+    return [
+        Curve(panel, f"level {k + 1}: {name}", traj.t, d[:, k, u], 0.0, 0.0, unit, upper=True)
+        for u, (panel, unit) in enumerate(zip(LEVEL_PANELS, ("m", "rad"), strict=True))
+        for k, name in enumerate(traj.levels)
+        if measured[k, u]
+    ]
 
 
 def _marks(traj: Trajectory) -> dict[str, Array]:

@@ -41,6 +41,8 @@ TITLES = {
     "joint position": "joint position, fraction of its half range from the middle",
     "joint speed": "joint speed |q̇|, fraction of q̇_max",
     "joint acceleration": "joint acceleration |q̈|, fraction of q̈_max",
+    "task level error (m)": "task levels: worst length error from what each holds (m)",
+    "task level error (rad)": "task levels: worst angle error from what each holds (rad)",
 }
 
 
@@ -56,13 +58,15 @@ def plot_limits(page: LimitPage, path: str | Path, title: str = "") -> Path:
         matplotlib is not installed.
     """
     target = output_path(path, FIGURE_FORMATS)
-    panels = page.panels
+    panels = page.panels + page.level_panels
     rows = max(1, (len(panels) + 1) // 2)
     fig = new_figure((13.0, 2.9 * rows + 0.9))
     axes = fig.subplots(rows, 2, squeeze=False).ravel()
     span = (min(float(c.t[0]) for c in page.curves), max(float(c.t[-1]) for c in page.curves))
+    curves = (*page.curves, *page.levels)
     for i, (ax, panel) in enumerate(zip(axes, panels, strict=False)):
-        _draw_panel(ax, panel, [c for c in page.curves if c.panel == panel], page)
+        limit = panel in page.panels  # else a level's error: no bound
+        _draw_panel(ax, panel, [c for c in curves if c.panel == panel], page, limit)
         ax.set_xlim(span[0], span[1] + page.dt)
         if i + 2 >= len(panels):  # the lowest panel of its column
             ax.set_xlabel("t (s)")
@@ -78,8 +82,11 @@ def plot_limits(page: LimitPage, path: str | Path, title: str = "") -> Path:
     return save_figure(fig, target, dpi=110)
 
 
-def _draw_panel(ax: Axes, panel: str, curves: list[Curve], page: LimitPage) -> None:
-    """The curves of one panel, their bounds (the forbidden side shaded) and the marks."""
+def _draw_panel(
+    ax: Axes, panel: str, curves: list[Curve], page: LimitPage, bounded: bool = True
+) -> None:
+    """The curves of one panel, their bounds (the forbidden side shaded; none if not
+    ``bounded``) and the marks."""
     ranked = sorted(curves, key=lambda c: -float(np.max(c.past / max(abs(c.bound), 1e-3))))
     for rank, c in enumerate(ranked):
         step = "steps-post" if c.panel in ("joint speed", "joint acceleration") else "default"
@@ -95,9 +102,10 @@ def _draw_panel(ax: Axes, panel: str, curves: list[Curve], page: LimitPage) -> N
                 zorder=2,
                 label="others" if rank == NAMED else None,
             )
-    bounds = dict.fromkeys((c.bound, c.upper) for c in curves)
+    bounds = dict.fromkeys((c.bound, c.upper) for c in curves) if bounded else {}
     bottom, top = ax.get_ylim()  # the bounds in view too, with room on their forbidden side
-    low, high = min(b for b, _ in bounds), max(b for b, _ in bounds)
+    low = min((b for b, _ in bounds), default=bottom)
+    high = max((b for b, _ in bounds), default=top)
     pad = 0.08 * (max(top, high) - min(bottom, low))
     bottom, top = min(bottom, low - pad), max(top, high + pad)
     for bound, upper in bounds:

@@ -16,6 +16,7 @@ from dvqp.errors import one_line
 from dvqp.limits import start_broken_lines
 from dvqp.run.comparison import Row
 from dvqp.run.comparison import rows_to_csv as rows_to_csv  # part of this module's API (docs)
+from dvqp.run.levels import level_figures
 from dvqp.run.table_text import aligned, cell
 
 if TYPE_CHECKING:
@@ -67,6 +68,7 @@ WIDE_TABLE = (  # (row key, header, format)
     ("failures", "fails", "{}"),
     ("final_joint_speed", "end qd", "{:.3g}"),
     ("braking_time", "brake s", "{:.3f}"),
+    ("levels_gave_way", "levels gave way", "{}"),
 )
 """Every column (``--wide``)."""
 
@@ -82,10 +84,13 @@ def format_table(rows: Sequence[Row], wide: bool = False) -> str:
 
 def footer_lines(rows: Sequence[Row], width: int = 100) -> list[str]:
     """Why a run is not ``ok`` (its error) or ``ok`` but not ``tracked`` (safe, every limit
-    kept, yet the tool left the commanded motion), wrapped to ``width`` characters."""
+    kept, yet the tool left the commanded motion), and how each level of a run with more than
+    one fared, wrapped to ``width`` characters."""
     notes = []
     for r in rows:
         name = f"{r['scene']} / {r['backend']}"
+        if r.get("level_detail"):
+            notes.append(f"{name}: {r['level_detail']}")
         if r["error"]:
             notes.append(f"{name}: {r['error']}")
         elif r.get("tracked") is False:
@@ -108,6 +113,7 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         f"backend         {traj.backend}",
         f"steps           {_steps(row)}",
         f"result          {_result(row)}",
+        *_levels(traj),
         f"max task error  {cell(row['max_task_error'], '{:.2e}')}",
         f"min clearance   {cell(row['min_clearance'], '{:+.4f} m')}"
         + (f" ({row['closest']})" if row["closest"] else ""),
@@ -138,6 +144,15 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
     if output is not None:
         lines.append(f"saved           {output}")
     return "\n".join(lines)
+
+
+def _levels(traj: Trajectory) -> list[str]:
+    """``level 1         tool h, alpha: kept exactly; worst error 0.0068 mm, 4.8e-05 rad``: one
+    line a level, for a run with more than one."""
+    levels = level_figures(traj)
+    if len(levels) < 2:
+        return []
+    return [f"{f'level {k}':<16}{level.name}: {level.words()}" for k, level in enumerate(levels, 1)]
 
 
 def _accuracy(row: Row) -> str:

@@ -112,15 +112,20 @@ class Recording:
         """Steps recorded."""
         return len(self.steps)
 
-    def trajectory(self, pipe_radius: float, backend: str, scene_text: str) -> Trajectory:
-        """The record as a full :class:`Trajectory` (``dvqp plot`` reads its ``.npz``)."""
+    def trajectory(
+        self, pipe_radius: float, backend: str, scene_text: str, levels: tuple[str, ...] = ()
+    ) -> Trajectory:
+        """The record as a full :class:`Trajectory` (``dvqp plot`` reads its ``.npz``); the
+        step's task levels are named ``levels``."""
         first = self.samples[0]
-        recorder = TrajectoryRecorder(len(self.steps), first.q.shape[0], first.points.shape[0])
+        recorder = TrajectoryRecorder(
+            len(self.steps), first.q.shape[0], first.points.shape[0], levels=max(len(levels), 1)
+        )
         for name in SAMPLED:
             recorder.arrays[name][:] = [getattr(sample, name) for sample in self.samples]
         for k, (moved, _, took) in enumerate(self.steps):
             recorder.step(k, moved, took)
-        traj = recorder.trajectory(self.dt, pipe_radius, backend)
+        traj = recorder.trajectory(self.dt, pipe_radius, backend, levels=levels)
         commands = np.reshape([command for _, command, _ in self.steps], (-1, 4))
         reference = traj.tool[0] + np.vstack([np.zeros(4), np.cumsum(commands * self.dt, axis=0)])
         error = dv_error(reference, traj.tool, pipe_radius)

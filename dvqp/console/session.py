@@ -209,4 +209,9 @@ class ConsoleSession:
         :data:`~dvqp.console.recording.MAX_RECORD_SECONDS`), scene text included."""
         with self._lock:
             recording = self._recording.copy()
-        return recording.trajectory(self.scene.pipe_radius, self.backend, self.scene.text)
+        return recording.trajectory(
+            self.scene.pipe_radius,
+            self.backend,
+            self.scene.text,
+            self.resolver.spec.level_names,
+        )

@@ -30,10 +30,13 @@ PER_STEP = ("solve_time", "solver_time", "step_time", "task_error")
 class TrajectoryRecorder:
     """Storage for ``N + 1`` samples and the ``N = n_steps`` steps between them, of an arm of
     ``n_joints`` joints and ``n_points`` body points (and its rail point's ``[l, z, h]`` if
-    ``rail``)."""
+    ``rail``), its hard tasks in ``levels`` levels."""
 
-    def __init__(self, n_steps: int, n_joints: int, n_points: int, rail: bool = False) -> None:
+    def __init__(
+        self, n_steps: int, n_joints: int, n_points: int, rail: bool = False, levels: int = 1
+    ) -> None:
         self.arrays: dict[str, np.ndarray] = {
+            "level_error": np.zeros((n_steps, levels)),
             "q": np.zeros((n_steps + 1, n_joints)),
             "qdot": np.zeros((n_steps, n_joints)),
             "tool": np.zeros((n_steps + 1, 4)),
@@ -57,6 +60,7 @@ class TrajectoryRecorder:
         a["solve_time"][k], a["step_time"][k] = step.solve_time, step_time
         a["solver_time"][k] = step.solver_time
         a["task_error"][k], a["success"][k] = step.task_error, step.success
+        a["level_error"][k] = step.task_error if step.level_error is None else step.level_error
         a["iterations"][k] = -1 if step.iterations is None else step.iterations
         a["substeps"][k] = moved.substeps
         self.status[k] = step.status
@@ -83,13 +87,15 @@ class TrajectoryRecorder:
         start_broken: tuple[StartBroken, ...] = (),
         refusals: dict[str, int] | None = None,
         accuracy: dict[str, float] | None = None,
+        levels: tuple[str, ...] = (),
     ) -> Trajectory:
         """The first ``steps`` (default all) recorded steps and their samples (l and α
         unwrapped), with ``qddot``: the change of joint velocity at the start of each step over
         dt (the run starts at rest), rad/s²; ``brake_start`` the first braking step (−1: none);
         the limits the start broke (:meth:`dvqp.step.Stepper.start_broken`); the backend calls
         refused, by kind (:attr:`dvqp.resolution.qp.QPSolver.refusals`), and their accuracy
-        (:meth:`solvers.accuracy.AccuracyTally.to_dict`)."""
+        (:meth:`solvers.accuracy.AccuracyTally.to_dict`); the names of the levels of its hard
+        tasks (priority order)."""
         n = self.arrays["qdot"].shape[0]
         steps = n if steps is None else steps
         kept = {name: a[: max(steps + a.shape[0] - n, 0)] for name, a in self.arrays.items()}
@@ -105,5 +111,6 @@ class TrajectoryRecorder:
             start_broken=start_broken,
             refusals=dict(refusals or {}),
             accuracy=dict(accuracy or {}),
+            levels=tuple(levels),
             **kept,
         )

@@ -155,7 +155,10 @@ def simulate(
     check = resolver.holds_limits if verify is None else verify
     q_start = robot.check_q(q0, "q0")
     reserved = room(robot, resolver, dt) if stop else 0  # the stop's samples, in advance
-    record = TrajectoryRecorder(cmd.shape[0] + reserved, robot.n, robot.n_points, robot.has_rail)
+    levels = resolver.spec.level_names
+    record = TrajectoryRecorder(
+        cmd.shape[0] + reserved, robot.n, robot.n_points, robot.has_rail, len(levels)
+    )
     with _noticed(notice):
         stepper = Stepper(robot, radius, resolver, q_start, dt, obstacles, record.arrays)
         stepper.start(q_start)
@@ -173,7 +176,15 @@ def simulate(
     accuracy = {} if solver is None else solver.accuracy.to_dict()
     braked = n if stop else -1
     traj = record.trajectory(
-        dt, radius, resolver.name, n + steps, braked, stepper.start_broken(), refused, accuracy
+        dt,
+        radius,
+        resolver.name,
+        n + steps,
+        braked,
+        stepper.start_broken(),
+        refused,
+        accuracy,
+        levels,
     )
     held = np.full(steps, path_time[-1])
     return dataclasses.replace(traj, path_time=np.concatenate([path_time, held]))

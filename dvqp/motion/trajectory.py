@@ -51,6 +51,9 @@ DIAGNOSTICS = (
     "holder_height",
     "rail",
     "path_time",
+    "level_error",
+    "level_deviation",
+    "level_measured",
 )
 """Arrays added since dvqp 0.2; a file written before one was added lacks it (loaded empty)."""
 
@@ -148,6 +151,19 @@ class Trajectory:
         :attr:`dvqp.resolution.qp.QPSolver.accuracy`): ``solves``,
         ``unanswered`` and the shifted geometric means ``primal_residual``, ``dual_residual``,
         ``duality_gap`` (empty: the baseline, or an older file).
+    levels : tuple of str
+        The levels of the hard tasks, by priority (1 first): what each holds (``"tool h,
+        alpha"``; empty: an older file).
+    level_error : ndarray, shape (N, L) or (0, 0)
+        Each level's residual ``‖A_k Q̇ − b_k‖∞`` per step (task units per s, m/s or rad/s;
+        ``inf`` for a failed step): 0 to the solver's tolerance where the level was kept
+        exactly, larger where it gave way. With one level, ``task_error``.
+    level_deviation : ndarray, shape (N+1, L, 2) or (0, 0, 2)
+        Each level's worst error per sample against what its tasks hold (the tool against the
+        commanded motion, a point or posture against its target; :meth:`dvqp.Task.deviation`):
+        ``[length (m), angle (rad)]``, 0 where ``level_measured`` is False.
+    level_measured : ndarray of bool, shape (L, 2) or (0, 2)
+        Whether a level's ``level_deviation`` has a length (its tasks hold one) and an angle.
     """
 
     t: NDArray[np.float64]
@@ -183,6 +199,10 @@ class Trajectory:
     brake_start: int = -1
     refusals: dict[str, int] = field(default_factory=dict)
     accuracy: dict[str, float] = field(default_factory=dict)
+    levels: tuple[str, ...] = ()
+    level_error: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 0)))
+    level_deviation: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 0, 2)))
+    level_measured: NDArray[np.bool_] = field(default_factory=lambda: np.zeros((0, 2), dtype=bool))
 
     @classmethod
     def from_samples(
@@ -278,6 +298,7 @@ class Trajectory:
                     brake_start=np.int64(self.brake_start),
                     refusals=np.str_(json.dumps(self.refusals)),
                     accuracy=np.str_(json.dumps(self.accuracy)),
+                    levels=np.str_(json.dumps(list(self.levels))),
                     meta=np.str_(json.dumps({"versions": versions(), **CONVENTIONS})),
                 )
             else:
@@ -349,6 +370,7 @@ class Trajectory:
             brake_start=int(data["brake_start"]) if "brake_start" in data else -1,
             refusals=_counts(data, "refusals"),
             accuracy=_counts(data, "accuracy"),
+            levels=_names(data, "levels"),
         )
 
 
@@ -358,10 +380,13 @@ body point, so up to 1365 body points."""
 MAX_TEXT = 1 << 24
 """Most characters of a text a trajectory file holds (its scene's text: a scene file is at
 most 16 MiB, :data:`dvqp.scenes.scene.MAX_BYTES`)."""
-TEXTS = ("backend", "scene", "start_broken", "refusals", "accuracy", "meta")
+TEXTS = ("backend", "scene", "start_broken", "refusals", "accuracy", "levels", "meta")
 """A trajectory file's texts (0-d string arrays)."""
 NUMBERS = ("pipe_radius", "brake_start")
 """A trajectory file's single numbers."""
+PER_LEVEL = ("level_measured",)
+"""A trajectory file's arrays of a row per task level (not per sample): at most
+:data:`MAX_WIDTH` levels."""
 
 
 def check_members(members: dict[str, Member]) -> list[str]:
@@ -384,6 +409,10 @@ def check_members(members: dict[str, Member]) -> list[str]:
     names = [n for n in (*ARRAYS, *DIAGNOSTICS, "tracking_error", "dv") if n in members]
     for name in names:
         m = members[name]
+        if name in PER_LEVEL:
+            if len(m.shape) != 2 or m.shape[0] > MAX_WIDTH or m.shape[1] != 2:
+                raise ValueError(f"member {name!r}: shape {m.shape}, not (levels, 2)")
+            continue
         if not m.shape or m.shape[0] not in (samples, samples - 1, 0):
             rows = m.shape[0] if m.shape else "no"
             raise ValueError(f"member {name!r}: {rows} rows for {samples} samples")
@@ -395,6 +424,16 @@ def check_members(members: dict[str, Member]) -> list[str]:
         if m.shape or (name in TEXTS and m.dtype.itemsize > 4 * MAX_TEXT):
             raise ValueError(f"member {name!r}: not a single value of a trajectory file")
     return [*names, *(n for n in (*TEXTS, *NUMBERS) if n in members)]
+
+
+def _names(data: Any, name: str) -> tuple[str, ...]:
+    """The JSON list of strings ``name`` of a loaded file (``()``: none in it)."""
+    if name not in data:
+        return ()
+    names = json.loads(str(data[name]))
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        raise ValueError(name)
+    return tuple(names)
 
 
 def _counts(data: Any, name: str) -> dict[str, Any]:

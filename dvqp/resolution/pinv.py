@@ -1,4 +1,5 @@
-"""The paper's baseline (eq. 18): pseudoinverse plus null-space projection of ``∇w``.
+"""The paper's baseline (eq. 18): pseudoinverse plus null-space projection of ``∇w``, nested
+over the levels of the tasks' priorities.
 
 It uses the same tasks and objective as the QP and ignores the limits. Weighted least-norm form
 with a positive diagonal ``W`` (``W = I`` gives eq. 18)::
@@ -10,6 +11,19 @@ which is ``W⁻¹ g + J̄_W⁺ (ẋ − J̄ W⁻¹ g)``. With ``μ = 0`` this is
 ``½ Q̇ᵀ W Q̇ − gᵀ Q̇`` subject to ``J̄ Q̇ = ẋ``: the QP without inequalities. With soft tasks
 the metric becomes ``M = W + H`` (dense) and ``g`` takes their ``−c``; ``μ > 0`` (the damped,
 singularity-robust inverse) is then refused.
+
+Tasks at several priorities (levels ``A_k Q̇ = b_k``, 1 first) are nested: each level in the
+null space of those above, ``∇w`` last in the null space of them all. With ``Q = M⁻¹`` (the
+metric's inverse on what is still free) and ``Q̇ = 0`` at first, for each level::
+
+    S_k = A_k Q A_kᵀ + μ² I
+    Q̇  += Q A_kᵀ S_k⁻¹ (b_k − A_k Q̇)            level k's task in the null space above
+    Q  −= Q A_kᵀ S_k⁻¹ A_k Q                     what level k leaves free
+
+then ``Q̇ += Q g``. ``Q`` stays ``N M⁻¹`` with ``N`` the M-orthogonal projector on the levels'
+common null space (``μ = 0``), so when no limit is active each level's answer is the QP's:
+every level is met (its ``A_k Q`` of full row rank, else the undamped inverse refuses it) and
+``Q̇`` minimises the cost among those that meet them. With one level it is the formula above.
 """
 
 from __future__ import annotations
@@ -94,53 +108,104 @@ def _solve(factor: Array, x: Array) -> None:
         x[r] = v / factor[r, r]
 
 
-@njit(separate=True)
-def pinv_step(A, b, cost, weights, P, dense, damping, info, out) -> int:  # type: ignore[no-untyped-def]
-    """``out = M⁻¹g + M⁻¹Aᵀ (A M⁻¹ Aᵀ + μ² I)⁻¹ (b − A M⁻¹ g)`` with ``g = −cost`` and
-    ``M = diag(weights)``, or the dense ``P`` if ``dense``. Returns −1, :data:`SINGULAR` (the
-    Gram matrix not safely positive definite; ``info`` its pivots' extreme squares) or
-    :data:`NOT_DEFINITE` (the metric)."""
-    m, n = A.shape
-    mj, mg = np.empty((n, m)), np.empty(n)  # M⁻¹ Aᵀ, M⁻¹ g
+@njit(inline="always")
+def _inverse(P: Array, dense: bool, weights: Array, info: Array, Q: Array) -> bool:
+    """``Q = M⁻¹``: ``diag(1/weights)``, or the dense ``P``'s inverse column by column (False
+    if ``P`` is not positive definite)."""
+    n = Q.shape[0]
+    if not dense:
+        for c in range(n):
+            Q[c, c] = 1.0 / weights[c]
+        return True
+    factor = P.copy()
+    if not _cholesky(factor, info):
+        return False
+    column = np.empty(n)
     for c in range(n):
-        mg[c] = -cost[c]
+        for r in range(n):
+            column[r] = 1.0 if r == c else 0.0
+        _solve(factor, column)
+        for r in range(n):
+            Q[r, c] = column[r]
+    return True
+
+
+@njit(inline="always")
+def _level(A, b, first, m, Q, inverse, x, damping, info, lower) -> bool:  # type: ignore[no-untyped-def]
+    """Level ``A[first : first + m]``: ``x += Q Aᵀ S⁻¹ (b − A x)`` and ``Q −= Q Aᵀ S⁻¹ A Q``;
+    False if ``S`` is not safely positive definite (``lower``: below the first level, also
+    against the level's own size through ``inverse`` = M⁻¹)."""
+    n = A.shape[1]
+    qa, gram, rhs = np.empty((n, m)), np.empty((m, m)), np.empty(m)  # Q A_kᵀ, S_k
+    for c in range(n):
         for r in range(m):
-            mj[c, r] = A[r, c]
-    if dense:
-        factor = P.copy()
-        if not _cholesky(factor, info):
-            return NOT_DEFINITE
-        _solve(factor, mg)
-        column = np.empty(n)
-        for r in range(m):
-            for c in range(n):
-                column[c] = mj[c, r]
-            _solve(factor, column)
-            for c in range(n):
-                mj[c, r] = column[c]
-    else:
-        for c in range(n):
-            mg[c] /= weights[c]
-            for r in range(m):
-                mj[c, r] /= weights[c]
-    gram, rhs = np.empty((m, m)), np.empty(m)
+            acc = 0.0
+            for j in range(n):
+                acc += Q[c, j] * A[first + r, j]
+            qa[c, r] = acc
+    scale = 0.0  # a lower level's own size, before its projection: a row Q hides
     for r in range(m):
-        v = b[r]
+        v = b[first + r]
         for c in range(n):
-            v -= A[r, c] * mg[c]
+            v -= A[first + r, c] * x[c]
         rhs[r] = v
-        for s in range(m):
+        for t in range(m):
             acc = 0.0
             for c in range(n):
-                acc += A[r, c] * mj[c, s]
-            gram[r, s] = acc
+                acc += A[first + r, c] * qa[c, t]
+            gram[r, t] = acc
         gram[r, r] += damping * damping
-    if not _cholesky(gram, info) or (damping == 0.0 and info[0] <= SINGULAR_RCOND * info[1]):
-        return SINGULAR
+        own = 0.0
+        for c in range(n if lower else 0):
+            for j in range(n):
+                own += A[first + r, c] * inverse[c, j] * A[first + r, j]
+        scale = max(scale, own)
+    if not _cholesky(gram, info) or (
+        damping == 0.0 and info[0] <= SINGULAR_RCOND * max(info[1], scale)
+    ):
+        return False
     _solve(gram, rhs)
     for c in range(n):
-        v = mg[c]
+        v = 0.0
         for r in range(m):
-            v += mj[c, r] * rhs[r]
+            v += qa[c, r] * rhs[r]
+        x[c] += v
+    column = np.empty(m)
+    for c in range(n):  # Q −= Q A_kᵀ S_k⁻¹ (Q A_kᵀ)ᵀ, column by column
+        for r in range(m):
+            column[r] = qa[c, r]
+        _solve(gram, column)
+        for i in range(n):
+            v = 0.0
+            for r in range(m):
+                v += qa[i, r] * column[r]
+            Q[i, c] -= v
+    return True
+
+
+@njit(separate=True)
+def pinv_step(A, b, levels, cost, weights, P, dense, damping, info, out) -> int:  # type: ignore[no-untyped-def]
+    """``out``: the nested step of the module docstring over the levels ``A[levels[k] :
+    levels[k+1]]`` (``levels`` (L + 1,)), with ``g = −cost`` and ``M = diag(weights)``, or the
+    dense ``P`` if ``dense``. Returns −1, :data:`SINGULAR` (a level's Gram matrix ``S_k`` not
+    safely positive definite: undamped, its smallest pivot below :data:`SINGULAR_RCOND` of its
+    largest or, below the first level, of the level's own ``max_r A_r M⁻¹ A_rᵀ``, which the
+    levels above may have hidden; ``info`` the pivots' extreme squares and the level k) or
+    :data:`NOT_DEFINITE` (the metric)."""
+    n = A.shape[1]
+    Q = np.zeros((n, n))  # M⁻¹, then what the levels leave free
+    if not _inverse(P, dense, weights, info, Q):
+        return NOT_DEFINITE
+    inverse = Q.copy() if levels.shape[0] > 2 else Q  # M⁻¹, kept for the lower levels' scale
+    x = np.zeros(n)
+    for level in range(levels.shape[0] - 1):
+        first, m = levels[level], levels[level + 1] - levels[level]
+        if m > 0 and not _level(A, b, first, m, Q, inverse, x, damping, info, level > 0):
+            info[2] = level
+            return SINGULAR
+    for c in range(n):
+        v = x[c]
+        for j in range(n):
+            v -= Q[c, j] * cost[j]
         out[c] = v
     return -1

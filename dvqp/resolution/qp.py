@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 
 import solvers
 from dvqp.errors import BackendError
+from dvqp.resolution.levels import Levels, load_relaxed, relaxed_problem, strict_problem
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 from dvqp.workspace import QPBuffers
@@ -122,33 +123,32 @@ class QPSolver:
         The problem's arrays, rewritten in place every step.
     task_weight
         ``ρ`` of the relaxed problem's slack.
+    breaks, weights
+        The first row of each level of ``A`` and the number of rows ((L + 1,); None: one
+        level), and each row's weight within its level ((m,); None: all 1).
     """
 
     def __init__(
-        self, factory: Callable[[], solvers.Backend], qp: QPBuffers, task_weight: float
+        self,
+        factory: Callable[[], solvers.Backend],
+        qp: QPBuffers,
+        task_weight: float,
+        breaks: NDArray[np.int64] | None = None,
+        weights: NDArray[np.float64] | None = None,
     ) -> None:
         self.qp = qp
-        n, m, p = qp.cost.shape[0], qp.b.shape[0], qp.h.shape[0]
-        G, h = (qp.G, qp.h) if p else (None, None)
-        self.strict = solvers.Problem.trusted(qp.P, qp.cost, qp.A, qp.b, G, h, qp.lb, qp.ub)
-        P_r = np.zeros((n + m, n + m))
-        P_r[n:, n:] = np.diag(np.full(m, task_weight))
-        A_r = np.zeros((m, n + m))
-        A_r[:, n:] = -np.eye(m)
-        G_r = np.zeros((p, n + m)) if p else None
-        inf = np.full(m, np.inf)
-        self.relaxed = solvers.Problem.trusted(
-            P_r,
-            np.zeros(n + m),
-            A_r,
-            qp.b,
-            G_r,
-            h,
-            np.concatenate([qp.lb, -inf]),
-            np.concatenate([qp.ub, inf]),
-        )
+        m = qp.b.shape[0]
+        self.strict = strict_problem(qp, m, qp.b)
+        weights = np.ones(m) if weights is None else np.asarray(weights, dtype=float)
+        self.relaxed = relaxed_problem(qp, 0, m, weights, task_weight, qp.b)
         self.backends = factory(), factory()
         self.factory, self.task_weight = factory, task_weight
+        self.levels = (
+            Levels(factory, qp, breaks, weights, task_weight)
+            if breaks is not None and len(breaks) > 2
+            else None
+        )
+        """The levels of a step with hard tasks at several priorities (None: one level)."""
         self.feedforward = np.zeros(m)
         """The hard tasks' nominal motion this step, in their units per s, shape (m,): part
         of ``b``; when it is not zero, a step whose strict problem has no accepted answer slows
@@ -180,6 +180,19 @@ class QPSolver:
         if rest and not (np.any(qp.lb > 0.0) or np.any(qp.ub < 0.0) or np.any(qp.h < 0.0)):
             return Answer(np.zeros_like(qp.cost), "optimal", 0, 0.0)
         strict, relaxed = self.backends
+        levels, refused = self.levels, None
+        if levels is not None and levels.together:  # all the task rows, strict: as one level
+            solution = refused = strict.solve(self.strict)
+            self._count("strict", self.strict, solution)
+            if solution.found and solution.x is not None:
+                x = solution.x[: qp.cost.shape[0]]
+                return Answer(x, "optimal", solution.iterations, solution.solver_time)
+        if levels is not None:
+            slow = self._slow_down if not rest and np.any(self.feedforward) else None
+            out = levels.solve(self._count, slow, refused)
+            if out.x is not None:
+                return Answer(out.x, out.status, out.iterations, out.solver_time, out.rate)
+            return self._brake(out.message, out.iterations, out.solver_time, out.rate)
         solution = strict.solve(self.strict)
         self._count("strict", self.strict, solution)
         spent, status, rate = solution.solver_time, "optimal", 1.0
@@ -187,16 +200,22 @@ class QPSolver:
             solution, rate = self._slow_down()
             spent, status = spent + solution.solver_time, "slowed"
         if not solution.found:
-            self._load_relaxed()
+            load_relaxed(qp, self.relaxed)
             solution = relaxed.solve(self.relaxed)
             self._count("relaxed", self.relaxed, solution)
             spent, status = spent + solution.solver_time, "relaxed"
         if solution.found and solution.x is not None:
             x = solution.x[: qp.cost.shape[0]]
             return Answer(x, status, solution.iterations, spent, rate)
+        return self._brake(solution.message, solution.iterations, spent, rate)
+
+    def _brake(self, message: str, iterations: int | None, spent: float, rate: float) -> Answer:
+        """No accepted answer: the velocity closest to rest within the joint bounds
+        (``"braking"``), or a failure if those cross."""
+        qp = self.qp
         if np.any(qp.lb > qp.ub):
-            return Answer(None, f"failed: {solution.message}", solution.iterations, spent, 0.0)
-        return Answer(np.clip(0.0, qp.lb, qp.ub), "braking", solution.iterations, spent, rate)
+            return Answer(None, f"failed: {message}", iterations, spent, 0.0)
+        return Answer(np.clip(0.0, qp.lb, qp.ub), "braking", iterations, spent, rate)
 
     def _slow_down(self) -> tuple[solvers.Solution, float]:
         """Solve the time-scaled problem; leave in ``b`` the task the answer meets (or, if it
@@ -249,15 +268,6 @@ class QPSolver:
         for watch in self.watchers:
             watch(kind, problem, solution)
 
-    def _load_relaxed(self) -> None:
-        """Copy the strict problem's data into the relaxed one's ``Q̇`` columns."""
-        qp, r = self.qp, self.relaxed
-        n = qp.cost.shape[0]
-        r.P[:n, :n], r.q[:n], r.A[:, :n] = qp.P, qp.cost, qp.A
-        r.lb[:n], r.ub[:n] = qp.lb, qp.ub
-        if r.G is not None:
-            r.G[:, :n] = qp.G
-
     def reset(self) -> None:
         """Forget the backends' warm starts, the refusals and accuracy counted (a run starts)."""
         self.refusals.clear()
@@ -265,3 +275,5 @@ class QPSolver:
         for backend in (*self.backends, self._pacer):
             if backend is not None:
                 backend.reset()
+        if self.levels is not None:
+            self.levels.reset()

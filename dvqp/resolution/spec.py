@@ -1,4 +1,4 @@
-"""What one resolution step is made of: tasks, the objective, limits and the metric ``W``."""
+"""What one resolution step is made of: tasks (in levels), the objective, limits, ``W``."""
 
 from __future__ import annotations
 
@@ -12,11 +12,15 @@ from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.limits import AccelerationLimit, Limit
 from dvqp.objective.objective import Objective
-from dvqp.tasks.task import Task
+from dvqp.tasks.task import Task, check_priority, check_weight
 
 DEFAULT_TASK_WEIGHT = 1e4
 """``ρ`` of the hard tasks' slack (dimensionless relative to W): large, so a task is given
 up last."""
+
+RANK_RCOND = 1e-6
+"""A level's Jacobian whose smallest singular value is below this fraction of its largest
+cannot be met even alone (its rows are dependent there)."""
 
 
 @dataclass(frozen=True)
@@ -26,7 +30,9 @@ class StepSpec:
     Parameters
     ----------
     tasks
-        At least one hard task (e.g. :class:`~dvqp.tasks.ToolTask`), any soft tasks.
+        At least one hard task (e.g. :class:`~dvqp.tasks.ToolTask`), any soft tasks; kept in
+        order of priority (1 first, tasks of one priority in the order given), so that each
+        level's rows of ``A`` follow each other.
     objective
         ``w(Q)``, followed as ``g = λ ∂w/∂Q`` in the hard tasks' null space.
     limits
@@ -44,12 +50,18 @@ class StepSpec:
     task_weight: float = DEFAULT_TASK_WEIGHT
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "tasks", tuple(self.tasks))
+        tasks = tuple(self.tasks)
         object.__setattr__(self, "limits", tuple(self.limits))
-        _check_kind("tasks", self.tasks, Task)
+        _check_kind("tasks", tasks, Task)
         _check_kind("limits", self.limits, Limit)
-        if not any(t.hard for t in self.tasks):
+        if not any(t.hard for t in tasks):
             raise ParameterError("tasks", "need at least one hard task (e.g. ToolTask())")
+        for i, task in enumerate(tasks):
+            if task.hard:
+                check_priority(task.priority, f"tasks[{i}].priority")
+                check_weight(task.weight, f"tasks[{i}].weight")
+        ordered = sorted(tasks, key=lambda t: t.priority if t.hard else 0)
+        object.__setattr__(self, "tasks", tuple(ordered))
         if sum(isinstance(limit, AccelerationLimit) for limit in self.limits) > 1:
             raise ParameterError("limits", "at most one AccelerationLimit in a step")
         w = np.asarray(self.weights, dtype=np.float64)
@@ -60,6 +72,18 @@ class StepSpec:
         object.__setattr__(self, "weights", _validate.readonly(w.copy()))
         tw = _validate.positive("task_weight", self.task_weight)
         object.__setattr__(self, "task_weight", tw)
+
+    @property
+    def levels(self) -> tuple[tuple[Task, ...], ...]:
+        """The hard tasks by level: one tuple per priority, highest (1) first."""
+        hard = [t for t in self.tasks if t.hard]
+        priorities = sorted({t.priority for t in hard})
+        return tuple(tuple(t for t in hard if t.priority == p) for p in priorities)
+
+    @property
+    def level_names(self) -> tuple[str, ...]:
+        """What reports call each level: its tasks' labels (``"tool h, alpha"``)."""
+        return tuple("; ".join(t.label for t in level) for level in self.levels)
 
     def diagonal(self, n: int) -> NDArray[np.float64]:
         """The diagonal of ``W`` for n joints, shape (n,)."""
@@ -74,6 +98,20 @@ class StepSpec:
             self.weights,
             self.task_weight,
         )
+
+
+def unmeetable(jacobian: NDArray[np.float64]) -> str | None:
+    """Why a level whose rows are ``jacobian`` (m, n) cannot be met even alone, whatever the
+    limits: more rows than joints, or rows dependent (rank below m, :data:`RANK_RCOND`); None
+    if it can."""
+    m, n = jacobian.shape
+    if m > n:
+        return f"it has {m} rows for {n} joints"
+    s = np.linalg.svd(jacobian, compute_uv=False)
+    if m and not s[-1] > RANK_RCOND * s[0]:
+        rank = int(np.sum(s > RANK_RCOND * s[0]))
+        return f"its {m} rows are dependent at the start (rank {rank})"
+    return None
 
 
 def _check_kind(name: str, items: Sequence[object], kind: type) -> None:

@@ -34,6 +34,9 @@ class Step(NamedTuple):
     rate : float
         The fraction of the commanded progress along a path the step made, in [0, 1]: below 1
         when a time-scaled step slowed (0 for a failed one); 1 without time scaling.
+    level_error : ndarray of shape (L,) or None
+        Each level's ``‖A_k Q̇ − b_k‖∞`` (levels by priority, 1 first; ``inf`` for a failed
+        step); None: one level, whose error is ``task_error``.
     """
 
     qdot: NDArray[np.float64]
@@ -44,6 +47,7 @@ class Step(NamedTuple):
     iterations: int | None = None
     solver_time: float = 0.0
     rate: float = 1.0
+    level_error: NDArray[np.float64] | None = None
 
 
 class Resolver:

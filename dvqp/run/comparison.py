@@ -21,6 +21,7 @@ from dvqp.geometry import proximity
 from dvqp.kinematics import KinematicState
 from dvqp.limits import lowest_link, self_distance, start_broken_lines
 from dvqp.resolution.registry import PINV
+from dvqp.run.levels import level_figures
 from dvqp.run.planning import check_run, path_figures, plan
 from dvqp.run.sample_checks import final_errors, tracking, worst_sample_excess
 from dvqp.run.table_text import csv_text
@@ -80,6 +81,8 @@ FIELDS = (
     "final_tracking_error",
     "final_joint_speed",
     "braking_time",
+    "levels_gave_way",
+    "level_detail",
     "error",
 )
 """Keys of a result row, in table / CSV order."""
@@ -128,7 +131,11 @@ def summarize(scene: Scene, traj: Trajectory, settings: str = "default") -> Row:
     largest joint-limit violation (rad) of ``q`` and velocity-limit violation (rad/s) of
     ``Q̇``; the final tracking error (m); ``final_joint_speed``, the largest ``|Q̇|`` of the
     last step that succeeded (rad/s; 0: at rest), ``braking_time`` (s; None: not stopped) and
-    ``final_tool`` ``[l, z, h, α]``. Undefined figures are None.
+    ``final_tool`` ``[l, z, h, α]``. A run with hard tasks at more than one priority has
+    ``levels_gave_way`` (each level's steps that did not keep it exactly, ``"0/161"``, priority
+    order) and ``level_detail`` (each level kept exactly or given way, and its worst error in
+    mm and rad, :func:`dvqp.run.levels.level_figures`); None with one level. Undefined figures
+    are None.
     """
     ok = traj.success
     steps_us = traj.step_time * 1e6
@@ -160,7 +167,22 @@ def summarize(scene: Scene, traj: Trajectory, settings: str = "default") -> Row:
         "final_joint_speed": final_joint_speed(traj),
         "braking_time": traj.braking_time,
         "final_tool": [float(v) for v in traj.tool[-1]],
+        **_levels(traj),
         "error": why,
+    }
+
+
+def _levels(traj: Trajectory) -> Row:
+    """``levels_gave_way`` and ``level_detail`` of a run with more than one level (else
+    None)."""
+    levels = level_figures(traj)
+    if len(levels) < 2:
+        return {"levels_gave_way": None, "level_detail": None}
+    return {
+        "levels_gave_way": "/".join(str(level.gave_way) for level in levels),
+        "level_detail": "; ".join(
+            f"level {k} ({level.name}) {level.words()}" for k, level in enumerate(levels, 1)
+        ),
     }
 
 

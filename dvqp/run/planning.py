@@ -25,6 +25,7 @@ from dvqp.motion.schedule import MAX_SLOWDOWN, TIMINGS, path_deviation
 from dvqp.motion.simulate import StepWatcher, dv_error, simulate
 from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.registry import make_resolver, tier_options
+from dvqp.run.levels import level_deviation
 from dvqp.run.sample_checks import final_errors, worst_sample_excess
 from dvqp.scenes.scene import Scene
 from dvqp.tasks import Task
@@ -99,7 +100,11 @@ def plan(
     backend
         ``"pinv"`` or a QP backend name (:func:`dvqp.resolution.registry.available_resolvers`).
     tasks, limits
-        Tasks and limits added to the scene's own (the baseline ignores limits).
+        Tasks and limits added to the scene's own (the baseline ignores limits); a task joins
+        the level of its ``priority`` (each level kept as well as the limits and the levels
+        above let it, :mod:`dvqp.resolution.levels`). The trajectory records each level's
+        residual per step and error per sample (:attr:`Trajectory.level_error`,
+        :attr:`~Trajectory.level_deviation`).
     progress
         Called as ``progress(k, N)`` after each step.
     notice
@@ -133,7 +138,8 @@ def plan(
         The baseline met a singular task Jacobian.
     """
     settings = backend_settings(scene, backend, options, tier)
-    resolver = make_resolver(backend, scene.spec().with_extra(tasks, limits), settings)
+    spec = scene.spec().with_extra(tasks, limits)
+    resolver = make_resolver(backend, spec, settings)
     c = scene_commands(scene)
     scaled = scene_timing(scene, timing) == "scaled"
     traj = simulate(
@@ -160,7 +166,9 @@ def plan(
         held = c.reference[-1:].repeat(traj.t.shape[0] - c.reference.shape[0], axis=0)
         reference = np.vstack([c.reference, held])
     error = dv_error(reference, traj.tool, scene.pipe_radius)
-    return dataclasses.replace(traj, tracking_error=error, scene_text=scene.text)
+    traj = dataclasses.replace(traj, tracking_error=error, scene_text=scene.text)
+    deviation, measured = level_deviation(spec, traj)
+    return dataclasses.replace(traj, level_deviation=deviation, level_measured=measured)
 
 
 def scene_timing(scene: Scene, timing: str | None = None) -> str:

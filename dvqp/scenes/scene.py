@@ -28,11 +28,11 @@ from dvqp.motion.saddle import SaddleWeld
 from dvqp.objective import Objective
 from dvqp.resolution.spec import StepSpec
 from dvqp.scenes import obstacles as obstacle_section
-from dvqp.scenes import robot_section, start
+from dvqp.scenes import robot_section, start, tasks_section
 from dvqp.scenes import sections as sec
 from dvqp.scenes.fields import Fields
 from dvqp.scenes.solver_options import solver_options
-from dvqp.tasks import ToolTask
+from dvqp.tasks import Task, ToolTask
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -51,6 +51,7 @@ TOP_KEYS = (
     "constraints",
     "motion",
     "solvers",
+    "tasks",
 )
 """The keys a scene file may have at its top level."""
 MAX_BYTES = 1 << 24
@@ -89,6 +90,9 @@ class Scene:
         ``[solvers.<backend>]``: settings handed to that QP backend when the scene runs on it.
     saddle : SaddleWeld or None
         ``[motion.saddle]``: the weld curve round a branch that ``path`` was sampled from.
+    tasks : tuple of Task
+        ``[[tasks]]``: the hard tasks at their priorities; empty (no ``[[tasks]]``): the tool's
+        DV task, all four components, alone (the paper's).
     """
 
     name: str
@@ -110,10 +114,13 @@ class Scene:
     ramp: float = 0.0
     solver_options: dict[str, dict[str, Any]] = field(default_factory=dict, repr=False)
     saddle: SaddleWeld | None = field(default=None, repr=False)
+    tasks: tuple[Task, ...] = field(default=(), repr=False)
 
     def spec(self) -> StepSpec:
-        """The step of this scene: the tool's DV task, the objective, the limits, ``W``."""
-        return StepSpec((ToolTask(),), self.objective, self.limits, self.weights)
+        """The step of this scene: its tasks (the tool's DV task if it names none), the
+        objective, the limits, ``W``."""
+        tasks = self.tasks or (ToolTask(),)
+        return StepSpec(tasks, self.objective, self.limits, self.weights)
 
     @property
     def mode(self) -> str:
@@ -165,6 +172,8 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
         options = solver_options(f, doc)
     with f.guard("robot.q0"):
         start.check_start(f, robot, q0, radius, obstacles)
+    with f.guard("tasks"):
+        tasks = tasks_section.tasks(f, doc, robot, q0, radius)
     with f.guard("constraints"):
         start.check_floor(f, robot, q0, radius, limits)
     stem = "scene" if source.startswith("<") else Path(source).stem
@@ -188,6 +197,7 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
         ramp=ramp,
         solver_options=options,
         saddle=saddle,
+        tasks=tasks,
     )
 
 

@@ -117,7 +117,7 @@ def _attempt(
         )
         return Advance(failed, 1)
     reached = stepper.move()
-    motion = stepper.motion
+    motion, levels = stepper.motion, stepper.level_error
     step = Step(
         stepper.x.copy(),
         True,
@@ -127,6 +127,7 @@ def _attempt(
         found.iterations,
         found.solver_time,
         found.rate,
+        levels.copy() if levels.shape[0] > 1 else None,
     )
     broken = _excess(stepper, q, verify) if reached else SINGULAR
     if not reached and (not verify or depth >= halvings):
@@ -188,6 +189,7 @@ def straight_excess(stepper: Stepper, q: NDArray[np.float64], end: NDArray[np.fl
 
 def _failed(step: Step, broken: Excess, substeps: int, where: str = "") -> Advance:
     status = f"failed: {where}{broken.describe()} in {substeps} substeps"
+    levels = None if step.level_error is None else np.full_like(step.level_error, math.inf)
     failed = Step(
         np.zeros_like(step.qdot),
         False,
@@ -197,6 +199,7 @@ def _failed(step: Step, broken: Excess, substeps: int, where: str = "") -> Advan
         step.iterations,
         step.solver_time,
         0.0,
+        levels,
     )
     return Advance(failed, substeps, broken)
 
@@ -218,5 +221,6 @@ def _joined(
         iterations,
         a.solver_time + b.solver_time,
         0.5 * (a.rate + b.rate),
+        None if a.level_error is None else np.maximum(a.level_error, b.level_error),
     )
     return Advance(step, first.substeps + second.substeps)

@@ -59,16 +59,37 @@ class BoundArrays:
 
 
 @dataclass(frozen=True)
+class TaskArrays:
+    """dvqp's compiled tasks and the levels of the task rows ``A Q̇ = b`` (m rows, L levels).
+
+    ``tool`` (T, 6): each :class:`~dvqp.tasks.ToolTask`'s ``[first row, count, c0 .. c3]``
+    (rows of ``J̄``, −1 unused); ``point`` (P, 6): each :class:`~dvqp.tasks.PointTask`'s
+    ``[first row, count, point, c0 .. c2]``, its ``point_target`` (P, 3) (m) and
+    ``point_gain`` (P,) (1/s); ``posture`` (Q,): each :class:`~dvqp.tasks.PostureTask`'s first
+    row, its ``posture_target`` (Q, n) (rad) and ``posture_gain`` (Q,); ``levels`` (L + 1,)
+    the first row of each level and m; ``level_error`` (L,) each level's ``‖A Q̇ − b‖∞`` of the
+    last integrated step (task units per s)."""
+
+    tool: Index
+    point: Index
+    point_target: Array
+    point_gain: Array
+    posture: Index
+    posture_target: Array
+    posture_gain: Array
+    levels: Index
+    level_error: Array
+
+
+@dataclass(frozen=True)
 class MeasureArrays:
-    """Which compiled dampers measure which damper rows (int64): the first row of ``A`` of each
-    :class:`~dvqp.tasks.ToolTask` (``tool_rows``); each obstacle damper's first row
+    """Which compiled dampers measure which damper rows (int64): each obstacle damper's first row
     (``obstacle_start`` (O,)) and obstacles ``members[offsets[o]:offsets[o+1]]``
     (``obstacle_members`` (M,), ``obstacle_offsets`` (O + 1,)); ``[first row, first guarded
     point, count]`` of each height damper (``heights`` (H, 3)) and ``[row, link]`` of each of
     their link chords (``chords`` (C, 2)); the first row of each tilt and self-collision damper
     (``tilts``, ``selves``)."""
 
-    tool_rows: Index
     obstacle_start: Index
     obstacle_offsets: Index
     obstacle_members: Index
@@ -81,7 +102,7 @@ class MeasureArrays:
 @dataclass(frozen=True)
 class PinvArrays:
     """The baseline's step (eq. 18), when ``baseline``: ``weights`` (n,) of ``W``, ``dense``
-    (soft tasks make the metric ``P``), ``damping`` μ, ``info`` (2,) the Cholesky pivots'
+    (soft tasks make the metric ``P``), ``damping`` μ, ``info`` (3,) the Cholesky pivots'
     extremes, ``x`` (n,) the step."""
 
     baseline: bool
@@ -155,6 +176,7 @@ class Pipeline:
     objective: ObjectiveArrays
     bounds: BoundArrays
     measures: MeasureArrays
+    tasks: TaskArrays
     params: DamperArrays
     dampers: DamperBuffers
     qp: QPBuffers

@@ -34,6 +34,7 @@ from dvqp.step.arrays import (
     PinvArrays,
     Pipeline,
     RecordArrays,
+    TaskArrays,
 )
 from dvqp.step.hooks import Hooks
 from dvqp.workspace import StepPlan
@@ -61,6 +62,8 @@ class Layout:
     objective: ObjectiveArrays
     bounds: BoundArrays
     measures: MeasureArrays
+    tasks: TaskArrays
+    row_weights: np.ndarray
     params: DamperArrays
     hooks: Hooks
     refine: np.ndarray
@@ -82,8 +85,19 @@ def build(
     shapes = len({id(shape) for shape in union})
     plan = StepPlan(n, k, radius, shapes, robot.has_rail, robot.part_names)
     hooks = Hooks(plan, KinematicState.compute(robot, q0, radius), dt)
-    step = StepWiring(plan, hooks, union)
-    for part in parts:
+    step = StepWiring(plan, hooks, union, hooks.start)
+    weights: list[float] = []
+    breaks, priority = [0], None
+    for task in spec.tasks:  # in order of priority: each level's rows follow each other
+        before = plan.rows("tasks")
+        task.join(step)
+        count = plan.rows("tasks") - before
+        if task.hard and priority is not None and task.priority != priority:
+            breaks.append(before)
+        priority = task.priority if task.hard else priority
+        weights += [float(task.weight)] * count
+    breaks.append(plan.rows("tasks"))
+    for part in parts[len(spec.tasks) :]:
         part.join(step)
     table = {key: np.array(rows, dtype=np.int64) for key, rows in step.measures.items()}
     measures = replace(
@@ -104,10 +118,37 @@ def build(
     params = DamperArrays(*(np.ascontiguousarray(c) for c in columns[:5]), columns[5] != 0.0)
     refine, far = step.refinement(len(step.shapes))
     layout = Layout(
-        plan, tuple(step.shapes), objective, _bounds(step), measures, params, hooks, refine, far
+        plan,
+        tuple(step.shapes),
+        objective,
+        _bounds(step),
+        measures,
+        _tasks(step, np.array(breaks, dtype=np.int64)),
+        np.array(weights),
+        params,
+        hooks,
+        refine,
+        far,
     )
     _verified(layout, step, robot.joint_names)
     return layout, step.rows_of(recorded)
+
+
+def _tasks(step: StepWiring, levels: np.ndarray) -> TaskArrays:
+    """The compiled tasks' tables and the levels' first rows (``levels`` (L + 1,))."""
+    n, t = step.plan.n, step.tasks
+    points, postures = t["point"], t["posture"]
+    return TaskArrays(
+        np.array(t["tool"], dtype=np.int64).reshape(-1, 6),
+        np.array([entry for entry, _, _ in points], dtype=np.int64).reshape(-1, 6),
+        np.array([target for _, target, _ in points], dtype=float).reshape(-1, 3),
+        np.array([gain for _, _, gain in points], dtype=float),
+        np.array([first for first, _, _ in postures], dtype=np.int64),
+        np.array([target for _, target, _ in postures], dtype=float).reshape(-1, n),
+        np.array([gain for _, _, gain in postures], dtype=float),
+        levels,
+        np.zeros(levels.shape[0] - 1),
+    )
 
 
 def _bounds(step: StepWiring) -> BoundArrays:
@@ -203,10 +244,11 @@ def lay_out(
         layout.objective,
         layout.bounds,
         layout.measures,
+        layout.tasks,
         layout.params,
         plan.dampers,
         plan.qp,
-        PinvArrays(baseline, weights, layout.hooks.soft, damping, np.zeros(2), x),
+        PinvArrays(baseline, weights, layout.hooks.soft, damping, np.zeros(3), x),
         plan.checks,
         layout.joint_values,
         layout.damper_values,

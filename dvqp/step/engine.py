@@ -19,13 +19,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 import solvers
-from dvqp.errors import ParameterError, ShapeError, SingularConfigurationError
+from dvqp.errors import ParameterError, ShapeError, SingularConfigurationError, TaskLevelError
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState, singular_frame
 from dvqp.limits import Bounds, Constraint, Limit, VelocityDamper
 from dvqp.objective import Term
 from dvqp.resolution.qp import QPResolver, QPSolver
+from dvqp.resolution.spec import unmeetable
 from dvqp.resolution.step import Resolver
 from dvqp.step import stages
 from dvqp.step.arrays import RecordArrays
@@ -100,8 +101,15 @@ class Stepper(Verification):
         plan = self.layout.plan
         self.struct = as_struct(self.arrays)
         assert plan.qp is not None and plan.checks is not None
+        tasks = self.layout.tasks
         self.solver = (
-            QPSolver(dropping(resolver.factory), plan.qp, spec.task_weight)
+            QPSolver(
+                dropping(resolver.factory),
+                plan.qp,
+                spec.task_weight,
+                tasks.levels,
+                self.layout.row_weights,
+            )
             if isinstance(resolver, QPResolver)
             else None
         )
@@ -115,6 +123,9 @@ class Stepper(Verification):
         """(2,): ``[value, ratio]`` of the loaded state's worst excess."""
         self.motion = self.arrays.motion
         """(2,): ``[‖A x − b‖∞, max |dt x|]`` of the last :meth:`move`."""
+        self.level_error = tasks.level_error
+        """(L,): each level's ``‖A_k x − b_k‖∞`` of the last :meth:`move` (task units per s),
+        levels by priority (1 first)."""
         self.limits: tuple[Limit, ...] = spec.limits
         self._observers = [
             lim
@@ -126,6 +137,27 @@ class Stepper(Verification):
         tool and every task held still, λ = 0), a damper holds a drift below its safe value
         instead of pulling it back (right side at least 0), and Q̇ = 0 is taken when it is
         feasible (:meth:`~dvqp.resolution.qp.QPSolver.solve`)."""
+        if tasks.levels.shape[0] > 2:
+            self._check_levels(q0, dt)
+
+    def _check_levels(self, q0: ArrayLike, dt: float) -> None:
+        """Refuse a level that cannot be met even alone at ``q0`` (its rows as the step writes
+        them: :func:`~dvqp.resolution.spec.unmeetable`).
+
+        Raises
+        ------
+        TaskLevelError
+            Such a level.
+        """
+        if not self.load(q0):
+            return  # singular: start() says so
+        self.prepare(np.zeros(4), dt)
+        breaks, A = self.layout.tasks.levels, self.arrays.qp.A
+        names = self.resolver.spec.level_names
+        for level in range(breaks.shape[0] - 1):
+            why = unmeetable(A[breaks[level] : breaks[level + 1]])
+            if why is not None:
+                raise TaskLevelError(level + 1, names[level], why)
 
     def load(self, q: ArrayLike) -> bool:
         """Evaluate the state at ``q`` (rad); False if a guarded frame is on the pipe axis."""
@@ -230,8 +262,8 @@ class Stepper(Verification):
         v = self.solver.feedforward
         v[:] = 0.0
         if feedforward is not None:
-            for start in self.layout.measures.tool_rows:
-                v[start : start + 4] = feedforward
+            for start, count, *components in self.layout.tasks.tool:
+                v[start : start + count] = feedforward[components[:count]]
 
     def prepare(self, command: Array, dt: float) -> int:
         """Write the problem of a step from the loaded state for ``command`` (4,) over ``dt``
@@ -259,10 +291,17 @@ class Stepper(Verification):
     def _pinv_error(self, status: int) -> SingularConfigurationError:
         if status == stages.INDEFINITE_METRIC:
             return SingularConfigurationError("the soft tasks' metric is not positive definite")
-        lo, hi = self.arrays.pinv.info
+        lo, hi, level = self.arrays.pinv.info
+        names = self.resolver.spec.level_names
+        which = (
+            f" of level {int(level) + 1} ({names[int(level)]}) in the null space of the levels "
+            "above"
+            if len(names) > 1
+            else ""
+        )
         return SingularConfigurationError(
-            f"task Jacobian is (nearly) rank deficient (Cholesky pivots from {lo:.3g} to "
-            f"{hi:.3g}); use a damped inverse"
+            f"task Jacobian{which} is (nearly) rank deficient (Cholesky pivots from {lo:.3g} "
+            f"to {hi:.3g}); use a damped inverse"
         )
 
     def record_into(self, samples: Mapping[str, np.ndarray]) -> None:

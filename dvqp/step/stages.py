@@ -28,6 +28,8 @@ from dvqp.objective.obstacle_links import obstacle_links
 from dvqp.objective.obstacle_points import obstacle_points
 from dvqp.objective.orbital_level import orbital_level
 from dvqp.resolution.pinv import NOT_DEFINITE, pinv_step
+from dvqp.tasks.point import point_rows
+from dvqp.tasks.posture import posture_rows
 from dvqp.tasks.tool_dv import tool_rows
 from solvers.jit import njit
 
@@ -64,14 +66,19 @@ def evaluate(s, integrate, first, last) -> int:  # type: ignore[no-untyped-def]
 
 @njit(inline="always")
 def _integrate(s) -> None:  # type: ignore[no-untyped-def]
-    """``s.motion = [‖A x − b‖∞, max |dt x|]`` and ``q += dt x``."""
+    """``s.motion = [‖A x − b‖∞, max |dt x|]``, each level's ``‖A x − b‖∞`` and ``q += dt x``."""
     A, b, x, q, dt = s.qp.A, s.qp.b, s.x, s.state.q, s.dt[0]
+    levels, level_error = s.tasks.levels, s.tasks.level_error
     error = 0.0
-    for r in range(A.shape[0]):
-        v = -b[r]
-        for c in range(A.shape[1]):
-            v += A[r, c] * x[c]
-        error = max(error, abs(v))
+    for level in range(level_error.shape[0]):
+        worst = 0.0
+        for r in range(levels[level], levels[level + 1]):
+            v = -b[r]
+            for c in range(A.shape[1]):
+                v += A[r, c] * x[c]
+            worst = max(worst, abs(v))
+        level_error[level] = worst
+        error = max(error, worst)
     largest = 0.0
     for i in range(q.shape[0]):
         moved = q[i] + dt * x[i]
@@ -243,7 +250,10 @@ def prepare_baseline(s, first, last) -> int:  # type: ignore[no-untyped-def]
     if first <= ROWS <= last and not _rows(s):
         return BAD_COMMAND
     if first <= CLOSE <= last:
-        status = pinv_step(qp.A, qp.b, qp.cost, p.weights, qp.P, p.dense, p.damping, p.info, p.x)
+        levels = s.tasks.levels
+        status = pinv_step(
+            qp.A, qp.b, levels, qp.cost, p.weights, qp.P, p.dense, p.damping, p.info, p.x
+        )
         if status != -1:
             return INDEFINITE_METRIC if status == NOT_DEFINITE else SINGULAR_TASK
     return -1
@@ -256,8 +266,17 @@ def _rows(s) -> bool:  # type: ignore[no-untyped-def]
     for i in range(4):
         if not math.isfinite(s.command[i]):
             return False
-    for t in range(s.measures.tool_rows.shape[0]):
-        tool_rows(s.state.tool_jacobian, s.command, qp.A, qp.b, s.measures.tool_rows[t])
+    t, st = s.tasks, s.state
+    for i in range(t.tool.shape[0]):
+        start, count = t.tool[i, 0], t.tool[i, 1]
+        tool_rows(st.tool_jacobian, s.command, t.tool[i, 2 : 2 + count], qp.A, qp.b, start)
+    period, g, dg = 2.0 * math.pi * s.radius, st.guarded, st.guarded_jacobians
+    for i in range(t.point.shape[0]):
+        start, count, point = t.point[i, 0], t.point[i, 1], t.point[i, 2]
+        components, target, gain = t.point[i, 3 : 3 + count], t.point_target[i], t.point_gain[i]
+        point_rows(g, dg, point, components, target, gain, period, qp.A, qp.b, start)
+    for i in range(t.posture.shape[0]):
+        posture_rows(st.q, t.posture_target[i], t.posture_gain[i], qp.A, qp.b, t.posture[i])
     if p.dense:
         for i in range(qp.P.shape[0]):
             for j in range(qp.P.shape[1]):

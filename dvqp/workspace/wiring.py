@@ -30,7 +30,6 @@ Array = NDArray[np.float64]
 Index = NDArray[np.int64]
 
 MEASURES = (
-    "tool_rows",
     "obstacle_start",
     "obstacle_offsets",
     "obstacle_members",
@@ -39,8 +38,12 @@ MEASURES = (
     "tilts",
     "selves",
 )
-"""The tables of damper and task rows the compiled kernels write (see
+"""The tables of damper rows the compiled kernels write (see
 :class:`~dvqp.step.arrays.MeasureArrays`)."""
+
+TASK_TABLES = ("tool", "point", "posture")
+"""The compiled task kinds, each a table of the task rows its kernel writes (see
+:class:`~dvqp.step.arrays.TaskArrays`)."""
 
 
 class PartHooks(Protocol):
@@ -82,11 +85,17 @@ class StepWiring:
         The run's rows: a part reserves its own (``plan.task_rows``, ``plan.damper_rows``, ...).
     hooks : PartHooks
         Where a part of your own goes.
+    start : object
+        The state the run is laid out at (a :class:`~dvqp.KinematicState`): where a task
+        without a target finds its start value.
     shapes : list
         The union of the obstacles the parts measure (``part.measured``, each shape once, in
         order of first use): rows of the compiled measurement.
     measures : dict of str to list
         :data:`MEASURES`: each compiled kernel's rows.
+    tasks : dict of str to list
+        :data:`TASK_TABLES`: each compiled task's entry (its first row of ``A``, its row count,
+        and what its kernel reads), in the order the tasks joined.
     levels, k_height : list
         Each orbital-level term's ``h*`` (m) and ``k²`` (k,) (1/m²).
     q_min, q_max, qd_max : ndarray, shape (n,)
@@ -100,12 +109,15 @@ class StepWiring:
         Every damper's rows, in row order.
     """
 
-    def __init__(self, plan: StepPlan, hooks: PartHooks, shapes: Iterable[Any]) -> None:
-        self.plan, self.hooks = plan, hooks
+    def __init__(
+        self, plan: StepPlan, hooks: PartHooks, shapes: Iterable[Any], start: Any = None
+    ) -> None:
+        self.plan, self.hooks, self.start = plan, hooks, start
         self.shapes: list[Any] = list({id(s): s for s in shapes}.values())
         self._rows = {id(shape): row for row, shape in enumerate(self.shapes)}
         self.measures: dict[str, list[Any]] = {key: [] for key in MEASURES}
         self.measures["obstacle_offsets"].append(0)
+        self.tasks: dict[str, list[Any]] = {key: [] for key in TASK_TABLES}
         self.levels: list[float] = []
         self.k_height: list[Array] = []
         self._point_coef: list[tuple[Index, Array]] = []

@@ -140,3 +140,23 @@ def test_the_safety_diagnostics_round_trip_and_old_files_still_load(tmp_path: Pa
     np.testing.assert_array_equal(loaded.tool, traj.tool)
     assert loaded.limits_kept.shape == (0,) and loaded.substeps.shape == (0,)
     assert loaded.brake_start == -1 and loaded.braking_time is None  # not known to be stopped
+
+
+def test_each_levels_residual_and_error_round_trip_and_old_files_have_none(
+    tmp_path: Path,
+) -> None:
+    from tests.runs import run
+
+    traj = run("reach-priorities", "daqp")
+    assert traj.level_error.shape == (traj.n_steps, 2)
+    assert traj.level_deviation.shape == (traj.t.shape[0], 2, 2)
+    again = Trajectory.load(traj.save(tmp_path / "r.npz"))
+    assert again.levels == traj.levels == ("tool h, alpha", "tool l, z")
+    np.testing.assert_array_equal(again.level_error, traj.level_error)
+    np.testing.assert_array_equal(again.level_deviation, traj.level_deviation)
+    np.testing.assert_array_equal(again.level_measured, [[True, True], [True, False]])
+    with np.load(tmp_path / "r.npz") as data:  # a file written before levels were recorded
+        older = {k: data[k] for k in data.files if not k.startswith("level")}
+    np.savez(tmp_path / "old.npz", **older)
+    old = Trajectory.load(tmp_path / "old.npz")
+    assert old.levels == () and old.level_error.shape == (0, 0)

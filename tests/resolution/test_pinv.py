@@ -38,11 +38,22 @@ def compiled(
     metric: np.ndarray | None = None,
     damping: float = 0.0,
 ) -> tuple[int, np.ndarray]:
-    """``pinv_step`` on its own: its status and ``Q̇`` (the dense ``metric`` if given)."""
-    out, info = np.full(jac.shape[1], np.nan), np.zeros(2)
+    """``pinv_step`` on its own, one level: its status and ``Q̇`` (the dense ``metric`` if
+    given)."""
+    out, info = np.full(jac.shape[1], np.nan), np.zeros(3)
     P = np.eye(jac.shape[1]) if metric is None else metric
+    levels = np.array([0, jac.shape[0]], dtype=np.int64)
     status = pinv_step(
-        np.ascontiguousarray(jac), xdot, -g, weights, P, metric is not None, damping, info, out
+        np.ascontiguousarray(jac),
+        xdot,
+        levels,
+        -g,
+        weights,
+        P,
+        metric is not None,
+        damping,
+        info,
+        out,
     )
     return int(status), out
 

@@ -5,16 +5,18 @@ The QP claims run on DAQP (the fastest backend here); the baseline claims on ``p
 
 from __future__ import annotations
 
+import dataclasses
 from collections import Counter
 
 import numpy as np
+import pytest
 
 from dvqp import Constraint, KinematicState, QPResolver, Scene, Stepper, Trajectory, plan
 from dvqp.limits import ObstacleDamper, SurfaceHeight
 from dvqp.run.planning import check_run, scene_commands
 from dvqp.scenes.scene import loads
 from tests.oracle_limits import measure
-from tests.runs import run, scene
+from tests.runs import QP, run, scene
 
 
 def tight_rows(s: Scene, traj: Trajectory, tol: float = 1e-6) -> Counter[str]:
@@ -155,3 +157,26 @@ def test_many_obstacles_scene_holds_the_margin_at_several_obstacles() -> None:
     low_clamps = {"obstacles[0]", "obstacles[1]", "obstacles[2]"}
     assert len(obstacles & low_clamps) >= 2  # the low clamps in turn
     assert base.min_clearance.min() < -0.003
+
+
+@pytest.mark.parametrize("backend", QP)
+def test_priorities_scene_keeps_height_and_heading_while_the_reach_runs_out(backend: str) -> None:
+    s, qp = scene("reach-priorities"), run("reach-priorities", backend)
+    check_run(s, qp)  # safe to send: every step, every limit kept, the end within 2.5 cm
+    assert qp.limits_kept.all() and not qp.start_broken
+    e = np.abs(qp.tracking_error)
+    assert e[:, 2].max() <= 0.05e-3  # m: the probe's height, every sample
+    assert e[:, 3].max() <= 1e-4  # rad: its heading
+    assert e[:, 0].max() >= 5e-3  # m: while it lags along the weld
+    assert qp.levels == ("tool h, alpha", "tool l, z")
+    assert qp.level_error[:, 0].max() <= 1e-6  # level 1 kept exactly in every step
+    gave_way = qp.level_error[:, 1] > 1e-6
+    assert gave_way.sum() > 100 and np.all(qp.status[gave_way] == "relaxed")
+    one = plan(dataclasses.replace(s, tasks=()), backend)  # the tool as one task
+    assert one.limits_kept.all() and np.abs(one.tracking_error[:, 2]).max() > 1e-3
+
+
+def test_priorities_scene_baseline_drives_the_carriage_past_its_limit() -> None:
+    s, base = scene("reach-priorities"), run("reach-priorities", "pinv")
+    assert base.level_error.max() < 1e-9  # both levels met, as the baseline holds no limit
+    assert base.q[:, 0].max() > s.robot.q_max[0] + 0.5

@@ -1,0 +1,258 @@
+"""Strict task priorities: a step's levels resolved one after the other, each on any backend.
+
+The hard tasks' rows ``A Q̇ = b`` come in L levels (rows ``breaks[k] .. breaks[k+1]`` of level
+k, priority order). The limits are level 0, always hard. The step is the lexicographic
+optimum::
+
+    level k:  minimise   ½ Q̇ᵀ(W + H)Q̇ + (c − g)ᵀQ̇ + ½ ρ Σ_i w_i s_i²
+              subject to A_j Q̇ = b_j + r_j   (j < k: each level above at what it achieved)
+                         A_k Q̇ − s = b_k      (s = 0 when level k can be met exactly)
+                         G Q̇ ≤ h,  lb ≤ Q̇ ≤ ub
+
+each level optimised in what the levels above leave free, its own slack ``s`` used only when
+it cannot be met exactly, and its achieved residual ``r_k = A_k Q̇ − b_k`` fixed as an
+equality for the levels below; the cost (the paper's weighted ``∇w`` and the soft tasks) is
+what every level's QP minimises among its optima, so the last level's answer is the step.
+
+Every level's problem is an ordinary QP of :mod:`solvers`, set up once over the step's
+arrays (:func:`strict_problem`, :func:`relaxed_problem`: pure functions of those arrays) and
+solved by a backend of its own (warm-started from that level's previous step), so it works
+with every backend, and each answer is checked from the problem data
+(:meth:`solvers.Solution.checked`) like every answer. As few QPs as possible: first the levels
+as far down as they can be met together (``rows <= n``: all of them unless a level has more
+rows than the joints left) as one strict QP — when it is accepted, every level in it is met
+exactly and that is the step; else level by level from the first not met: strict, else
+relaxed, and after a level that gave way, the levels below together again. Two shortcuts give
+the very answer of the levels one by one in one QP: when the levels together are refused, the
+last of them relaxed with those above held exactly (accepted: those above could be met, and it
+gave way in what they leave free); and a level with more rows than the joints the levels above
+leave (a posture below other tasks), which is never met exactly, relaxed with those above held
+exactly. Refused, the levels are taken one by one.
+
+A level whose relaxed QP has no accepted answer ends the cascade: the step is the answer of
+the level above (which keeps every limit and every level above), the levels from there give
+way. If the first level has none, the step brakes (:class:`~dvqp.resolution.qp.QPSolver`).
+
+DAQP has a native hierarchical mode (``break_points``, soft constraints); it is not used: its
+``lam`` holds each soft row's slack perturbation, not the levels' multipliers, so its levels'
+answers cannot be checked from their KKT conditions as every answer here is, and its soft rows
+trade a level that could be met against the cost (a residual of ``ρ_soft · λ``, not 0).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+import solvers
+from dvqp.workspace import QPBuffers
+
+Array = NDArray[np.float64]
+
+#: Shows one backend call: ``(kind, problem, solution)``, kind ``"strict"`` or ``"relaxed"``.
+Count = Callable[[str, solvers.Problem, solvers.Solution], None]
+#: The time-scaled attempt (:meth:`~dvqp.resolution.qp.QPSolver._slow_down`): its solution and
+#: the fraction of the nominal progress made.
+Slow = Callable[[], tuple[solvers.Solution, float]]
+
+
+def strict_problem(qp: QPBuffers, rows: int, b: Array) -> solvers.Problem:
+    """The levels whose rows are ``A[:rows]`` met exactly, ``A[:rows] Q̇ = b[:rows]``, with the
+    step's cost, constraints and bounds (views of ``qp``'s arrays and of ``b``: nothing to copy
+    per step)."""
+    p = qp.h.shape[0]
+    G, h = (qp.G, qp.h) if p else (None, None)
+    return solvers.Problem.trusted(qp.P, qp.cost, qp.A[:rows], b[:rows], G, h, qp.lb, qp.ub)
+
+
+def relaxed_problem(
+    qp: QPBuffers, first: int, rows: int, weights: Array, task_weight: float, b: Array
+) -> solvers.Problem:
+    """Over ``x = [Q̇; s]``: ``A[:first] Q̇ = b[:first]`` (the levels above, held), ``A[first:rows]
+    Q̇ − s = b[first:rows]`` (this level, with its slack), the step's constraints and bounds, and
+    the cost plus ``½ ρ Σ w_i s_i²`` (``ρ`` the ``task_weight``, ``w`` the rows' ``weights``
+    (m,)). Its ``Q̇`` columns are filled by :func:`load_relaxed`; ``b`` is shared."""
+    n, p, m = qp.cost.shape[0], qp.h.shape[0], rows - first
+    P = np.zeros((n + m, n + m))
+    P[n:, n:] = np.diag(task_weight * weights[first:rows])
+    A = np.zeros((rows, n + m))
+    A[first:, n:] = -np.eye(m)
+    inf = np.full(m, np.inf)
+    return solvers.Problem.trusted(
+        P,
+        np.zeros(n + m),
+        A,
+        b[:rows],
+        np.zeros((p, n + m)) if p else None,
+        qp.h if p else None,
+        np.concatenate([qp.lb, -inf]),
+        np.concatenate([qp.ub, inf]),
+    )
+
+
+def load_relaxed(qp: QPBuffers, problem: solvers.Problem) -> None:
+    """Copy this step's cost, task rows, constraints and bounds into ``problem``'s ``Q̇``
+    columns (a :func:`relaxed_problem`)."""
+    n, rows = qp.cost.shape[0], problem.b.shape[0]  # type: ignore[union-attr]
+    problem.P[:n, :n], problem.q[:n] = qp.P, qp.cost
+    problem.A[:, :n] = qp.A[:rows]  # type: ignore[index]
+    problem.lb[:n], problem.ub[:n] = qp.lb, qp.ub  # type: ignore[index]
+    if problem.G is not None:
+        problem.G[:, :n] = qp.G
+
+
+@dataclass
+class Outcome:
+    """What the levels gave: the step ``x`` (n,) (None: not even the first level had an
+    answer), ``status`` (``"optimal"``, ``"slowed"`` or ``"relaxed"``), the backend's
+    iterations and time (s) over every call, ``rate`` (time scaling), and the last refusal's
+    message."""
+
+    x: Array | None
+    status: str
+    iterations: int | None
+    solver_time: float
+    rate: float
+    message: str = ""
+
+
+class Levels:
+    """The levels of a step's QP ``qp`` (rows ``breaks[k] .. breaks[k+1]`` of level k), each
+    problem on its own backend from ``factory``; ``weights`` (m,) the rows' weights within
+    their level, ``task_weight`` ``ρ``."""
+
+    def __init__(
+        self,
+        factory: Callable[[], solvers.Backend],
+        qp: QPBuffers,
+        breaks: NDArray[np.int64],
+        weights: Array,
+        task_weight: float,
+    ) -> None:
+        self.factory, self.qp, self.task_weight = factory, qp, task_weight
+        self.breaks, self.weights = [int(r) for r in breaks], np.asarray(weights, dtype=float)
+        self.count = len(self.breaks) - 1
+        n = qp.cost.shape[0]
+        meetable = [k for k in range(self.count) if self.breaks[k + 1] <= n]
+        self.reach = meetable[-1] if meetable else -1
+        """The last level down to which the levels may be met together (no more rows than
+        joints); −1: not even the first."""
+        self.fixed = np.zeros(self.breaks[-1])
+        """The right sides the levels below see: each level above at what it achieved."""
+        self._strict: dict[int, tuple[solvers.Problem, solvers.Backend]] = {}
+        self._relaxed: dict[int, tuple[solvers.Problem, solvers.Backend]] = {}
+
+    def reset(self) -> None:
+        """Forget every level backend's warm start."""
+        for _, backend in (*self._strict.values(), *self._relaxed.values()):
+            backend.reset()
+
+    def strict(self, level: int) -> tuple[solvers.Problem, solvers.Backend]:
+        """The problem (and its backend) of the levels down to ``level`` met exactly."""
+        if level not in self._strict:
+            problem = strict_problem(self.qp, self.breaks[level + 1], self.fixed)
+            self._strict[level] = problem, self.factory()
+        return self._strict[level]
+
+    def relaxed(self, level: int) -> tuple[solvers.Problem, solvers.Backend]:
+        """The problem (and its backend) of ``level`` with its slack, the levels above held."""
+        if level not in self._relaxed:
+            first, rows = self.breaks[level], self.breaks[level + 1]
+            problem = relaxed_problem(
+                self.qp, first, rows, self.weights, self.task_weight, self.fixed
+            )
+            self._relaxed[level] = problem, self.factory()
+        return self._relaxed[level]
+
+    @property
+    def together(self) -> bool:
+        """Whether every level may be met together (no more rows than joints): then the first
+        attempt is the strict QP of all the task rows."""
+        return self.reach == self.count - 1
+
+    def solve(
+        self, count: Count, slow: Slow | None = None, refused: solvers.Solution | None = None
+    ) -> Outcome:
+        """The step: each level met as well as the limits and the levels above let it (see the
+        module docstring). ``count`` is shown every backend call; ``slow``, if given, is tried
+        once the levels that may be met together are not (time-scaled path following: the
+        step then slows along the path, or its task becomes stopping on it, ``qp.b``);
+        ``refused``: the levels together (:attr:`together`) were already tried, strict, and
+        had no accepted answer (that call, counted)."""
+        qp, n = self.qp, self.qp.cost.shape[0]
+        self.fixed[:] = qp.b
+        x: Array | None = None
+        status, rate, message = "optimal", 1.0, ""
+        spent = 0.0 if refused is None else refused.solver_time
+        iterations = 0 if refused is None else refused.iterations or 0
+        counted = refused is None or refused.iterations is not None
+        tried: set[int] = set()  # strict problems refused since the held values last changed
+        settled = 0
+
+        def attempt(kind: str, problem: solvers.Problem, backend: solvers.Backend) -> bool:
+            nonlocal spent, iterations, counted, x, message
+            solution = backend.solve(problem)
+            count(kind, problem, solution)
+            spent += solution.solver_time
+            counted = counted and solution.iterations is not None
+            iterations += solution.iterations or 0
+            if solution.found and solution.x is not None:
+                x = np.array(solution.x[:n])
+                return True
+            message = solution.message
+            return False
+
+        while settled < self.count:
+            top = self.reach
+            if top >= settled and top not in tried:
+                tried.add(top)
+                if top + 1 < self.count:  # the next level cannot be met: relaxed, those held
+                    if attempt("relaxed", *self._loaded(top + 1)):
+                        self._hold(top + 1, x)  # type: ignore[arg-type]
+                        status, settled = "relaxed", top + 2
+                        tried.clear()
+                        continue
+                else:
+                    if refused is None and attempt("strict", *self.strict(top)):
+                        settled = top + 1
+                        continue
+                    refused = None
+                    if slow is not None and settled == 0:
+                        solution, rate = slow()  # once: σ = 0 is then no better
+                        slow = None
+                        spent += solution.solver_time
+                        if solution.found and solution.x is not None:
+                            x, status = np.array(solution.x[:n]), "slowed"
+                            break
+                        self.fixed[:] = qp.b  # the task of stopping on the path
+                    if top > settled and attempt("relaxed", *self._loaded(top)):
+                        self._hold(top, x)  # type: ignore[arg-type]
+                        status, settled = "relaxed", top + 1  # the last level gave way
+                        continue
+            if top > settled and settled not in tried:
+                tried.add(settled)
+                if attempt("strict", *self.strict(settled)):
+                    settled += 1
+                    continue
+            if not attempt("relaxed", *self._loaded(settled)):
+                break
+            self._hold(settled, x)  # type: ignore[arg-type]
+            status, settled = "relaxed", settled + 1
+            tried.clear()
+        if settled < self.count and x is not None:
+            status = "relaxed"  # the levels from `settled` give way to those above
+        return Outcome(x, status, iterations if counted else None, spent, rate, message)
+
+    def _hold(self, level: int, x: Array) -> None:
+        """Hold ``level`` from now on at what ``x`` achieves (its right side, for the levels
+        below)."""
+        first, rows = self.breaks[level], self.breaks[level + 1]
+        self.fixed[first:rows] = self.qp.A[first:rows] @ x
+
+    def _loaded(self, level: int) -> tuple[solvers.Problem, solvers.Backend]:
+        problem, backend = self.relaxed(level)
+        load_relaxed(self.qp, problem)
+        return problem, backend
