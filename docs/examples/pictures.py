@@ -29,8 +29,12 @@ IMG = Path("docs/img")
 def draw_runs(scene: dvqp.Scene) -> dvqp.Trajectory:
     """Plan ``scene`` with DAQP and with pinv, draw each run; return the baseline's run."""
     env = environment(scene.text)
-    drawn = {"obstacles": env.obstacles, "orbital_level": env.orbital_level, "weld_z": env.weld,
-             "min_height": env.min_height}  # fmt: skip
+    drawn = {
+        "obstacles": env.obstacles,
+        "orbital_level": env.orbital_level,
+        "weld_z": env.weld,
+        "min_height": env.min_height,
+    }
     for backend, name in (("daqp", scene.name), ("pinv", f"{scene.name}-pinv")):
         traj = dvqp.plan(scene, backend)
         print(plot_trajectory(traj, IMG / f"{name}.png", **drawn))

@@ -119,6 +119,42 @@ class Outcome:
     message: str = ""
 
 
+class _Calls:
+    """The backend calls of one step: what they cost and the last accepted answer."""
+
+    def __init__(self, count: Count, n: int, refused: solvers.Solution | None) -> None:
+        self.count, self.n = count, n
+        self.x: Array | None = None
+        self.message = ""
+        self.spent = 0.0 if refused is None else refused.solver_time
+        self.iterations = 0 if refused is None else refused.iterations or 0
+        self.counted = refused is None or refused.iterations is not None
+
+    def attempt(self, kind: str, problem: solvers.Problem, backend: solvers.Backend) -> bool:
+        """Solve ``problem`` on ``backend``; whether its answer was accepted (then :attr:`x`)."""
+        solution = backend.solve(problem)
+        self.count(kind, problem, solution)
+        self.spent += solution.solver_time
+        self.counted = self.counted and solution.iterations is not None
+        self.iterations += solution.iterations or 0
+        if solution.found and solution.x is not None:
+            self.x = np.array(solution.x[: self.n])
+            return True
+        self.message = solution.message
+        return False
+
+    @property
+    def answer(self) -> Array:
+        """The last accepted answer (only read after an accepted attempt)."""
+        assert self.x is not None
+        return self.x
+
+    def outcome(self, status: str, rate: float) -> Outcome:
+        """The step's outcome with ``status`` and the path's progress ``rate``."""
+        iterations = self.iterations if self.counted else None
+        return Outcome(self.x, status, iterations, self.spent, rate, self.message)
+
+
 class Levels:
     """The levels of a step's QP ``qp`` (rows ``breaks[k] .. breaks[k+1]`` of level k), each
     problem on its own backend from ``factory``; ``weights`` (m,) the rows' weights within
@@ -182,36 +218,20 @@ class Levels:
         step then slows along the path, or its task becomes stopping on it, ``qp.b``);
         ``refused``: the levels together (:attr:`together`) were already tried, strict, and
         had no accepted answer (that call, counted)."""
-        qp, n = self.qp, self.qp.cost.shape[0]
+        qp = self.qp
         self.fixed[:] = qp.b
-        x: Array | None = None
-        status, rate, message = "optimal", 1.0, ""
-        spent = 0.0 if refused is None else refused.solver_time
-        iterations = 0 if refused is None else refused.iterations or 0
-        counted = refused is None or refused.iterations is not None
+        calls = _Calls(count, qp.cost.shape[0], refused)
+        status, rate = "optimal", 1.0
         tried: set[int] = set()  # strict problems refused since the held values last changed
         settled = 0
-
-        def attempt(kind: str, problem: solvers.Problem, backend: solvers.Backend) -> bool:
-            nonlocal spent, iterations, counted, x, message
-            solution = backend.solve(problem)
-            count(kind, problem, solution)
-            spent += solution.solver_time
-            counted = counted and solution.iterations is not None
-            iterations += solution.iterations or 0
-            if solution.found and solution.x is not None:
-                x = np.array(solution.x[:n])
-                return True
-            message = solution.message
-            return False
-
+        attempt = calls.attempt
         while settled < self.count:
             top = self.reach
             if top >= settled and top not in tried:
                 tried.add(top)
                 if top + 1 < self.count:  # the next level cannot be met: relaxed, those held
                     if attempt("relaxed", *self._loaded(top + 1)):
-                        self._hold(top + 1, x)  # type: ignore[arg-type]
+                        self._hold(top + 1, calls.answer)
                         status, settled = "relaxed", top + 2
                         tried.clear()
                         continue
@@ -223,13 +243,13 @@ class Levels:
                     if slow is not None and settled == 0:
                         solution, rate = slow()  # once: σ = 0 is then no better
                         slow = None
-                        spent += solution.solver_time
+                        calls.spent += solution.solver_time
                         if solution.found and solution.x is not None:
-                            x, status = np.array(solution.x[:n]), "slowed"
+                            calls.x, status = np.array(solution.x[: calls.n]), "slowed"
                             break
                         self.fixed[:] = qp.b  # the task of stopping on the path
                     if top > settled and attempt("relaxed", *self._loaded(top)):
-                        self._hold(top, x)  # type: ignore[arg-type]
+                        self._hold(top, calls.answer)
                         status, settled = "relaxed", top + 1  # the last level gave way
                         continue
             if top > settled and settled not in tried:
@@ -239,12 +259,12 @@ class Levels:
                     continue
             if not attempt("relaxed", *self._loaded(settled)):
                 break
-            self._hold(settled, x)  # type: ignore[arg-type]
+            self._hold(settled, calls.answer)
             status, settled = "relaxed", settled + 1
             tried.clear()
-        if settled < self.count and x is not None:
+        if settled < self.count and calls.x is not None:
             status = "relaxed"  # the levels from `settled` give way to those above
-        return Outcome(x, status, iterations if counted else None, spent, rate, message)
+        return calls.outcome(status, rate)
 
     def _hold(self, level: int, x: Array) -> None:
         """Hold ``level`` from now on at what ``x`` achieves (its right side, for the levels
