@@ -57,12 +57,19 @@ def test_the_baseline_drives_the_probe_through_the_clamp() -> None:
     assert min(safety.clearances(s, q)[1] for q in traj.q[::10]) < -0.02
 
 
+def closest_samples(reported: np.ndarray, every: int = 50, closest: int = 12) -> list[int]:
+    """Every ``every``-th sample and the ``closest`` samples of least reported clearance (the
+    sampled oracle costs ~0.2 s a sample)."""
+    least = np.argsort(reported, kind="stable")[:closest]
+    return sorted({*range(0, len(reported), every), *map(int, least)})
+
+
 @pytest.mark.parametrize("backend", [b for b in ("daqp", "clarabel") if b in QP])
 def test_no_part_enters_an_inlet_a_band_or_a_pad(backend: str) -> None:
     s, traj = scene("pipe-rack"), run("pipe-rack", backend)
     assert {o.kind for o in s.obstacles} == {"inlet", "band", "polygon"}
     assert succeeded(s, traj) and "relaxed" in set(traj.status)
-    every = [safety.clearances(s, q) for q in traj.q[::15]]
+    every = [safety.clearances(s, traj.q[k]) for k in closest_samples(traj.min_clearance)]
     assert min(c for c, _ in every) >= 0.01 - 0.001
     worst = int(np.argmin(traj.min_clearance))
     true, _ = safety.clearances(s, traj.q[worst])
@@ -72,7 +79,8 @@ def test_no_part_enters_an_inlet_a_band_or_a_pad(backend: str) -> None:
 def test_the_baseline_drives_the_probe_into_the_pad() -> None:
     s, traj = scene("pipe-rack"), run("pipe-rack", "pinv")
     assert not succeeded(s, traj)
-    assert min(safety.clearances(s, q)[1] for q in traj.q[::15]) < -0.01
+    samples = closest_samples(traj.probe_clearance)
+    assert min(safety.clearances(s, traj.q[k])[1] for k in samples) < -0.01
 
 
 @functools.cache

@@ -99,14 +99,16 @@ def slowed_residual(p: object, x: np.ndarray, v: np.ndarray, rate: float, rho: f
 
 
 def checked_samples(traj: dvqp.Trajectory) -> list[int]:
-    """Every 40th sample, the last and the extremes of the recorded figures."""
+    """About 30 samples evenly spaced (at least 40 steps apart), the last, and the extremes of
+    the recorded figures."""
     extremes = (
         np.argmin(traj.min_clearance),
         np.argmin(traj.self_distance),
         np.argmax(traj.limit_excess),
         np.argmin(traj.probe_clearance),
     )
-    return sorted({*range(0, traj.n_steps + 1, 40), traj.n_steps, *map(int, extremes)})
+    every = max(40, traj.n_steps // 30)
+    return sorted({*range(0, traj.n_steps + 1, every), traj.n_steps, *map(int, extremes)})
 
 
 @functools.cache
