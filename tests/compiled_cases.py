@@ -21,7 +21,7 @@ import dvqp
 from dvqp import KinematicState, ObstacleSet, Robot
 from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon
 from tests.common import LINK_LENGTHS, PIPE_RADIUS, Q0
-from tests.oracle_geometry import circle_points, circle_segments
+from tests.oracles.geometry import circle_points, circle_segments
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 BUNDLED_WITH_OBSTACLES = ("paper-two-inlets", "paper-inlets", "pipe-rack", "many-obstacles")

@@ -29,7 +29,7 @@ from dvqp.limits import (
     VelocityDamper,
 )
 from tests.common import PIPE_RADIUS
-from tests.oracle_limits import closest_parts, damper_rhs, distance_jacobian, measure
+from tests.oracles.limits import closest_parts, damper_rhs, distance_jacobian, measure
 
 DT = 0.005
 ROOT = Path(__file__).resolve().parent.parent

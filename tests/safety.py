@@ -5,7 +5,7 @@ signed distance written in NumPy, each guarded link taken as the real straight 3
 sampled densely and each sample mapped to the developed view (not the closest-point
 computations the planner uses); heights of the points and of those sampled links (the body
 links' lowest points, the holder's) and the tilt from the frames' Cartesian positions; self
-distances from an exact closest-point formulation of its own (``tests/oracle_resolution.py``).
+distances from an exact closest-point formulation of its own (``tests/oracles/resolution.py``).
 """
 
 from __future__ import annotations
@@ -18,9 +18,9 @@ import numpy as np
 from dvqp import Scene
 from dvqp.geometry.shapes import Shape
 from dvqp.limits import ObstacleDamper, SurfaceHeight, TiltLimit
-from tests.oracle_limits import guarded_links
-from tests.oracle_resolution import Frames, frames, point_distances
-from tests.oracle_resolution import tilt as frame_tilt
+from tests.oracles.limits import guarded_links
+from tests.oracles.resolution import Frames, frames, point_distances
+from tests.oracles.resolution import tilt as frame_tilt
 
 
 def _limit(scene: Scene, kind: type) -> object:

@@ -13,7 +13,7 @@ import pytest
 from dvqp.cli import main
 from dvqp.cli.limit_series import Curve, LimitPage, limit_series
 from dvqp.cli.plot_limits import plot_limits
-from tests.oracle_geometry import twin
+from tests.oracles.geometry import twin
 from tests.runs import BUNDLED, run, scene
 
 pytest.importorskip("matplotlib")
@@ -124,7 +124,7 @@ def test_the_curves_are_the_quantities_the_run_recorded(name: str) -> None:
 
 @pytest.mark.parametrize("name", ["paper-two-inlets", "pipe-rack", "many-obstacles"])
 def test_each_obstacle_curve_agrees_with_an_independent_distance(name: str) -> None:
-    """tests/oracle_geometry.py's distances (circles, inlets, bands, polygons): a curve (the
+    """tests/oracles/geometry.py's distances (circles, inlets, bands, polygons): a curve (the
     least over the guarded points and real links) is never above the points' own, and within
     the links' bend (< 1 mm on this arm) of the straight DV polyline's (rail point, body
     points, tool), also far from the obstacle, where a run measures only a bound."""

@@ -22,8 +22,8 @@ from tests.compiled_cases import (
     paper_robot,
     scene_case,
 )
-from tests.oracle_geometry import UserCircle, polygon_points, short_way, twin
-from tests.oracle_limits import guarded_links, link_name, point_name
+from tests.oracles.geometry import UserCircle, polygon_points, short_way, twin
+from tests.oracles.limits import guarded_links, link_name, point_name
 
 FIELDS = ("distance", "normal", "penalty", "penalty_gradient", "t")
 

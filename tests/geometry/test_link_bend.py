@@ -17,8 +17,8 @@ from dvqp.geometry import link_bends, proximity
 from dvqp.geometry.bend import link_bend
 from dvqp.workspace import link_ends
 from tests.common import PIPE_RADIUS, random_configurations
-from tests.oracle_limits import bend
-from tests.oracle_resolution import point_distances
+from tests.oracles.limits import bend
+from tests.oracles.resolution import point_distances
 from tests.runs import scene
 
 

@@ -18,7 +18,7 @@ from dvqp.errors import ParameterError
 from dvqp.geometry import distances, segment_distances
 from dvqp.geometry.proximity import measure
 from dvqp.geometry.shapes import Band, Circle, Inlet, Polygon, Shape
-from tests.oracle_geometry import short_way, twin, wrap
+from tests.oracles.geometry import short_way, twin, wrap
 
 
 def chain_links(points: np.ndarray) -> np.ndarray:

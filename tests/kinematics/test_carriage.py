@@ -16,7 +16,7 @@ from dvqp.cli.drawing import body_at
 from dvqp.limits import ObstacleDamper
 from tests.common import LINK_LENGTHS, PIPE_RADIUS, random_configurations
 from tests.limit_fixtures import ROOT, damper_rows, scene
-from tests.oracle_resolution import frames, point_distances
+from tests.oracles.resolution import frames, point_distances
 
 CLAMP = ROOT / "scenes" / "carriage-clamp.toml"
 

@@ -8,7 +8,7 @@ from dvqp.errors import ParameterError
 from dvqp.limits import AccelerationLimit, JointPositionLimit
 from tests import stepping
 from tests.common import LINK_LENGTHS, PIPE_RADIUS
-from tests.oracle_limits import acceleration_box, braking
+from tests.oracles.limits import acceleration_box, braking
 
 DT = 0.01
 

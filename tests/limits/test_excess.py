@@ -18,8 +18,8 @@ from dvqp.limits import (
 from dvqp.limits.excess import worst_excess
 from tests import stepping
 from tests.common import LINK_LENGTHS, PIPE_RADIUS
-from tests.oracle_limits import assert_excess
-from tests.oracle_limits import worst_excess as oracle_worst
+from tests.oracles.limits import assert_excess
+from tests.oracles.limits import worst_excess as oracle_worst
 
 
 def test_the_worst_excess_is_the_largest_relative_to_its_tolerance(

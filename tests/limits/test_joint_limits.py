@@ -7,7 +7,7 @@ from dvqp.limits import AccelerationLimit, JointPositionLimit, JointVelocityLimi
 from tests import stepping
 from tests.common import LINK_LENGTHS
 from tests.limit_fixtures import DT, DTS, configurations
-from tests.oracle_limits import joint_box
+from tests.oracles.limits import joint_box
 
 
 def box(limit: object, robot: Robot, q: np.ndarray, dt: float = DT) -> Bounds:

@@ -1,6 +1,6 @@
 """The step's limits write their rows and box into one problem: dvqp's compiled limits and a
 user's NumPy (or compiled) limits side by side, each against what it keeps, measured
-independently (:mod:`tests.oracle_limits`)."""
+independently (:mod:`tests.oracles.limits`)."""
 
 from __future__ import annotations
 
@@ -53,8 +53,8 @@ from tests.limit_fixtures import (
     scene,
     tight_limits,
 )
-from tests.oracle_limits import damper_rhs, joint_box, segment_distance
-from tests.oracle_objective import total
+from tests.oracles.limits import damper_rhs, joint_box, segment_distance
+from tests.oracles.objective import total
 
 
 def assert_problem(

@@ -13,8 +13,8 @@ from dvqp.cli import main
 from dvqp.cli.report import format_summary
 from dvqp.run.comparison import summarize
 from tests import runs
-from tests.oracle_limits import chord_low, guarded_links, link_name
-from tests.oracle_resolution import frames
+from tests.oracles.limits import chord_low, guarded_links, link_name
+from tests.oracles.resolution import frames
 
 RUNS = [("narrow-passage", "daqp"), ("narrow-passage", "pinv")]
 

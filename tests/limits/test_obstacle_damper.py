@@ -12,7 +12,7 @@ from dvqp.limits import ObstacleDamper
 from tests import stepping
 from tests.common import PIPE_RADIUS, central_difference
 from tests.limit_fixtures import DT, configurations, damper_rows, near_obstacles, problem_rows
-from tests.oracle_limits import damper_rhs, measure
+from tests.oracles.limits import damper_rhs, measure
 
 
 def test_pairs_outside_the_influence_distance_add_no_row(

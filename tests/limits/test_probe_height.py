@@ -9,7 +9,7 @@ from dvqp.limits import ProbeHeight, SurfaceHeight
 from tests import stepping
 from tests.common import PIPE_RADIUS, central_difference
 from tests.limit_fixtures import DT, configurations, damper_rows
-from tests.oracle_limits import assert_excess, chord_low, worst_excess
+from tests.oracles.limits import assert_excess, chord_low, worst_excess
 
 
 def holder_low(robot: Robot, q: np.ndarray) -> float:

@@ -13,7 +13,7 @@ from dvqp.workspace import PairBuffers, as_struct
 from tests import stepping
 from tests.common import PIPE_RADIUS, random_configurations
 from tests.limit_fixtures import damper_rows
-from tests.oracle_limits import segment_distance, self_distances
+from tests.oracles.limits import segment_distance, self_distances
 
 DT = 0.01
 

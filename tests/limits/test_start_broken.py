@@ -20,7 +20,7 @@ from dvqp.resolution.pinv import PseudoinverseResolver
 from dvqp.run.comparison import summarize
 from dvqp.scenes import loads
 from dvqp.step import Stepper
-from tests.oracle_limits import measure
+from tests.oracles.limits import measure
 from tests.runs import SCENES, run, scene
 
 PAPER = (SCENES / "paper-two-inlets.toml").read_text(encoding="utf-8")

@@ -12,7 +12,7 @@ from dvqp.limits import SurfaceHeight, damper_value
 from tests import stepping
 from tests.common import PIPE_RADIUS, central_difference
 from tests.limit_fixtures import DT, configurations, damper_rows
-from tests.oracle_limits import chord_low
+from tests.oracles.limits import chord_low
 
 
 def body_lows(robot: Robot, q: np.ndarray) -> np.ndarray:

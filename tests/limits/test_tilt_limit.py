@@ -12,7 +12,7 @@ from dvqp.limits.tilt import tilt_angle, tilt_cosine
 from tests import stepping
 from tests.common import PIPE_RADIUS, central_difference, random_configurations
 from tests.limit_fixtures import DT, damper_rows, problem_rows
-from tests.oracle_limits import tilt, tilt_sine
+from tests.oracles.limits import tilt, tilt_sine
 
 
 def test_the_tilt_row_is_minus_the_gradient_of_sin_tilt(robot: Robot) -> None:

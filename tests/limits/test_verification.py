@@ -1,6 +1,6 @@
 """The step's exact verification: the worst excess of every limit (dvqp's and a user's dampers)
 at a configuration, against the values measured independently and the old rule
-(:func:`tests.oracle_limits.worst_excess`)."""
+(:func:`tests.oracles.limits.worst_excess`)."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from dvqp.limits import JointPositionLimit, ObstacleDamper, ProbeHeight, TiltLim
 from tests import stepping
 from tests.common import LINK_LENGTHS, PIPE_RADIUS
 from tests.limit_fixtures import DT, ROOT, SCENES, configurations, scene, tight_limits
-from tests.oracle_limits import assert_excess, measure, verified, worst_excess
+from tests.oracles.limits import assert_excess, measure, verified, worst_excess
 
 
 def walks(found: Sequence[np.ndarray]) -> list[tuple[np.ndarray, np.ndarray]]:

@@ -9,7 +9,7 @@ import pytest
 import dvqp
 from dvqp.limits import AccelerationLimit, SelfCollision, self_distance
 from dvqp.run.comparison import summarize
-from tests.oracle_resolution import frames, self_distances
+from tests.oracles.resolution import frames, self_distances
 from tests.runs import BUNDLED, QP, run, scene
 
 

@@ -1,5 +1,5 @@
 """The objective's terms and their sum, through the step: values against the old NumPy
-formulas (:mod:`tests.oracle_objective`), gradients against finite differences."""
+formulas (:mod:`tests.oracles.objective`), gradients against finite differences."""
 
 import numpy as np
 import pytest
@@ -18,7 +18,7 @@ from dvqp.errors import ParameterError, ShapeError
 from dvqp.objective import ObstacleLinks, ObstaclePoints, OrbitalLevel
 from tests import stepping
 from tests.common import PIPE_RADIUS, central_difference, objective_with, random_configurations
-from tests.oracle_objective import evaluate, total
+from tests.oracles.objective import evaluate, total
 
 R = PIPE_RADIUS
 

@@ -1,4 +1,4 @@
-"""The step's objective against the old NumPy terms (:mod:`tests.oracle_objective`): each
+"""The step's objective against the old NumPy terms (:mod:`tests.oracles.objective`): each
 compiled term and their sum over every shape class and bundled scene, with a user's terms
 (NumPy or compiled) and shapes of one's own mixed in."""
 
@@ -32,7 +32,7 @@ from tests.compiled_cases import (
     scene_case,
 )
 from tests.limit_fixtures import damper_rows
-from tests.oracle_objective import evaluate, total
+from tests.oracles.objective import evaluate, total
 
 K_HEIGHT = np.array([100.0, 50.0, 80.0, 120.0, 90.0])
 K_OBSTACLE = np.array([1.0, 2.0, 0.5, 1.5, 1.0])

@@ -33,7 +33,7 @@ from dvqp.resolution.pinv import pinv_step
 from dvqp.resolution.spec import DEFAULT_TASK_WEIGHT
 from dvqp.step import advance
 from tests.common import LINK_LENGTHS, PIPE_RADIUS, Q0, objective_with, random_configurations
-from tests.oracle_resolution import frames, kkt, kkt_residual, nested
+from tests.oracles.resolution import frames, kkt, kkt_residual, nested
 from tests.resolution.test_qp_resolver import CorruptingBackend
 
 DT = 0.005

@@ -2,7 +2,7 @@
 
 The compiled step (:func:`dvqp.resolution.pinv.pinv_step`, and the baseline's
 :class:`~dvqp.Stepper`) is compared with the formula written out in NumPy and with the KKT
-minimiser (``tests/oracle_resolution.py``).
+minimiser (``tests/oracles/resolution.py``).
 """
 
 import numpy as np
@@ -24,7 +24,7 @@ from dvqp import (
 from dvqp.errors import ParameterError, ShapeError, SingularConfigurationError
 from dvqp.resolution.pinv import SINGULAR, pinv_step
 from tests.common import PIPE_RADIUS, Q0, random_configurations, spec_with
-from tests.oracle_resolution import eq18, frames, kkt
+from tests.oracles.resolution import eq18, frames, kkt
 
 DT = 0.005
 COMMAND = np.array([0.02, 0.01, 0.0, 0.1])

@@ -40,7 +40,7 @@ from tests.common import (
     random_configurations,
     spec_with,
 )
-from tests.oracle_resolution import eq18, kkt
+from tests.oracles.resolution import eq18, kkt
 
 DT = 0.005
 

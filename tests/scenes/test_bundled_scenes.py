@@ -15,7 +15,7 @@ from dvqp import Constraint, KinematicState, QPResolver, Scene, Stepper, Traject
 from dvqp.limits import ObstacleDamper, SurfaceHeight
 from dvqp.run.planning import check_run, scene_commands
 from dvqp.scenes.scene import loads
-from tests.oracle_limits import measure
+from tests.oracles.limits import measure
 from tests.runs import QP, run, scene
 
 

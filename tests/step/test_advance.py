@@ -27,7 +27,7 @@ from dvqp.run.planning import scene_commands
 from dvqp.step import JOINT_STRIDE, MAX_HALVINGS, advance
 from dvqp.step.engine import Resolution
 from tests.common import PIPE_RADIUS, Q0
-from tests.oracle_resolution import frames, link_distances, point_distances
+from tests.oracles.resolution import frames, link_distances, point_distances
 
 SCENE = Path(__file__).resolve().parents[2] / "scenes" / "paper-two-inlets.toml"
 PERIOD = 2.0 * math.pi * PIPE_RADIUS

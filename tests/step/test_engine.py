@@ -25,7 +25,7 @@ from dvqp.resolution.pinv import PseudoinverseResolver
 from dvqp.run.planning import scene_commands, scene_timing
 from solvers import Problem
 from tests import safety
-from tests.oracle_resolution import (
+from tests.oracles.resolution import (
     eq18,
     frames,
     kkt_residual,

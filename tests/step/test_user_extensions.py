@@ -19,8 +19,8 @@ import pytest
 
 import dvqp
 from tests.common import PIPE_RADIUS, central_difference
-from tests.oracle_resolution import frames
-from tests.oracle_resolution import tilt as tilt_of
+from tests.oracles.resolution import frames
+from tests.oracles.resolution import tilt as tilt_of
 from tests.stepping import stepper
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "docs" / "examples"

@@ -22,7 +22,7 @@ from dvqp import (
 )
 from dvqp.kinematics.developed_view import wrap
 from tests.common import PIPE_RADIUS, central_difference, random_configurations
-from tests.oracle_resolution import frames
+from tests.oracles.resolution import frames
 
 DT = 0.005
 NAMES = ("l", "z", "h")

@@ -36,8 +36,8 @@ from dvqp.limits import (
     SurfaceHeight,
     TiltLimit,
 )
-from tests.oracle_geometry import inlet_points
-from tests.oracle_limits import (
+from tests.oracles.geometry import inlet_points
+from tests.oracles.limits import (
     chord_low,
     closest_parts,
     guarded_links,

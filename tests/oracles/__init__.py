@@ -1,0 +1,1 @@
+"""Independent oracles: a second implementation of the package's math, in NumPy, for tests."""
