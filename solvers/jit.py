@@ -244,7 +244,11 @@ class SeparateDispatcher(KernelDispatcher):
 def njit(
     function: Callable[..., Any] | None = None, *, separate: bool = False, **options: Any
 ) -> Any:
-    """``numba.njit(cache=True, **options)``, its cache a :class:`SoftCache`.
+    """``numba.njit(cache=True, **options)``, its cache a :class:`SoftCache`, without the
+    C-callable wrapper numba adds to every compile for first-class function values (nothing
+    here takes a dispatcher as a value: compiled callers call a kernel directly or through its
+    symbol, :mod:`solvers.linking`); it cost about 20 ms of every compile, 1.5-2 s of a cold
+    plan.
 
     Use as ``@njit``, ``@njit(inline="always")`` or ``@njit(separate=True)`` (a kernel
     compiled and cached on its own, :class:`SeparateDispatcher`); compiles at the first call, as
@@ -257,7 +261,8 @@ def njit(
 
     def decorate(f: Callable[..., Any]) -> KernelDispatcher:
         kind = SeparateDispatcher if separate else KernelDispatcher
-        dispatcher = kind(py_func=f, locals={}, targetoptions={"nopython": True, **options})
+        targetoptions = {"nopython": True, "no_cfunc_wrapper": True, **options}
+        dispatcher = kind(py_func=f, locals={}, targetoptions=targetoptions)
         dispatcher._cache = _cache_for(f)  # what numba's enable_caching() sets, soft
         return dispatcher
 
