@@ -33,8 +33,10 @@ from typing import Any
 
 import numba
 from numba import types
+from numba.core import sigutils
 from numba.core.caching import FunctionCache, IndexDataCacheFile, NullCache
 from numba.core.compiler import Flags
+from numba.core.compiler_lock import global_compiler_lock
 from numba.core.dispatcher import Dispatcher
 from numba.core.registry import CPUDispatcher
 from numba.core.typing.templates import Signature
@@ -159,6 +161,12 @@ class SoftCache(FunctionCache):
         linking.record(cres.library, needs)
         return cres
 
+    def _index_key(self, sig: Any, codegen: Any) -> Any:
+        """numba's key, marked for an overload compiled for compiled callers only (no CPython
+        wrapper: :class:`KernelDispatcher`), so that a Python call never loads one."""
+        key = super()._index_key(sig, codegen)
+        return (*key, "native") if linking.is_native_only() else key
+
     def _save_overload(self, sig: Any, data: Any) -> None:
         """numba's, the entry holding the symbols its code calls (:mod:`solvers.linking`)."""
         if not self._enabled or not self._impl.check_cachable(data):
@@ -207,26 +215,66 @@ class _Flags(Flags):  # type: ignore[misc]
         return memo[1]  # type: ignore[no-any-return]
 
 
+def _flags(flags: Flags) -> _Flags:
+    """A compile's flags (:class:`_Flags`), without the CPython wrapper when the compile is
+    for compiled callers only (:func:`solvers.linking.native_only`)."""
+    made = _Flags(flags)
+    if linking.is_native_only():
+        made.no_cpython_wrapper = True
+    return made
+
+
 class KernelDispatcher(CPUDispatcher):  # type: ignore[misc]
-    """numba's CPU dispatcher, compiled for the plain types of a compiled caller's arguments.
+    """numba's CPU dispatcher, compiled for the plain types of a compiled caller's arguments,
+    without a CPython wrapper until Python calls it.
 
     numba compiles a function called from compiled code for its arguments' types as typed
     there, a constant as its literal type: ``f(x, True)`` and ``f(x, False)`` were two
     specialisations of ``f`` and of everything it calls (with a cold cache, seconds). No
     kernel here asks for a literal, so a call is typed with each argument's plain type (one
     specialisation; the constant is converted at the call).
+
+    numba also wraps every compile for calls from Python (about 20 ms of a small kernel's
+    compile), yet most kernels are only ever called from compiled code. A compile for a
+    compiled caller (or for :mod:`solvers.linking`) has no wrapper and is cached under a key
+    of its own; the first Python call of such an overload compiles (or loads) the wrapped
+    one, which then serves both. A kernel that Python calls in every run as well (a NumPy view
+    the start's checks use) is declared ``njit(python=True)`` and always compiled wrapped.
     """
 
     separate = False
     """Whether compiled callers call it through its symbol (:mod:`solvers.linking`)."""
+    python = False
+    """Whether Python calls it in every run too: always compiled with the CPython wrapper."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
-        self._compiler._customize_flags = _Flags  # its compiles' flags, and those they nest
+        self._compiler._customize_flags = _flags  # its compiles' flags, and those they nest
+        self._native_only: set[tuple[Any, ...]] = set()
+        self._unwrapped: list[Any] = []  # replaced overloads: compiled callers hold their code
 
     def get_call_template(self, args: tuple[Any, ...], kws: dict[str, Any]) -> Any:
         plain = tuple(types.unliteral(a) for a in args)
-        return super().get_call_template(plain, {k: types.unliteral(v) for k, v in kws.items()})
+        with linking.native_only(not self.python):
+            return super().get_call_template(plain, {k: types.unliteral(v) for k, v in kws.items()})
+
+    def compile(self, sig: Any) -> Any:
+        if not linking.is_native_only():
+            args = tuple(sigutils.normalize_signature(sig)[0])
+            if args in self._native_only:  # a Python call: the wrapped overload replaces it
+                with global_compiler_lock:
+                    if args in self._native_only:
+                        self._unwrapped.append(self.overloads.pop(args))
+                        self._native_only.discard(args)
+        return super().compile(sig)
+
+    def add_overload(self, cres: Any) -> None:
+        args = tuple(cres.signature.args)
+        if cres.objectmode or not linking.is_native_only():
+            super().add_overload(cres)
+            return
+        self._native_only.add(args)  # not callable from Python: kept out of numba's table
+        self.overloads[args] = cres
 
 
 class SeparateDispatcher(KernelDispatcher):
@@ -250,7 +298,8 @@ def njit(
     symbol, :mod:`solvers.linking`); it cost about 20 ms of every compile, 1.5-2 s of a cold
     plan.
 
-    Use as ``@njit``, ``@njit(inline="always")`` or ``@njit(separate=True)`` (a kernel
+    Use as ``@njit``, ``@njit(inline="always")``, ``@njit(python=True)`` (see
+    :class:`KernelDispatcher`) or ``@njit(separate=True)`` (a kernel
     compiled and cached on its own, :class:`SeparateDispatcher`); compiles at the first call, as
     numba's.
     """
@@ -259,10 +308,13 @@ def njit(
     if separate and options.get("inline", "never") != "never":
         raise TypeError("njit: a separate kernel is never inlined")
 
+    python = options.pop("python", False)
+
     def decorate(f: Callable[..., Any]) -> KernelDispatcher:
         kind = SeparateDispatcher if separate else KernelDispatcher
         targetoptions = {"nopython": True, "no_cfunc_wrapper": True, **options}
         dispatcher = kind(py_func=f, locals={}, targetoptions=targetoptions)
+        dispatcher.python = python
         dispatcher._cache = _cache_for(f)  # what numba's enable_caching() sets, soft
         return dispatcher
 

@@ -26,9 +26,11 @@ raised in the kernel propagates to its caller as from a linked call.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib
-from collections.abc import Callable, Iterable
+import threading
+from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
 import llvmlite.binding as llvm
@@ -45,6 +47,26 @@ kernel."""
 
 _EXPOSED: dict[str, int] = {}
 """Symbols made known to LLVM in this process, with their addresses."""
+
+_MODE = threading.local()
+
+
+@contextlib.contextmanager
+def native_only(native: bool = True) -> Iterator[None]:
+    """Compiles started in this block (on this thread) are for compiled callers only: without
+    numba's CPython wrapper (:class:`solvers.jit.KernelDispatcher`); ``native=False``: with
+    it, whatever the block around says."""
+    before = getattr(_MODE, "native", False)
+    _MODE.native = native
+    try:
+        yield
+    finally:
+        _MODE.native = before
+
+
+def is_native_only() -> bool:
+    """Whether compiles on this thread are for compiled callers only (:func:`native_only`)."""
+    return bool(getattr(_MODE, "native", False))
 
 
 def _native(cres: Any) -> int:
@@ -142,7 +164,8 @@ def provide(needs: Iterable[Need]) -> bool:
     for module, name, args, expected in needs:
         try:
             dispatcher = getattr(importlib.import_module(module), name)
-            dispatcher.compile(args)
+            with native_only(not getattr(dispatcher, "python", False)):
+                dispatcher.compile(args)
             cres = dispatcher.overloads[tuple(args)]
         except Exception:  # gone, renamed, no longer compiles: the entry is stale
             return False
@@ -156,7 +179,8 @@ def provide(needs: Iterable[Need]) -> bool:
 def address_of(dispatcher: Any, argtypes: tuple[Any, ...]) -> int:
     """Compile (or load) ``dispatcher`` for ``argtypes`` and return its native function's
     address, for :func:`indirect` calls."""
-    dispatcher.compile(tuple(argtypes))
+    with native_only(not getattr(dispatcher, "python", False)):
+        dispatcher.compile(tuple(argtypes))
     return _native(dispatcher.overloads[tuple(argtypes)])
 
 

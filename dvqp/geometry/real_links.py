@@ -13,7 +13,7 @@ from dvqp.geometry.measure import fill, link_row, point_row
 from solvers.jit import njit
 
 
-@njit(separate=True)
+@njit(separate=True, python=True)  # Python calls it in every plan too
 def real_links(shapes, chain, origins, radius, tool, near) -> None:  # type: ignore[no-untyped-def]
     """The clearance of every guarded link's real DV image to every obstacle, into ``near``'s
     ``real_*`` rows: the least over the link's pieces of the straight piece's clearance less

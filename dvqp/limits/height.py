@@ -236,7 +236,7 @@ def chord_heights(
             gradient[r, q] = ux * jx + uy * jy
 
 
-@njit(separate=True)
+@njit(separate=True, python=True)  # Python calls it in every plan too
 def lowest_chords(guarded, origins, ends, k, radius):  # type: ignore[no-untyped-def]
     """``(h, i, h_holder)``: the lowest height (m) of the chords of the guarded links ``ends``
     (L, 2) other than the probe holder (link ``k − 1``): the body links and the carriage link,

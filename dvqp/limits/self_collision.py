@@ -105,7 +105,7 @@ class SelfCollision(VelocityDamper):
         return tuple(_pair(names, a, b) for a, b in zip(pairs.i, pairs.j, strict=True))
 
 
-@njit(separate=True)
+@njit(separate=True, python=True)  # Python calls it in every plan too
 def pair_distances(o, pairs) -> None:  # type: ignore[no-untyped-def]
     """Distance, unit normal ``c_i − c_j``, ``s`` and ``t`` of the link pairs of the guarded
     points ``o`` (m, 3) into ``pairs`` (a packed PairBuffers): link i's segment
