@@ -130,6 +130,7 @@ def main(argv: list[str] | None = None) -> int:
                 ["compare", args.scene],
                 fresh(tmp, "c"),
             ),
+            ("cold: dvqp bench (2 scenes)", ["bench", "--count", "2"], fresh(tmp, "bench")),
             (
                 "cold: dvqp export-qps",
                 ["export-qps", args.scene, "--backend", args.backend, "-o", str(tmp / "qps")],
