@@ -106,7 +106,9 @@ def footer_lines(rows: Sequence[Row], width: int = 100) -> list[str]:
 
 def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None) -> str:
     """What ``dvqp plan`` prints about a run: ``row`` from :func:`dvqp.run.comparison.summarize`,
-    ``output`` the file the trajectory was saved to (or None)."""
+    ``output`` the file the trajectory was saved to (or None); a line longer than 100
+    characters is wrapped, its continuation two columns right of the value (a file name
+    never)."""
     tool = traj.tool[-1]
     lines = [
         f"scene           {scene.name} ({one_line(scene.source)}), {scene.mode} mode",
@@ -143,7 +145,14 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         )
     if output is not None:
         lines.append(f"saved           {output}")
-    return "\n".join(lines)
+    wrap = textwrap.TextWrapper(
+        100, subsequent_indent=" " * 18, break_long_words=False, break_on_hyphens=False
+    )
+    physical = [part for line in lines for part in line.split("\n")]
+    names = (physical[0], physical[-1] if output is not None else None)  # files: never wrapped
+    return "\n".join(
+        wrapped for line in physical for wrapped in ([line] if line in names else wrap.wrap(line))
+    )
 
 
 def _levels(traj: Trajectory) -> list[str]:

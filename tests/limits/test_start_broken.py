@@ -163,7 +163,8 @@ def test_the_baseline_that_makes_it_worse_is_broken_and_says_by_how_much() -> No
     )
     assert worse > 0.005
     text = format_summary(s, traj, summarize(s, traj), None)
-    limits = text.split("\nlimits          ")[1].split("\nstep time")[0].split("\n")
+    value = text.split("\nlimits          ")[1].split("\nstep time")[0]
+    limits = value.replace("\n" + " " * 18, " ").split("\n")  # a wrapped item on one line
     assert limits[0].startswith("BROKEN: ") and limits[1] == f"                {line}"
     why = summarize(s, traj)["error"]  # the samples it made worse, and the start's
     assert " samples break a limit: " in why and why.endswith(
