@@ -18,11 +18,13 @@ from typing import Any, TextIO
 
 from numba.core import event
 
-AFTER = 1.0
-"""s: compiling for longer than this is announced."""
+AFTER = 0.1
+"""s: compiling for longer than this is announced (a run with every kernel cached compiles
+nothing; a cold one starts compiling about 2 s after the command starts, most of it
+importing)."""
 
-ESTIMATES = {"plan": 20, "compare": 30, "export-qps": 25, "bench": 35}
-"""s of CPU a first run of each command compiles for on the paper scene (a 2-core machine,
+ESTIMATES = {"plan": 27, "compare": 35, "export-qps": 30, "bench": 40}
+"""s a first run of each command compiles for on the paper scene (a 2-core machine, quiet:
 ``benchmarks/startup.py``); other commands compile less."""
 
 
