@@ -178,7 +178,7 @@ class Stepper(Verification):
             return status
         for hook in hooks.measured:
             hook()
-        stages.evaluate(s, False, stages.ASSESS, stages.ASSESS)
+        stages.evaluate(s, False, stages.ASSESS, stages.DAMPERS)
         for hook in hooks.assessed:
             hook()
         return int(stages.evaluate(s, False, stages.CONCLUDE, stages.CONCLUDE))
