@@ -2,7 +2,10 @@
 
 Usage::
 
-    python benchmarks/floor.py [--repeat 5] [--scenes NAME,...] [--no-scenes]
+    PYTHONPATH=. python benchmarks/floor.py [--repeat 5] [--scenes NAME,...] [--no-scenes]
+
+(``python benchmarks/x.py`` puts ``benchmarks/`` first on the path, not the current folder:
+without ``PYTHONPATH`` the installed ``dvqp`` is measured, which the script then says.)
 
 Everything is measured in this one process (compiled code loaded from the cache before the
 first timed run), medians in µs:
@@ -141,20 +144,22 @@ def stage_times(scene: dvqp.Scene, backend: str, traj: dvqp.Trajectory) -> dict[
     command = np.zeros(4)
     found: dict[str, list[float]] = {k: [] for k in STAGES}
     evaluate = stages.evaluate
+    OBJECTIVE, DAMPERS, CONCLUDE = stages.OBJECTIVE, stages.DAMPERS, stages.CONCLUDE
     for k in range(traj.n_steps):
         stepper.observe(traj.qdot[k - 1] if k else np.zeros(scene.robot.n), dt)
         stepper.load(traj.q[k])
         kin = timed(lambda: kinematics(model, scene.pipe_radius, state))
         measure = timed(lambda: evaluate(s, False, stages.MEASURE, stages.MEASURE))
         found["kinematics"].append(kin)
-        found["obstacles"].append(measure - kin + timed(lambda: evaluate(s, False, 1, 1)))
-        found["objective"].append(timed(lambda: evaluate(s, False, 2, 2)))
-        found["dampers"].append(timed(lambda: evaluate(s, False, 3, 3)))
+        links = timed(lambda: evaluate(s, False, stages.LINKS, stages.LINKS))
+        found["obstacles"].append(measure - kin + links)
+        found["objective"].append(timed(lambda: evaluate(s, False, OBJECTIVE, OBJECTIVE)))
+        found["dampers"].append(timed(lambda: evaluate(s, False, DAMPERS, DAMPERS)))
         stepper.record_at[0] = -1
-        verify = timed(lambda: evaluate(s, False, 4, 4))
+        verify = timed(lambda: evaluate(s, False, CONCLUDE, CONCLUDE))
         found["verification"].append(verify)
         stepper.record_at[0] = k
-        found["recording"].append(timed(lambda: evaluate(s, False, 4, 4)) - verify)
+        found["recording"].append(timed(lambda: evaluate(s, False, CONCLUDE, CONCLUDE)) - verify)
         stepper.record_at[0] = -1
         found["QP assembly"].append(timed(lambda: stepper.prepare(command, dt)))
     return {k: float(np.median(v)) for k, v in found.items() if v}
@@ -262,6 +267,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--scenes", help="comma-separated scene names (default: every bundled)")
     parser.add_argument("--no-scenes", action="store_true", help="the paper scene only")
     args = parser.parse_args(argv)
+    if Path(dvqp.__file__).resolve().parents[1] != ROOT:
+        print(
+            f"measuring the dvqp of {Path(dvqp.__file__).parent}, not this checkout's: "
+            f"run with PYTHONPATH={ROOT}",
+            file=sys.stderr,
+        )
     print_paper(paper_rows(args.repeat))
     if args.no_scenes:
         return 0
