@@ -215,20 +215,21 @@ def print_paper(rows: dict[str, dict[str, float]]) -> None:
     )
 
 
-def kinds(files: list[str]) -> dict[str, tuple[float, float, int, int]]:
-    """Per scene file, the DAQP run's slowed and relaxed steps' medians over its strict ones
-    (NaN: none), and how many of each."""
+def kinds(files: list[str], repeat: int) -> dict[str, tuple[float, float, int, int]]:
+    """Per scene file, the median of the DAQP runs' slowed and of their relaxed steps over
+    that of their strict ones (``repeat`` runs; NaN: none), and how many of each a run has."""
     out = {}
     for f in files:
-        traj = dvqp.plan(dvqp.load_scene(f), "daqp")
-        status, times = np.asarray(traj.status), traj.step_time
-        ok = np.arange(status.shape[0]) > 0
-        strict = np.median(times[ok & (status == "optimal")])
+        scene = dvqp.load_scene(f)
+        runs = [dvqp.plan(scene, "daqp") for _ in range(repeat)]
+        status = np.concatenate([np.asarray(t.status)[1:] for t in runs])
+        times = np.concatenate([t.step_time[1:] for t in runs])
+        strict = np.median(times[status == "optimal"])
         cells = []
         for kind in ("slowed", "relaxed"):
-            chosen = ok & (status == kind)
+            chosen = status == kind
             cells.append(np.median(times[chosen]) / strict if chosen.any() else np.nan)
-            cells.append(int(chosen.sum()))
+            cells.append(int(chosen.sum()) // repeat)
         out[Path(f).stem] = (cells[0], cells[2], cells[1], cells[3])
     return out
 
@@ -241,7 +242,7 @@ def print_scenes(files: list[str], repeat: int) -> None:
         for b in ("pinv", "daqp"):
             for f, value in zip(order, bracketed(order, str(PAPER), b), strict=True):
                 got.setdefault((Path(f).stem, b), []).append(value)
-    found = kinds(files)
+    found = kinds(files, repeat)
     header = (
         f"{'scene':<20} {'pinv us':>8} {'/paper':>6} {'daqp us':>8} {'/paper':>6} "
         f"{'slowed':>13} {'relaxed':>13}"
