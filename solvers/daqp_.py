@@ -221,7 +221,8 @@ class DaqpBackend(StatefulBackend):
         if self._model is None or guess is not None:
             self._release()
             return self._setup(problem, guess)
-        self._bound = None  # bound afresh: the compiled copy is tried again
+        if self._stack is None:
+            self._bound = None  # bound afresh: the compiled copy is tried again
         self._load(problem)
         start = perf_counter()
         flag = self._model.update(H=self._H, f=self._f, A=self._M, sense=self._sense)

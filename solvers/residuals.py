@@ -204,13 +204,26 @@ def passing(values: tuple[float, ...], tolerance: float) -> Residuals | None:
         and complementarity <= dual_tol
     ):
         return None
-    residuals = _new(Residuals)  # a frozen dataclass, filled without its slower __init__
+    return filled(equality, inequality, bounds, stationarity, complementarity, gap)
+
+
+def filled(
+    equality: float,
+    inequality: float,
+    bounds: float,
+    stationarity: float | None = None,
+    complementarity: float | None = None,
+    duality_gap: float | None = None,
+) -> Residuals:
+    """``Residuals(...)`` of these values, filled without the frozen dataclass's slower
+    ``__init__`` (a per-solve path)."""
+    residuals = _new(Residuals)
     residuals.__dict__.update(
         equality=equality,
         inequality=inequality,
         bounds=bounds,
         stationarity=stationarity,
         complementarity=complementarity,
-        duality_gap=gap,
+        duality_gap=duality_gap,
     )
     return residuals

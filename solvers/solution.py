@@ -13,7 +13,7 @@ from .exceptions import ProblemShapeError, SolverError
 from .kkt import evaluate, floats, quick
 from .problem import Problem
 from .refusal import refusal
-from .residuals import ACCEPTABLE, Residuals, failed_checks, passing
+from .residuals import ACCEPTABLE, Residuals, failed_checks, filled, passing
 
 
 @dataclass(eq=False)
@@ -267,11 +267,11 @@ def _verdict(solution: Solution, values: tuple[float, ...]) -> Solution:
         return solution
     code, equality, inequality, bounds, stationarity, complementarity, scale, gap = values
     if code == ACCEPTABLE:
-        solution.residuals = Residuals(
+        solution.residuals = filled(
             equality, inequality, bounds, stationarity, complementarity, gap
         )
     elif code == FINITE:
-        solution.residuals = Residuals(equality, inequality, bounds)
+        solution.residuals = filled(equality, inequality, bounds)
     else:
         solution.y = solution.z = solution.z_box = None
         solution.message = f"{solution.backend} said {solution.status!r} but x is not finite"

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.errors import ParameterError
-from dvqp.kinematics.developed_view import wrap, wrap_angle
+from dvqp.kinematics.developed_view import wrap_period
 from dvqp.motion.deviation import path_deviation
 
 Array = NDArray[np.float64]
@@ -34,9 +34,9 @@ TIMINGS = ("fixed", "scaled")
 
 def dv_error(reference: Array, actual: Array, radius: float) -> Array:
     """``x_d − x`` of DV coordinates (…, 4) with l wrapped modulo 2πR and α modulo 2π."""
-    e = np.asarray(reference, dtype=float) - np.asarray(actual, dtype=float)
-    e[..., 0] = wrap(e[..., 0], radius)
-    e[..., 3] = wrap_angle(e[..., 3])
+    e = np.subtract(reference, actual, dtype=np.float64)
+    # l and α (components 0 and 3) in one call: periods 2πR and 2π (wrap, wrap_angle)
+    e[..., ::3] = wrap_period(e[..., ::3], np.array([2.0 * math.pi * radius, 2.0 * math.pi]))
     return e
 
 

@@ -188,7 +188,7 @@ class QPSolver:
                 x = solution.x[: qp.cost.shape[0]]
                 return Answer(x, "optimal", solution.iterations, solution.solver_time)
         if levels is not None:
-            slow = self._slow_down if not rest and np.any(self.feedforward) else None
+            slow = self._slow_down if not rest and self.feedforward.any() else None
             out = levels.solve(self._count, slow, refused)
             if out.x is not None:
                 return Answer(out.x, out.status, out.iterations, out.solver_time, out.rate)
@@ -196,7 +196,7 @@ class QPSolver:
         solution = strict.solve(self.strict)
         self._count("strict", self.strict, solution)
         spent, status, rate = solution.solver_time, "optimal", 1.0
-        if not solution.found and not rest and np.any(self.feedforward):
+        if not solution.found and not rest and self.feedforward.any():
             solution, rate = self._slow_down()
             spent, status = spent + solution.solver_time, "slowed"
         if not solution.found:

@@ -44,6 +44,16 @@ def dropping(factory: Callable[[], solvers.Backend]) -> Callable[[], solvers.Bac
     return lambda: RowDropping(factory())
 
 
+def paced_rows(tool: NDArray[np.int64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """The rows of the tool tasks ``tool`` (``TaskArrays.tool``: first row, count,
+    components) and the command's component each takes, as two index arrays."""
+    rows = [(start + i, c) for start, count, *cs in tool for i, c in enumerate(cs[:count])]
+    return (
+        np.array([r for r, _ in rows], dtype=np.intp),
+        np.array([c for _, c in rows], dtype=np.intp),
+    )
+
+
 class Resolution(NamedTuple):
     """How a step's joint velocity (:attr:`Stepper.x`) was found: ``success``, ``status``
     (``"optimal"``, ``"slowed"``, ``"relaxed"``, ``"braking"`` or why it failed), the
@@ -137,6 +147,8 @@ class Stepper(Verification):
         tool and every task held still, λ = 0), a damper holds a drift below its safe value
         instead of pulling it back (right side at least 0), and Q̇ = 0 is taken when it is
         feasible (:meth:`~dvqp.resolution.qp.QPSolver.solve`)."""
+        self._paced = paced_rows(tasks.tool)
+        """The tool tasks' rows and the command's components they take (:meth:`pace`)."""
         if tasks.levels.shape[0] > 2:
             self._check_levels(q0, dt)
 
@@ -178,7 +190,7 @@ class Stepper(Verification):
             return status
         for hook in hooks.measured:
             hook()
-        stages.evaluate(s, False, stages.ASSESS, stages.ASSESS)
+        stages.evaluate(s, False, stages.ASSESS, stages.DAMPERS)
         for hook in hooks.assessed:
             hook()
         return int(stages.evaluate(s, False, stages.CONCLUDE, stages.CONCLUDE))
@@ -262,8 +274,8 @@ class Stepper(Verification):
         v = self.solver.feedforward
         v[:] = 0.0
         if feedforward is not None:
-            for start, count, *components in self.layout.tasks.tool:
-                v[start : start + count] = feedforward[components[:count]]
+            rows, components = self._paced
+            v[rows] = feedforward[components]
 
     def prepare(self, command: Array, dt: float) -> int:
         """Write the problem of a step from the loaded state for ``command`` (4,) over ``dt``

@@ -33,8 +33,12 @@ from dvqp.tasks.posture import posture_rows
 from dvqp.tasks.tool_dv import tool_rows
 from solvers.jit import njit
 
-MEASURE, ASSESS, CONCLUDE = 0, 1, 2
-"""Stages of :func:`evaluate`."""
+MEASURE, LINKS, OBJECTIVE, DAMPERS, CONCLUDE = 0, 1, 2, 3, 4
+"""Stages of :func:`evaluate`: the kinematics and the obstacles' distances, the real links,
+the objective, the dampers' distances, the exact verification (and the sample)."""
+ASSESS = LINKS
+"""The first stage after a run's measuring parts of your own (:mod:`dvqp.step.hooks`); they
+assess after :data:`DAMPERS`."""
 ROWS, CLOSE = 0, 1
 """Stages of :func:`prepare`."""
 SINGULAR_TASK, INDEFINITE_METRIC, BAD_COMMAND = -2, -3, -4
@@ -54,10 +58,12 @@ def evaluate(s, integrate, first, last) -> int:  # type: ignore[no-untyped-def]
             return singular  # type: ignore[no-any-return]
         measure_chain(s.shapes, s.state.guarded, s.near)
         pair_distances(s.state.origins, s.pairs)
-    if first <= ASSESS <= last:
+    if first <= LINKS <= last:
         real_links(s.shapes, s.state.guarded, s.state.origins, s.radius, s.model.tool, s.near)
         penalties(s.shapes.size, s.near)  # the paper's w: of the straight DV links
+    if first <= OBJECTIVE <= last:
         _objective(s)
+    if first <= DAMPERS <= last:
         _distances(s)
     if first <= CONCLUDE <= last:
         _conclude(s)

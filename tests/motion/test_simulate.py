@@ -12,6 +12,7 @@ import dvqp
 from dvqp import JogSegment, KinematicState, Obstacle, Robot, jog_commands, simulate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry import min_clearance
+from dvqp.kinematics.developed_view import wrap, wrap_angle
 from dvqp.motion.simulate import COMPILE_NOTICE, dv_error
 from tests.common import PIPE_RADIUS, baseline, objective_with, obstacles_of
 
@@ -69,6 +70,16 @@ def test_dv_error_wraps_l_and_alpha() -> None:
     a = np.array([np.pi * PIPE_RADIUS - 0.01, 0.0, 0.0, np.pi - 0.01])
     b = np.array([-np.pi * PIPE_RADIUS + 0.01, 0.0, 0.0, -np.pi + 0.01])
     np.testing.assert_allclose(dv_error(a, b, PIPE_RADIUS), [-0.02, 0.0, 0.0, -0.02], atol=1e-12)
+
+
+def test_dv_error_is_each_component_wrapped_alone_bit_for_bit() -> None:
+    rng = np.random.default_rng(5)
+    for shape in ((4,), (30, 4), (3, 5, 4)):
+        a, b = 4.0 * rng.normal(size=shape), 4.0 * rng.normal(size=shape)
+        expected = a - b
+        expected[..., 0] = wrap(expected[..., 0], PIPE_RADIUS)
+        expected[..., 3] = wrap_angle(expected[..., 3])
+        np.testing.assert_array_equal(dv_error(a, b, PIPE_RADIUS), expected)
 
 
 def test_bad_commands_raise_typed_errors(robot: Robot, q0: np.ndarray) -> None:

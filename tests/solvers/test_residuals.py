@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from solvers import Problem, ProblemShapeError, Solution, residuals
-from solvers.residuals import failed_checks, kkt_residuals
+from solvers.residuals import Residuals, failed_checks, filled, kkt_residuals
 from tests.solvers.oracle import kkt_residuals as oracle
 from tests.solvers.qp_cases import equality_case, kkt_case
 
@@ -160,3 +160,11 @@ def test_a_nan_makes_its_residual_nan_and_never_passes(
     assert not checked.found
     if field == "h":  # what a NumPy max(0.0, nan) gives, and the package must not
         assert oracle(problem, **point)[0].inequality == 0.0  # type: ignore[arg-type]
+
+
+def test_filled_residuals_are_the_dataclass_s_own() -> None:
+    for values in ((1e-9, 2.0, 3.0), (1.0, 2.0, 3.0, 4.0, 5.0, 6.0)):
+        made, quick = Residuals(*values), filled(*values)
+        assert quick == made and hash(quick) == hash(made) and repr(quick) == repr(made)
+        with pytest.raises(AttributeError):
+            quick.equality = 0.0  # type: ignore[misc]
