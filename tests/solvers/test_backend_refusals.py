@@ -81,7 +81,8 @@ def test_the_summary_counts_refused_calls_and_stderr_has_no_warning(
     code = main(["plan", str(SCENES / "probe-into-clamp.toml"), "--backend", "qpsolvers:osqp"])
     out, err = capsys.readouterr()
     assert code == 0 and err == ""
-    solver_line = next(line for line in out.splitlines() if line.startswith("solver "))
+    lines = out.replace("\n" + " " * 18, " ").splitlines()  # wrapped lines joined
+    solver_line = next(line for line in lines if line.startswith("solver "))
     assert "calls refused (" in solver_line and "infeasible)" in solver_line
 
 
