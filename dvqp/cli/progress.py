@@ -114,6 +114,7 @@ def interruptible() -> Iterator[None]:
         for child in multiprocessing.active_children():
             with contextlib.suppress(OSError, TypeError):
                 os.kill(child.pid, signum)  # type: ignore[arg-type]
+        _PENDING.append(signum)
         raise STOPS[signal.Signals(signum)]
 
     previous = {signum: signal.signal(signum, handler) for signum in STOPS}
@@ -122,6 +123,22 @@ def interruptible() -> Iterator[None]:
     finally:
         for signum, before in previous.items():
             signal.signal(signum, before)
+        _PENDING.clear()
+
+
+_PENDING: list[int] = []
+"""Signals :func:`interruptible` received this command (raised at once, and again by
+:func:`stop_if_signalled`)."""
+
+
+def stop_if_signalled() -> None:
+    """Raise the stop of a signal :func:`interruptible` already received, again: the handler
+    raises where the main thread happens to run Python code, and that may be a finaliser
+    (``__del__``, a weakref callback, a C extension's callback), where CPython prints the
+    exception and drops it. A command's loops call this at each step (through its
+    :class:`ProgressBar`), so a dropped Ctrl-C or ``SIGTERM`` still stops it."""
+    if _PENDING:
+        raise STOPS[signal.Signals(_PENDING[-1])]
 
 
 def terminated(exc: BaseException) -> bool:
@@ -201,7 +218,9 @@ class ProgressBar:
         self._started, self._first = time.perf_counter(), 0
 
     def show(self, done: int, total: int, label: str = "") -> None:
-        """Draw ``done`` of ``total`` with a label (redrawn at most every 1 %)."""
+        """Draw ``done`` of ``total`` with a label (redrawn at most every 1 %); first, raise a
+        stop that a signal asked for and that was dropped (:func:`stop_if_signalled`)."""
+        stop_if_signalled()
         if not self.enabled or total <= 0:
             return
         if total != self._total:  # the steps after compiling: a clock of their own

@@ -1,0 +1,39 @@
+"""A Ctrl-C or SIGTERM that lands where CPython drops the exception (a finaliser) still stops
+the command at its next step."""
+
+from __future__ import annotations
+
+import io
+import signal
+import sys
+
+import pytest
+
+from dvqp.cli.progress import ProgressBar, Terminated, interruptible
+
+
+class Finaliser:
+    """Runs Python code when collected: an exception raised in it is printed and dropped."""
+
+    def __del__(self) -> None:
+        signal.raise_signal(signal.SIGTERM)  # the handler raises here, inside the finaliser
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="signals as on Linux")
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # the dropped one
+def test_a_sigterm_dropped_in_a_finaliser_stops_the_next_step() -> None:
+    bar = ProgressBar(io.StringIO())
+    reached = []
+    with pytest.raises(Terminated), interruptible():
+        Finaliser()  # collected at once: its Terminated is dropped by CPython
+        reached.append("the step after the signal ran")
+        bar.show(1, 10)  # the command's next step
+        reached.append("and the one after it")
+    assert reached == ["the step after the signal ran"]  # dropped, then raised at the step
+
+
+def test_a_command_without_a_signal_is_not_stopped() -> None:
+    bar = ProgressBar(io.StringIO())
+    with interruptible():
+        bar.show(1, 10)
+        bar.show(10, 10)
