@@ -255,7 +255,7 @@ class KernelDispatcher(CPUDispatcher):  # type: ignore[misc]
 
     def get_call_template(self, args: tuple[Any, ...], kws: dict[str, Any]) -> Any:
         plain = tuple(types.unliteral(a) for a in args)
-        with linking.native_only(not self.python):
+        with linking.for_callers(self):
             return super().get_call_template(plain, {k: types.unliteral(v) for k, v in kws.items()})
 
     def compile(self, sig: Any) -> Any:

@@ -64,6 +64,12 @@ def native_only(native: bool = True) -> Iterator[None]:
         _MODE.native = before
 
 
+def for_callers(dispatcher: Any) -> contextlib.AbstractContextManager[None]:
+    """The mode of a compile of ``dispatcher`` for compiled callers: native only, unless it
+    is declared ``njit(python=True)`` (Python calls it in every run too)."""
+    return native_only(not getattr(dispatcher, "python", False))
+
+
 def is_native_only() -> bool:
     """Whether compiles on this thread are for compiled callers only (:func:`native_only`)."""
     return bool(getattr(_MODE, "native", False))
@@ -164,7 +170,7 @@ def provide(needs: Iterable[Need]) -> bool:
     for module, name, args, expected in needs:
         try:
             dispatcher = getattr(importlib.import_module(module), name)
-            with native_only(not getattr(dispatcher, "python", False)):
+            with for_callers(dispatcher):
                 dispatcher.compile(args)
             cres = dispatcher.overloads[tuple(args)]
         except Exception:  # gone, renamed, no longer compiles: the entry is stale
@@ -179,7 +185,7 @@ def provide(needs: Iterable[Need]) -> bool:
 def address_of(dispatcher: Any, argtypes: tuple[Any, ...]) -> int:
     """Compile (or load) ``dispatcher`` for ``argtypes`` and return its native function's
     address, for :func:`indirect` calls."""
-    with native_only(not getattr(dispatcher, "python", False)):
+    with for_callers(dispatcher):
         dispatcher.compile(tuple(argtypes))
     return _native(dispatcher.overloads[tuple(argtypes)])
 

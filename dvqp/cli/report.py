@@ -143,16 +143,12 @@ def format_summary(scene: Scene, traj: Trajectory, row: Row, output: Path | None
         lines.append(
             f"final deviation {row['final_tracking_error'] * 1e3:.3g} mm from the commanded motion"
         )
-    if output is not None:
-        lines.append(f"saved           {output}")
     wrap = textwrap.TextWrapper(
         100, subsequent_indent=" " * 18, break_long_words=False, break_on_hyphens=False
     )
-    physical = [part for line in lines for part in line.split("\n")]
-    names = (physical[0], physical[-1] if output is not None else None)  # files: never wrapped
-    return "\n".join(
-        wrapped for line in physical for wrapped in ([line] if line in names else wrap.wrap(line))
-    )
+    body = [w for line in lines[1:] for part in line.split("\n") for w in wrap.wrap(part)]
+    saved = [f"saved           {output}"] if output is not None else []
+    return "\n".join([lines[0], *body, *saved])  # the file names never wrapped
 
 
 def _levels(traj: Trajectory) -> list[str]:

@@ -137,10 +137,16 @@ class _Calls:
         self.spent += solution.solver_time
         self.counted = self.counted and solution.iterations is not None
         self.iterations += solution.iterations or 0
+        if self.accepted(solution):
+            return True
+        self.message = solution.message
+        return False
+
+    def accepted(self, solution: solvers.Solution) -> bool:
+        """Whether ``solution`` was accepted; then its joint velocities are :attr:`x`."""
         if solution.found and solution.x is not None:
             self.x = np.array(solution.x[: self.n])
             return True
-        self.message = solution.message
         return False
 
     @property
@@ -244,8 +250,8 @@ class Levels:
                         solution, rate = slow()  # once: σ = 0 is then no better
                         slow = None
                         calls.spent += solution.solver_time
-                        if solution.found and solution.x is not None:
-                            calls.x, status = np.array(solution.x[: calls.n]), "slowed"
+                        if calls.accepted(solution):
+                            status = "slowed"
                             break
                         self.fixed[:] = qp.b  # the task of stopping on the path
                     if top > settled and attempt("relaxed", *self._loaded(top)):
