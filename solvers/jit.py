@@ -41,7 +41,7 @@ from numba.core.dispatcher import Dispatcher
 from numba.core.registry import CPUDispatcher
 from numba.core.typing.templates import Signature
 
-from . import linking
+from . import frame_chunks, linking
 
 _MAGIC = b"dvqp-sha256\n"
 _DIGEST = 32
@@ -266,7 +266,8 @@ class KernelDispatcher(CPUDispatcher):  # type: ignore[misc]
                     if args in self._native_only:
                         self._unwrapped.append(self.overloads.pop(args))
                         self._native_only.discard(args)
-        return super().compile(sig)
+        with frame_chunks.kept():  # numba's deep recursion maps no frame chunk a call
+            return super().compile(sig)
 
     def add_overload(self, cres: Any) -> None:
         args = tuple(cres.signature.args)

@@ -10,7 +10,9 @@ it holds.
 Its numba type is made from the field names and types only, so two dataclasses of the same
 layout have the same type: a compiled function taking it is compiled once per layout and then
 loaded from numba's cache. Arrays must therefore keep their kind from run to run: every array
-field is C-contiguous and writable (:func:`as_struct` refuses others).
+field is C-contiguous and writable (:func:`as_struct` refuses others). Making a struct
+compiles nothing: its memory is laid out and filled from Python
+(:mod:`dvqp.workspace.struct_memory`).
 """
 
 from __future__ import annotations
@@ -22,11 +24,11 @@ import numba
 import numpy as np
 from numba import types
 from numba.core import cgutils
-from numba.core.extending import NativeValue, box, intrinsic, unbox
+from numba.core.extending import NativeValue, box, unbox
 from numba.experimental import structref
 from numba.experimental.structref import _Utils
 
-from solvers.jit import njit
+from dvqp.workspace.struct_memory import build
 
 
 @structref.register
@@ -89,35 +91,13 @@ def _unbox(typ, obj, c):  # type: ignore[no-untyped-def]
     return NativeValue(value)
 
 
-@intrinsic
-def _fill(typingctx, struct, values):  # type: ignore[no-untyped-def]
-    """Store the items of the tuple ``values`` into the fields of a new ``struct``, in order."""
-
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
-        instance, items = args
-        data = _Utils(context, builder, signature.args[0]).get_data_struct(instance)
-        for i, (name, kind) in enumerate(signature.args[0].field_dict.items()):
-            item = builder.extract_value(items, i)
-            context.nrt.incref(builder, kind, item)  # the struct holds its own reference
-            setattr(data, name, item)
-        return context.get_dummy_value()
-
-    return types.none(struct, values), codegen
-
-
-@njit
-def _make(struct_type, values):  # type: ignore[no-untyped-def]
-    instance = structref.new(struct_type)
-    _fill(instance, values)
-    return instance
-
-
 def as_struct(value: Any) -> Arrays:
     """``value`` (a dataclass instance) as one numba struct of the same fields.
 
     Fields may be arrays (C-contiguous, writable), Python or NumPy numbers and booleans, or
-    dataclasses of the same kind (packed recursively: one compiled constructor a struct type;
-    one for a whole tree, handed a tuple of ~150 arrays, took longer to compile than all).
+    dataclasses of the same kind (packed recursively). Nothing is compiled: the struct is laid
+    out in Python (:mod:`dvqp.workspace.struct_memory`), field by field as numba's own
+    constructor would, each array holding a reference to its ndarray as an argument's does.
 
     Raises
     ------
@@ -130,7 +110,8 @@ def as_struct(value: Any) -> Arrays:
         names.append(field.name)
         items.append(as_struct(item) if dataclasses.is_dataclass(item) else _packable(field, item))
     fields = tuple((name, _type_of(item)) for name, item in zip(names, items, strict=True))
-    return _make(_kind(fields), tuple(items))  # type: ignore[no-any-return]
+    kind = _kind(fields)
+    return Arrays._numba_box_(kind, build(kind, items))  # type: ignore[no-any-return]
 
 
 def struct_type(value: Any) -> ArraysType:

@@ -244,10 +244,16 @@ def test_a_plan_over_a_damaged_cache_exits_0_with_a_note_and_the_next_runs_clean
 ) -> None:
     env, argv, expected = filled
     cache = Path(env["NUMBA_CACHE_DIR"])
-    (struct,) = cache.glob("workspace_*")
     damaged = [
         next(cache.glob("kinematics_*/model.kinematics-*.nbi")),
-        *(next(struct.glob(f"struct._make-*.{k}.nbc")) for k in (1, 2, 3)),
+        *(
+            next(cache.glob(f"{module}_*/{kernel}-*.1.nbc"))
+            for module, kernel in [
+                ("geometry", "measure.measure_chain"),
+                ("geometry", "real_links.real_links"),
+                ("step", "stages.evaluate"),
+            ]
+        ),
     ]
     cut(damaged[0])
     garble(damaged[1])

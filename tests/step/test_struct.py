@@ -75,6 +75,90 @@ def test_every_struct_and_array_is_freed_with_its_owner() -> None:
         "gc.collect(); s1 = rtsys.get_allocation_stats()\n"
         "print(s1.mi_alloc - s0.mi_alloc, s1.mi_free - s0.mi_free)\n"
     )
+    made, freed = map(int, _run_probe(probe).split())
+    assert made == freed == 100 * 4  # two arrays and two structs a round
+
+
+@dataclasses.dataclass(frozen=True)
+class Mixed:
+    flag: bool
+    x: np.ndarray
+    small: np.int32
+    on: np.bool_
+    m: np.ndarray
+    scale: np.float32
+    idx: np.ndarray
+    inner: Inner
+    last: bool
+
+
+@njit
+def _fields(s):  # type: ignore[no-untyped-def]
+    return (
+        s.flag,
+        s.x.sum(),
+        s.small,
+        s.on,
+        s.m[1, 0],
+        s.scale,
+        s.idx[2],
+        s.inner.a.sum(),
+        s.inner.k,
+        s.last,
+    )
+
+
+def test_every_kind_of_field_reads_back_as_written_whatever_its_alignment() -> None:
+    m = np.arange(6.0).reshape(3, 2)
+    inner = Inner(np.ones(4), -1.25)
+    numbers = np.int32(-7), np.bool_(False)
+    value = Mixed(
+        True, np.arange(5.0), *numbers, m, np.float32(0.5), np.array([4, 5, 6]), inner, True
+    )
+    assert _fields(as_struct(value)) == (True, 10.0, -7, False, 2.0, 0.5, 6, 4.0, -1.25, True)
+
+
+@njit
+def _view(s):  # type: ignore[no-untyped-def]
+    return s.x[1:3]
+
+
+@njit
+def _rebind(s, a):  # type: ignore[no-untyped-def]
+    s.x = a
+    return s.x.sum()
+
+
+def test_a_view_outlives_its_struct_and_dataclass() -> None:
+    packed = as_struct(Outer(np.arange(4.0) + 10.0, Inner(np.ones(1), 0.0), 0))
+    view = _view(packed)
+    del packed
+    gc.collect()
+    np.testing.assert_array_equal(view, [11.0, 12.0])  # the view holds the array's memory
+
+
+def test_a_field_a_compiled_function_rebinds_is_freed_once_with_the_struct() -> None:
+    probe = (
+        "import gc, numpy as np\n"
+        "from numba.core.runtime import rtsys\n"
+        "from tests.step.test_struct import Inner, Outer, _rebind\n"
+        "from dvqp.workspace import as_struct\n"
+        "s = as_struct(Outer(np.ones(2), Inner(np.ones(3), 1.0), 1))\n"
+        "_rebind(s, np.ones(5)); del s; gc.collect()\n"
+        "s0 = rtsys.get_allocation_stats()\n"
+        "for _ in range(50):\n"
+        "    s = as_struct(Outer(np.ones(2), Inner(np.ones(3), 1.0), 1))\n"
+        "    assert _rebind(s, np.ones(5)) == 5.0\n"
+        "    del s\n"
+        "gc.collect(); s1 = rtsys.get_allocation_stats()\n"
+        "print(s1.mi_alloc - s0.mi_alloc, s1.mi_free - s0.mi_free)\n"
+    )
+    made, freed = map(int, _run_probe(probe).split())
+    assert made == freed == 50 * 5  # two structs, two arrays, and the array rebound
+
+
+def _run_probe(probe: str) -> str:
+    """What ``probe`` prints, run in a fresh interpreter counting the runtime's allocations."""
     env = dict(os.environ, NUMBA_NRT_STATS="1")
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     run = subprocess.run(
@@ -86,5 +170,4 @@ def test_every_struct_and_array_is_freed_with_its_owner() -> None:
         check=False,
     )
     assert run.returncode == 0, run.stderr
-    made, freed = map(int, run.stdout.split())
-    assert made == freed == 100 * 4  # two arrays and two structs a round
+    return run.stdout
