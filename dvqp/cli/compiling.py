@@ -23,7 +23,7 @@ AFTER = 0.1
 nothing; a cold one starts compiling about 2 s after the command starts, most of it
 importing)."""
 
-ESTIMATES = {"plan": 27, "compare": 35, "export-qps": 30, "bench": 40}
+ESTIMATES = {"plan": 21, "compare": 28, "export-qps": 22, "bench": 30}
 """s a first run of each command compiles for on the paper scene (a 2-core machine, quiet:
 ``benchmarks/startup.py``); other commands compile less."""
 
