@@ -18,6 +18,7 @@ import ast
 import time
 from pathlib import Path
 
+import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
 
 import solvers

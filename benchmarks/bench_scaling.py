@@ -30,6 +30,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
+
 from dvqp.bench import outcome_differences
 
 ROOT = Path(__file__).resolve().parent.parent

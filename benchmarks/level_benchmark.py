@@ -22,6 +22,7 @@ import argparse
 import dataclasses
 from pathlib import Path
 
+import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
 
 import dvqp

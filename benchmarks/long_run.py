@@ -21,6 +21,7 @@ import time
 import tracemalloc
 from pathlib import Path
 
+import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
 
 import dvqp

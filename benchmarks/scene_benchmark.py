@@ -24,6 +24,7 @@ import argparse
 import sys
 from pathlib import Path
 
+import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
 from step_benchmark import isolated
 

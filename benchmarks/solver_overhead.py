@@ -35,6 +35,7 @@ import argparse
 import time
 from collections.abc import Callable
 
+import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
 
 import solvers

@@ -25,6 +25,7 @@ import sys
 import time
 from pathlib import Path
 
+import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
 
 import dvqp
