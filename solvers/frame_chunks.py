@@ -53,7 +53,9 @@ class State(ctypes.Structure):
     ]
 
 
-_FREE = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t)
+_FREE = ctypes.PYFUNCTYPE(  # the GIL held through the call, as CPython calls the allocator
+    None, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t
+)
 _built: list[Any] = []  # the code library, then the addresses of alloc and free
 _depth = 0
 

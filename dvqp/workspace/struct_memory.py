@@ -39,14 +39,17 @@ from numba.core.runtime import _nrt_python, rtsys
 from numba.np.numpy_support import as_dtype
 
 _HELPERS = _nrt_python.c_helpers
-_alloc = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_size_t, ctypes.c_void_p)(
+# PYFUNCTYPE, not CFUNCTYPE: ctypes keeps the GIL held through the call (CFUNCTYPE releases
+# it, and adapt_ndarray_from_python increfs the ndarray: another thread's reference counting
+# would race it).
+_alloc = ctypes.PYFUNCTYPE(ctypes.c_void_p, ctypes.c_size_t, ctypes.c_void_p)(
     _HELPERS["MemInfo_alloc_dtor"]
 )
-_data_of = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_void_p)(_HELPERS["MemInfo_data"])
-_adapt = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.py_object, ctypes.c_void_p)(
+_data_of = ctypes.PYFUNCTYPE(ctypes.c_void_p, ctypes.c_void_p)(_HELPERS["MemInfo_data"])
+_adapt = ctypes.PYFUNCTYPE(ctypes.c_int, ctypes.py_object, ctypes.c_void_p)(
     _HELPERS["adapt_ndarray_from_python"]
 )
-_acquired = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.py_object)(_HELPERS["meminfo_from_pyobject"])
+_acquired = ctypes.PYFUNCTYPE(ctypes.c_void_p, ctypes.py_object)(_HELPERS["meminfo_from_pyobject"])
 
 _WORD = 8  # bytes of a trailer entry (int64), and the trailer's alignment
 

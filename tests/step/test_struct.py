@@ -7,6 +7,7 @@ import gc
 import os
 import subprocess
 import sys
+import threading
 
 import numpy as np
 import pytest
@@ -171,3 +172,42 @@ def _run_probe(probe: str) -> str:
     )
     assert run.returncode == 0, run.stderr
     return run.stdout
+
+
+@dataclasses.dataclass(frozen=True)
+class Four:
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    d: np.ndarray
+
+
+def test_building_structs_while_other_threads_count_references_keeps_the_count() -> None:
+    shared = np.zeros(3)
+    value = Four(shared, shared, shared, shared)
+    as_struct(value)
+    gc.collect()
+    before = sys.getrefcount(shared)
+    stop = threading.Event()
+
+    def churn() -> None:  # increfs and decrefs the array, the GIL held
+        slots: list[object] = [None] * 64
+        while not stop.is_set():
+            for i in range(64):
+                slots[i] = shared
+            for i in range(64):
+                slots[i] = None
+
+    threads = [threading.Thread(target=churn) for _ in range(3)]
+    for thread in threads:
+        thread.start()
+    try:
+        for _ in range(2000):  # the runtime's helper increfs the array: safe with the GIL only
+            packed = as_struct(value)
+            del packed
+    finally:
+        stop.set()
+        for thread in threads:
+            thread.join()
+    gc.collect()
+    assert sys.getrefcount(shared) == before
