@@ -72,6 +72,12 @@ def _usable() -> bool:
     )
 
 
+_STATE = State()
+"""The one context the installed allocator uses: never freed, so that an allocator a Ctrl-C
+left installed (a KeyboardInterrupt raised between two calls of :func:`kept`'s bookkeeping)
+still works, chaining to the previous one, until the next block puts that one back."""
+
+
 @contextmanager
 def kept() -> Iterator[None]:
     """Keep freed frame chunks for reuse within the block (nested blocks share the outermost's
@@ -85,30 +91,42 @@ def kept() -> Iterator[None]:
             finally:
                 _depth -= 1
             return
-        state = _install()  # the allocator's context: alive while it is installed
+        _install()
         _depth = 1
         try:
             yield
         finally:
             _depth = 0
-            _restore(state)
+            _restore()
 
 
-def _install() -> State:
-    """Install the chaining allocator (CPython copies the structure); return its state."""
+def installed() -> bool:
+    """Whether the chaining allocator is the one in place."""
+    current = Allocator()
+    ctypes.pythonapi.PyObject_GetArenaAllocator(ctypes.byref(current))
+    return bool(_built) and current.alloc == _built[1]
+
+
+def _install() -> None:
+    """Install the chaining allocator over the one in place (CPython copies the structure);
+    nothing if it is in place already (left by an interrupted block: :data:`_STATE` still
+    holds the allocator before it)."""
     if not _built:
         _build()
-    state = State()
-    ctypes.pythonapi.PyObject_GetArenaAllocator(ctypes.byref(state.previous))
-    mine = Allocator(ctypes.addressof(state), _built[1], _built[2])
+    if installed():
+        return
+    if _STATE.count:  # chunks an interrupted restore kept: to the allocator they came from
+        _give_back(_STATE)
+    ctypes.pythonapi.PyObject_GetArenaAllocator(ctypes.byref(_STATE.previous))
+    mine = Allocator(ctypes.addressof(_STATE), _built[1], _built[2])
     ctypes.pythonapi.PyObject_SetArenaAllocator(ctypes.byref(mine))
-    return state
 
 
-def _restore(state: State) -> None:
-    """Put the previous allocator back and give it the kept chunks."""
-    ctypes.pythonapi.PyObject_SetArenaAllocator(ctypes.byref(state.previous))
-    _give_back(state)
+def _restore() -> None:
+    """Put the previous allocator back and give it the kept chunks (a chunk is taken off the
+    list before it is freed: an interruption can keep one, never free one twice)."""
+    ctypes.pythonapi.PyObject_SetArenaAllocator(ctypes.byref(_STATE.previous))
+    _give_back(_STATE)
 
 
 def _give_back(state: State) -> None:

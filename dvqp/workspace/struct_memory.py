@@ -62,16 +62,17 @@ class Layout:
     ----------
     size : int
         Bytes allocated: the payload, then the trailer.
-    fields : tuple of (int, str, numpy.dtype or None)
+    fields : tuple of (int, str, object)
         Per field in order: its offset (bytes), its kind (``"array"``, ``"struct"`` or
-        ``"number"``) and, for a number, the dtype it is stored as.
+        ``"number"``) and what it must be given: an array's dtype and dimensions, a struct's
+        numba type, the dtype a number is stored as.
     trailer : bytes
         The offsets of the fields holding a meminfo, then their count (int64 each), written
         at the end of the allocation for the destructor.
     """
 
     size: int
-    fields: tuple[tuple[int, str, np.dtype[Any] | None], ...]
+    fields: tuple[tuple[int, str, Any], ...]
     trailer: bytes
 
 
@@ -84,6 +85,10 @@ def layout(kind: Any) -> Layout:
     found = _LAYOUTS.get(kind)
     if found is not None:
         return found
+    for name, member in kind.field_dict.items():
+        element = member.dtype if isinstance(member, types.Array) else member
+        if not (isinstance(member, types.StructRef) or _numeric(element)):
+            raise TypeError(f"{name}: cannot lay out a {member} field")
     context = cpu_target.target_context
     payload = context.data_model_manager[kind.get_data_type()]
     data_type = payload.get_data_type()
@@ -94,23 +99,33 @@ def layout(kind: Any) -> Layout:
         offset = data_type.get_element_offset(target, index)
         if isinstance(member, types.Array):
             _first_member(context, member, "meminfo")
-            fields.append((offset, "array", None))
+            fields.append((offset, "array", (np.dtype(as_dtype(member.dtype)), member.ndim)))
             held.append(offset)
         elif isinstance(member, types.StructRef):
             _first_member(context, member, "meminfo")
-            fields.append((offset, "struct", None))
+            fields.append((offset, "struct", member))
             held.append(offset)
-        elif isinstance(member, types.Boolean | types.Integer | types.Float):
+        else:
             dtype = np.dtype(as_dtype(member))
             if dtype.itemsize != context.get_abi_sizeof(context.get_data_type(member)):
                 raise TypeError(f"cannot lay out a {member} field")
             fields.append((offset, "number", dtype))
-        else:
-            raise TypeError(f"cannot lay out a {member} field")
     start = -(-size // _WORD) * _WORD
     trailer = np.array([*held, len(held)], dtype=np.int64).tobytes()
     found = _LAYOUTS[kind] = Layout(start + len(trailer), tuple(fields), trailer)
     return found
+
+
+def _numeric(member: Any) -> bool:
+    """Whether ``member`` is a boolean, an integer or a float numba and NumPy share."""
+    if not isinstance(member, types.Boolean | types.Integer | types.Float):
+        return False
+    try:
+        as_dtype(member)
+        cpu_target.target_context.data_model_manager[member]
+    except NotImplementedError:  # e.g. a float16: a dtype, but no numba data model
+        return False
+    return True
 
 
 def _first_member(context: Any, member: Any, name: str) -> None:
@@ -129,7 +144,13 @@ def build(kind: Any, items: list[Any]) -> Any:
     MemoryError
         The runtime could not allocate it.
     TypeError
-        An array field the runtime refuses (not an ndarray).
+        An item that is not of its field's type (nothing is written for it: the fields
+        filled before it are released with the struct).
+
+    A Ctrl-C (KeyboardInterrupt) between two of these calls leaves no field half written;
+    it may leak the allocation (raised before its owner exists) or one reference to a nested
+    struct (raised between taking it and storing it): a reference is always taken before it
+    is stored, so an interruption can never release one too many.
     """
     plan = layout(kind)
     address = _alloc(plan.size, destructor())
@@ -139,14 +160,17 @@ def build(kind: Any, items: list[Any]) -> Any:
     ctypes.memset(data, 0, plan.size)  # a half-filled struct frees only what it holds
     ctypes.memmove(data + plan.size - len(plan.trailer), plan.trailer, len(plan.trailer))
     owner = _nrt_python._MemInfo(address)  # takes the allocation's reference
-    for (offset, what, dtype), item in zip(plan.fields, items, strict=True):
+    for (offset, what, expected), item in zip(plan.fields, items, strict=True):
         if what == "array":
-            if _adapt(item, data + offset) != 0:
-                raise TypeError(f"not an ndarray: {type(item).__name__}")
+            if not isinstance(item, np.ndarray) or (item.dtype, item.ndim) != expected:
+                raise TypeError(f"not a {expected[1]}-d {expected[0]} ndarray: {item!r:.60}")
+            _adapt(item, data + offset)
         elif what == "struct":
+            if getattr(item, "_numba_type_", None) != expected:
+                raise TypeError(f"not a struct of type {expected}: {type(item).__name__}")
             ctypes.c_void_p.from_address(data + offset).value = _acquired(item._meminfo)
         else:
-            number = np.array(item, dtype=dtype)
+            number = np.array(item, dtype=expected)
             ctypes.memmove(data + offset, number.ctypes.data, number.itemsize)
     return owner
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ctypes
+import sys
 
 import pytest
 
@@ -108,3 +109,34 @@ def test_no_more_than_slots_chunks_are_kept() -> None:
     assert state.count == SLOTS and previous.freed == [CHUNK] * 3
     frame_chunks._give_back(state)
     assert len(previous.freed) == SLOTS + 3 and not previous.blocks
+
+
+def test_an_interrupt_after_installing_leaves_a_working_allocator_the_next_block_restores() -> None:
+
+    before = current()
+    with frame_chunks.kept():  # built
+        pass
+    install = frame_chunks._install.__code__
+
+    def trace(frame, event, arg):  # type: ignore[no-untyped-def]
+        if frame.f_code is not install:
+            return None
+
+        def local(frame, event, arg):  # type: ignore[no-untyped-def]
+            if event == "return" and frame_chunks.installed():
+                raise KeyboardInterrupt  # as a Ctrl-C handled after the installing call
+            return local
+
+        return local
+
+    sys.settrace(trace)
+    try:
+        with pytest.raises(KeyboardInterrupt), frame_chunks.kept():
+            pass
+    finally:
+        sys.settrace(None)
+    assert frame_chunks.installed()  # left in place, its state alive: frames still allocate
+    assert [depth(600) for _ in range(20)] == [600] * 20
+    with frame_chunks.kept():
+        pass
+    assert current() == before and frame_chunks._STATE.count == 0

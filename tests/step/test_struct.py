@@ -211,3 +211,26 @@ def test_building_structs_while_other_threads_count_references_keeps_the_count()
             thread.join()
     gc.collect()
     assert sys.getrefcount(shared) == before
+
+
+def test_an_item_not_of_its_fields_type_is_refused_before_it_is_written() -> None:
+    from dvqp.workspace import struct_memory
+
+    kind = as_struct(Outer(np.zeros(3), Inner(np.ones(1), 0.0), 1))._numba_type_
+    inner = as_struct(Inner(np.ones(1), 0.0))
+    with pytest.raises(TypeError, match="not a 1-d float64 ndarray"):
+        struct_memory.build(kind, [np.zeros((2, 3, 4)), inner, 1])  # would overrun the field
+    with pytest.raises(TypeError, match="not a struct of type"):
+        struct_memory.build(kind, [np.zeros(3), as_struct(Outer(np.zeros(1), inner_value(), 1)), 1])
+
+
+def inner_value() -> Inner:
+    return Inner(np.ones(1), 0.0)
+
+
+@pytest.mark.parametrize(
+    "field", [np.float16(1.0), np.array([object()], dtype=object)], ids=["float16", "object"]
+)
+def test_a_field_numba_cannot_lay_out_is_a_type_error(field: object) -> None:
+    with pytest.raises(TypeError):
+        as_struct(Outer(np.zeros(1), Inner(np.ones(1), 0.0), field))  # type: ignore[arg-type]
