@@ -30,11 +30,10 @@ import tempfile
 import time
 from pathlib import Path
 
-import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
+from checkout import ROOT  # before dvqp: this checkout's, not an installed one
 
 from dvqp.bench import outcome_differences
 
-ROOT = Path(__file__).resolve().parent.parent
 STARTUP = re.compile(r"worker start-up ([0-9., ]+) s")
 
 

@@ -41,8 +41,8 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
+from checkout import ROOT  # before dvqp: this checkout's, not an installed one
 from scene_benchmark import bracketed
 
 import dvqp
@@ -56,7 +56,6 @@ from dvqp.step import Stepper, stages
 from dvqp.workspace import as_struct
 from solvers.daqp_ import DaqpBackend
 
-ROOT = Path(__file__).resolve().parent.parent
 PAPER = ROOT / "scenes" / "paper-two-inlets.toml"
 STAGES = (
     "kinematics",

@@ -20,14 +20,11 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-from pathlib import Path
 
-import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
+from checkout import ROOT  # before dvqp: this checkout's, not an installed one
 
 import dvqp
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def variants(scene: dvqp.Scene) -> dict[str, tuple[dvqp.Scene, tuple[dvqp.Task, ...]]]:

@@ -19,14 +19,11 @@ import argparse
 import re
 import time
 import tracemalloc
-from pathlib import Path
 
-import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
+from checkout import ROOT  # before dvqp: this checkout's, not an installed one
 
 import dvqp
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def scene_with(steps: int) -> dvqp.Scene:

@@ -24,11 +24,10 @@ import argparse
 import sys
 from pathlib import Path
 
-import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
+from checkout import ROOT  # before dvqp: this checkout's, not an installed one
 from step_benchmark import isolated
 
-ROOT = Path(__file__).resolve().parent.parent
 PAPER = "paper-two-inlets"
 
 

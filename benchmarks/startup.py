@@ -28,9 +28,8 @@ import threading
 import time
 from pathlib import Path
 
-import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
+from checkout import ROOT  # before dvqp: this checkout's, not an installed one
 
-ROOT = Path(__file__).resolve().parent.parent
 PROBE = """
 import json, sys
 from numba.core import event

@@ -27,16 +27,14 @@ import multiprocessing
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
-from pathlib import Path
 
-import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
+from checkout import ROOT  # before dvqp: this checkout's, not an installed one
 
 import dvqp
 import solvers
 from dvqp.resolution.registry import default_resolvers
 
-ROOT = Path(__file__).resolve().parent.parent
 FIELDS = ("step_time", "solve_time", "solver_time")
 
 
@@ -83,7 +81,6 @@ def measure_subclassed(scene_file: str) -> tuple[dict[str, np.ndarray], np.ndarr
     """:func:`measure` of DAQP on the scene with every part (task, terms, limits, shapes) a
     trivial subclass of its built-in class: the same compiled step, which should cost the
     same."""
-    sys.path.insert(0, str(ROOT))
     from tests.step.subclassing import subclassed_tool_task, swapped
 
     scene, _ = swapped(dvqp.load_scene(scene_file))

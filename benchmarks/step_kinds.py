@@ -23,16 +23,14 @@ import dataclasses
 import importlib.util
 import sys
 import time
-from pathlib import Path
 
-import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
+from checkout import ROOT  # before dvqp: this checkout's, not an installed one
 
 import dvqp
 from dvqp.console import ConsoleSession
 from dvqp.step import JOINT_STRIDE
 
-ROOT = Path(__file__).resolve().parent.parent
 SPLIT_DT = (0.3, 0.5)
 """s: steps of the paper scene at which a few steps break a limit and are split."""
 

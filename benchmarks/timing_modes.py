@@ -15,17 +15,14 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
-import checkout  # noqa: F401  (this checkout's dvqp, not an installed one)
 import numpy as np
+from checkout import ROOT  # before dvqp: this checkout's, not an installed one
 
 import dvqp
 from dvqp.motion.schedule import path_deviation
 from dvqp.run.comparison import summarize
 from dvqp.run.planning import scene_commands
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -29,7 +29,8 @@ from typing import Any
 
 from llvmlite import ir
 from numba.core.compiler_lock import global_compiler_lock
-from numba.core.registry import cpu_target
+
+from . import linking
 
 CHUNK = 16384
 """Bytes of the chunks kept: CPython's ``DATA_STACK_CHUNK_SIZE`` (3.11-3.13)."""
@@ -138,16 +139,9 @@ def _give_back(state: State) -> None:
 
 
 def _build() -> None:
-    """Compile the allocator's two functions (under numba's compile lock, held by
-    :func:`kept`)."""
-    context = cpu_target.target_context
-    library = context.codegen().create_library("solvers.frame_chunks")
-    module = library.create_ir_module("frame_chunks")
-    _define(module)
-    library.add_ir_module(module)
-    library.finalize()
-    alloc = library.get_pointer_to_function("solvers_chunk_alloc")
-    free = library.get_pointer_to_function("solvers_chunk_free")
+    """Compile the allocator's two functions."""
+    names = ["solvers_chunk_alloc", "solvers_chunk_free"]
+    library, (alloc, free) = linking.ir_functions("solvers.frame_chunks", _define, names)
     _built.extend([library, alloc, free])
 
 

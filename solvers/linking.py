@@ -34,11 +34,15 @@ from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
 import llvmlite.binding as llvm
+from llvmlite import ir
 from numba import types
 from numba.core import cgutils
 from numba.core.base import OverloadSelector
+from numba.core.compiler_lock import global_compiler_lock
 from numba.core.extending import intrinsic
 from numba.core.imputils import fix_returning_optional, impl_ret_new_ref
+from numba.core.registry import cpu_target
+from numba.core.runtime import rtsys
 from numba.core.typing import signature
 
 Need = tuple[str, str, tuple[Any, ...], str]
@@ -223,3 +227,23 @@ def indirect(restype: Any, argtypes: tuple[Any, ...]) -> Any:
     namespace: dict[str, Any] = {}
     exec(source, {"_type": _type}, namespace)  # an intrinsic needs its arguments named
     return intrinsic(namespace["call"])
+
+
+@global_compiler_lock
+def ir_functions(
+    name: str, define: Callable[[ir.Module], None], names: Iterable[str]
+) -> tuple[Any, list[int]]:
+    """Compile the functions ``define`` writes in LLVM IR into a code library of their own
+    (no numba typing, nothing cached: a few milliseconds once a process) and return the
+    library, which must be kept alive while they may run, and the addresses of ``names``.
+
+    The numba runtime is initialised first, so that its ``NRT_*`` functions are symbols the
+    module may call; numba's compile lock is held, as its code libraries need."""
+    context = cpu_target.target_context
+    rtsys.initialize(context)
+    library = context.codegen().create_library(name)
+    module = library.create_ir_module(name)
+    define(module)
+    library.add_ir_module(module)
+    library.finalize()
+    return library, [library.get_pointer_to_function(n) for n in names]

@@ -35,8 +35,10 @@ from numba import types
 from numba.core import cgutils
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.registry import cpu_target
-from numba.core.runtime import _nrt_python, rtsys
+from numba.core.runtime import _nrt_python
 from numba.np.numpy_support import as_dtype
+
+from solvers.linking import ir_functions
 
 _HELPERS = _nrt_python.c_helpers
 # PYFUNCTYPE, not CFUNCTYPE: ctypes keeps the GIL held through the call (CFUNCTYPE releases
@@ -98,11 +100,11 @@ def layout(kind: Any) -> Layout:
     for index, member in enumerate(kind.field_dict.values()):
         offset = data_type.get_element_offset(target, index)
         if isinstance(member, types.Array):
-            _first_member(context, member, "meminfo")
+            _meminfo_first(context, member)
             fields.append((offset, "array", (np.dtype(as_dtype(member.dtype)), member.ndim)))
             held.append(offset)
         elif isinstance(member, types.StructRef):
-            _first_member(context, member, "meminfo")
+            _meminfo_first(context, member)
             fields.append((offset, "struct", member))
             held.append(offset)
         else:
@@ -128,11 +130,11 @@ def _numeric(member: Any) -> bool:
     return True
 
 
-def _first_member(context: Any, member: Any, name: str) -> None:
-    """Check that ``member``'s data model starts with ``name`` (where the meminfo is read)."""
+def _meminfo_first(context: Any, member: Any) -> None:
+    """Check that ``member``'s data starts with its meminfo (where the destructor reads it)."""
     model = context.data_model_manager[member]
-    if model._fields[0] != name:  # numba's ArrayModel and StructRefModel both do
-        raise TypeError(f"cannot lay out a {member} field: its data does not start with {name}")
+    if model._fields[0] != "meminfo":  # numba's ArrayModel and StructRefModel both do
+        raise TypeError(f"cannot lay out a {member} field: its data does not start with meminfo")
 
 
 def build(kind: Any, items: list[Any]) -> Any:
@@ -184,16 +186,11 @@ def destructor() -> int:
 
 @global_compiler_lock
 def _build_destructor() -> None:
-    """Build :func:`destructor`'s function (numba's code libraries need its compile lock)."""
+    """Build :func:`destructor`'s function (once, whichever thread asks first)."""
     if not _DESTRUCTOR:
-        context = cpu_target.target_context
-        rtsys.initialize(context)  # NRT_MemInfo_release is then a symbol the JIT resolves
-        library = context.codegen().create_library("dvqp.workspace.struct_memory")
-        module = library.create_ir_module("struct_memory")
-        _release_fields(module)
-        library.add_ir_module(module)
-        library.finalize()
-        _DESTRUCTOR.extend([library, library.get_pointer_to_function("dvqp_release_fields")])
+        names = ["dvqp_release_fields"]
+        library, (address,) = ir_functions("dvqp.workspace.struct_memory", _release_fields, names)
+        _DESTRUCTOR.extend([library, address])
 
 
 def _release_fields(module: ir.Module) -> None:

@@ -221,11 +221,9 @@ def test_an_item_not_of_its_fields_type_is_refused_before_it_is_written() -> Non
     with pytest.raises(TypeError, match="not a 1-d float64 ndarray"):
         struct_memory.build(kind, [np.zeros((2, 3, 4)), inner, 1])  # would overrun the field
     with pytest.raises(TypeError, match="not a struct of type"):
-        struct_memory.build(kind, [np.zeros(3), as_struct(Outer(np.zeros(1), inner_value(), 1)), 1])
-
-
-def inner_value() -> Inner:
-    return Inner(np.ones(1), 0.0)
+        struct_memory.build(
+            kind, [np.zeros(3), as_struct(Outer(np.zeros(1), Inner(np.ones(1), 0.0), 1)), 1]
+        )
 
 
 @pytest.mark.parametrize(
