@@ -5,6 +5,7 @@
 >>> x = backend.solve(Problem(P, q, A=A, b=b)).require()  # doctest: +SKIP
 """
 
+from . import daqp_c  # noqa: F401  (DAQP's C calls: its kernel's cache listed with the rest)
 from .exceptions import ProblemShapeError, SolverError, UnknownBackendError
 from .problem import Problem
 from .protocol import Backend

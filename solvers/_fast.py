@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import types
 
-from .jit import compiled_on_first_call
+from .jit import compiled_on_first_call, njit
 
 _VEC_IN = types.Array(types.float64, 1, "C", readonly=True)
 _MAT_IN = types.Array(types.float64, 2, "C", readonly=True)
@@ -40,10 +40,8 @@ def refresh(source: np.ndarray, kept: np.ndarray) -> bool:
     return changed
 
 
-@compiled_on_first_call(
-    types.int64(*(_MAT_IN, _VEC_IN) * 3, _VEC_IN, _VEC_IN, _VEC_OUT, *(types.int64,) * 4)
-)
-def stack(
+@njit
+def stack_into(
     P: np.ndarray,
     q: np.ndarray,
     A: np.ndarray,
@@ -103,3 +101,25 @@ def stack(
                 changed = 1
                 data[j * n + k] = P[j, k]
     return changed
+
+
+@compiled_on_first_call(
+    types.int64(*(_MAT_IN, _VEC_IN) * 3, _VEC_IN, _VEC_IN, _VEC_OUT, *(types.int64,) * 4)
+)
+def stack(
+    P: np.ndarray,
+    q: np.ndarray,
+    A: np.ndarray,
+    b: np.ndarray,
+    G: np.ndarray,
+    h: np.ndarray,
+    lb: np.ndarray,
+    ub: np.ndarray,
+    data: np.ndarray,
+    n: int,
+    p: int,
+    m: int,
+    ms: int,
+) -> int:
+    """:func:`stack_into`, compiled for its one signature, called from Python."""
+    return stack_into(P, q, A, b, G, h, lb, ub, data, n, p, m, ms)

@@ -191,12 +191,8 @@ def kernel(
     return _residuals(P, q, A, b, G, h, lb, ub, x, y, z, z_box, flags)
 
 
-@compiled_on_first_call(
-    # Writable arrays (DAQP's buffer and answers): an exact match, the quickest dispatch.
-    types.UniTuple(types.float64, 8)(*(types.float64[::1],) * 3, *(types.int64,) * 5),
-    fastmath=_FASTMATH,
-)
-def stacked(
+@njit(fastmath=_FASTMATH)
+def stacked_values(
     data: np.ndarray, x: np.ndarray, lam: np.ndarray, n: int, p: int, m: int, ms: int, flags: int
 ) -> tuple[float, float, float, float, float, float, float, float]:
     """:func:`kernel` on DAQP's stacked copy of a problem, with DAQP's multipliers.
@@ -234,3 +230,15 @@ def stacked(
         lam[:ms],
         flags | HAS_Y | HAS_Z | (HAS_BOX if box else 0),
     )
+
+
+@compiled_on_first_call(
+    # Writable arrays (DAQP's buffer and answers): an exact match, the quickest dispatch.
+    types.UniTuple(types.float64, 8)(*(types.float64[::1],) * 3, *(types.int64,) * 5),
+    fastmath=_FASTMATH,
+)
+def stacked(
+    data: np.ndarray, x: np.ndarray, lam: np.ndarray, n: int, p: int, m: int, ms: int, flags: int
+) -> tuple[float, float, float, float, float, float, float, float]:
+    """:func:`stacked_values`, compiled for its one signature, called from Python."""
+    return stacked_values(data, x, lam, n, p, m, ms, flags)

@@ -1,4 +1,15 @@
-"""Direct DAQP adapter using ``daqp.Model`` (setup once, ``update``, warm active set).
+"""Direct DAQP adapter: set up once, update, warm active set; DAQP's C API where it can.
+
+Two ways to DAQP, the same calls in the same order:
+
+- **DAQP's C functions from compiled code** (:mod:`solvers.daqp_c`), when the installed
+  ``daqp`` is a version whose structures that module mirrors: the set-up allocates DAQP's
+  workspace as ``daqp.Model.setup`` does, and each solve is one compiled call
+  (:func:`~solvers.daqp_c.solve_stacked`): the copy into the buffers below, DAQP's update
+  (``H`` passed, i.e. re-factored, only when ``P`` changed) and solve, and the check, with
+  the time inside DAQP's calls read from the same clock as ``time.perf_counter``. The
+  answers are bitwise those of the second way (tests/solvers/test_daqp_c.py).
+- **``daqp.Model``** otherwise, as described below.
 
 DAQP solves ``min 1/2 x^T H x + f^T x  s.t.  lower <= x[:ms] <= upper`` (simple
 bounds, the first ``ms`` entries of ``lower``/``upper``) and
@@ -12,15 +23,15 @@ Warm start: ``Model.update`` keeps the working set of the previous solve when
 is only used on a cold set-up (``primal_start``); the Python ``update`` has no
 way to pass a primal iterate.
 
-Per-step cost (~8 µs on a dvqp-sized QP, of which ~4 µs in DAQP's ``update`` and
-``solve``): the stacked data ``H``, ``f``, ``[G; A]``, ``bupper``, ``blower`` live in one
-buffer allocated at set-up. An update copies the problem's arrays into it in one compiled
-call (:func:`solvers._fast.stack`; constant parts, e.g. ``-inf`` lower bounds of the ``G``
-rows, are written once), which also tells whether ``P`` changed; ``H`` is passed only then,
-so DAQP re-factors it only then. ``bupper``/``blower`` are not passed: the model keeps
-pointers to the very buffers given at set-up (``Model.setup`` does not copy float64
-C-contiguous arrays), and passing ``f`` and ``A`` makes DAQP recompute ``v``, ``M`` and
-then ``d`` from both bounds. Should a DAQP version copy the bounds instead, the stale bounds
+With ``daqp.Model``, the per-step cost (~8 µs on a dvqp-sized QP, of which ~4 µs in DAQP's
+``update`` and ``solve``): the stacked data ``H``, ``f``, ``[G; A]``, ``bupper``, ``blower``
+live in one buffer allocated at set-up. An update copies the problem's arrays into it in one
+compiled call (:func:`solvers._fast.stack`; constant parts, e.g. ``-inf`` lower bounds of
+the ``G`` rows, are written once), which also tells whether ``P`` changed; ``H`` is passed
+only then, so DAQP re-factors it only then. ``bupper``/``blower`` are not passed: the model
+keeps pointers to the very buffers given at set-up (``Model.setup`` does not copy float64
+C-contiguous arrays), and passing ``f`` and ``A`` makes DAQP recompute ``v``, ``M`` and then
+``d`` from both bounds. Should a DAQP version copy the bounds instead, the stale bounds
 would make the warm answer fail the check, and the cold retry would still solve it right.
 
 The check (:func:`solvers._kkt.stacked`) runs on that buffer, the bitwise copy of the
@@ -40,6 +51,7 @@ be writable (typed memoryviews reject read-only buffers), which the buffers are.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Hashable
 from time import perf_counter
 from typing import Any, ClassVar
@@ -47,6 +59,7 @@ from typing import Any, ClassVar
 import daqp
 import numpy as np
 
+from . import daqp_c
 from ._fast import EMPTY_MATRIX, EMPTY_VECTOR, refresh, stack
 from ._kkt import HAS_LB, HAS_UB, MISFITTING, stacked
 from .problem import Problem
@@ -97,6 +110,8 @@ class DaqpBackend(StatefulBackend):
         self._bound: Problem | None = None  # the problem whose arguments of stack are kept
         self._stack: tuple[Any, ...] | None = None  # None: copy _bound with NumPy
         self._sense = np.zeros(0, dtype=np.intc)  # the set-up's sense: equality rows flagged
+        self._c: daqp_c.Workspace | None = None  # DAQP called from compiled code (daqp_c)
+        self._c_args: tuple[Any, ...] | None = None  # solve_stacked's, but the mode and answers
 
     @classmethod
     def known_settings(cls) -> set[str]:
@@ -104,7 +119,9 @@ class DaqpBackend(StatefulBackend):
         return set(daqp.Model().settings)
 
     def _release(self) -> None:
-        self._model = self._bound = self._stack = None
+        if self._c is not None:
+            self._c.close()
+        self._model = self._bound = self._stack = self._c = self._c_args = None
 
     def _structure_of(self, problem: Problem) -> Hashable:
         """The base key, kept while the same problem object comes back (it holds the same
@@ -118,7 +135,7 @@ class DaqpBackend(StatefulBackend):
         (fixed objects, rewritten in place from one solve to the next), empty placeholders
         for its absent blocks, and the set-up's buffer and sizes."""
         A, G, lb, ub, empty = problem.A, problem.G, problem.lb, problem.ub, EMPTY_VECTOR
-        self._bound = problem
+        self._bound, self._c_args = problem, None
         self._stack = (
             problem.P,
             problem.q,
@@ -162,9 +179,26 @@ class DaqpBackend(StatefulBackend):
         self._H, self._M = data[:f].reshape(n, n), data[M:up].reshape(p + m, n)
         self._upper[:], self._lower[:] = np.inf, -np.inf
         self._bound = None
-        self._load(problem)  # H: DAQP's, and the reference that tells P changed
+        if daqp_c.available():  # copied with NumPy: the solves' compiled call copies, not stack
+            self._fill(problem)
+            self._H[:] = problem.P  # DAQP's, and the reference that tells P changed
+        else:
+            self._load(problem)
         sense = self._sense = np.zeros(rows, dtype=np.intc)
         sense[rows - m :] = _SENSE_EQUALITY
+        work = None
+        if daqp_c.available():
+            start = perf_counter()
+            with contextlib.suppress(daqp_c.LayoutError):  # then never again: daqp.Model
+                work = daqp_c.Workspace(
+                    self._H, self._f, self._M, self._upper, self._lower, sense, self.settings, guess
+                )
+        if work is not None:
+            if work.flag < 0:
+                work.close()
+                return RawResult(None, f"setup failed: {EXIT_FLAGS.get(work.flag, work.flag)}")
+            self._c = work
+            return self._in_c(problem, daqp_c.AS_SET_UP, start)
         model = daqp.Model()
         model.settings = dict(self.settings)
         start = perf_counter()
@@ -200,6 +234,8 @@ class DaqpBackend(StatefulBackend):
         return changed
 
     def _update(self, problem: Problem, guess: np.ndarray | None) -> RawResult | Solution:
+        if self._c is not None:
+            return self._in_c(problem, daqp_c.WARM, perf_counter())
         changed = self._load(problem)
         start = perf_counter()
         # f and A suffice: DAQP then recomputes v, M and d, reading both bounds through its
@@ -223,12 +259,62 @@ class DaqpBackend(StatefulBackend):
             return self._setup(problem, guess)
         if self._stack is None:
             self._bound = None  # bound afresh: the compiled copy is tried again
+        if self._c is not None:
+            return self._in_c(problem, daqp_c.RESTART, perf_counter())
         self._load(problem)
         start = perf_counter()
         flag = self._model.update(H=self._H, f=self._f, A=self._M, sense=self._sense)
         if flag < 0:
             return RawResult(None, f"update failed: {EXIT_FLAGS.get(flag, flag)}")
         return self._run(problem, start)
+
+    def _in_c(self, problem: Problem, mode: int, start: float) -> RawResult | Solution:
+        """Update (``mode``: :mod:`solvers.daqp_c`'s bits), solve and check in one compiled
+        call (:func:`~solvers.daqp_c.solve_stacked`) on the arrays kept for ``problem``."""
+        if problem is not self._bound:
+            self._bind(problem)
+        n, p, m, ms, flags = self._layout
+        x, lam = np.empty(n), np.empty(ms + p + m)
+        work = self._c
+        assert work is not None
+        if self._stack is not None:
+            if self._c_args is None:
+                self._c_args = (*self._stack[:9], work.handles, work.words, *self._layout)
+            try:
+                out = daqp_c.solve_stacked(*self._c_args, mode, x, lam)
+            except TypeError:  # arrays the compiled copy refuses: NumPy copies this problem
+                self._stack = None
+        if self._stack is None:
+            if self._load(problem):  # NumPy copied it (a misfit raises)
+                mode |= daqp_c.REFACTOR
+            out = daqp_c.solve_stacked(
+                self._H,
+                self._f,
+                self._M[p:],
+                self._upper[ms + p :],
+                self._M[:p],
+                self._upper[ms : ms + p],
+                self._lower[:ms],
+                self._upper[:ms],
+                self._data,
+                work.handles,
+                work.words,
+                n,
+                p,
+                m,
+                ms,
+                flags,
+                mode,
+                x,
+                lam,
+            )  # the set-up's own buffers: the compiled copy onto themselves changes nothing
+        stage, flag, iterations, spent = out[:4]
+        if stage == 0:
+            self._fill(problem)  # NumPy names the misfit it sees
+            raise ValueError("the problem's arrays do not fit the set-up's sizes")
+        if stage == 1:
+            return RawResult(None, f"update failed: {EXIT_FLAGS.get(int(flag), int(flag))}")
+        return self._judge(problem, out[4:], x, lam, int(flag), int(iterations), spent)
 
     def _run(self, problem: Problem, start: float) -> Solution:
         x, _, flag, info = self._model.solve()
@@ -240,8 +326,20 @@ class DaqpBackend(StatefulBackend):
             values = stacked(self._data, x, lam, *self._layout)
         except TypeError:  # not float64 vectors: judged (Solution.checked) sorts it out
             values = MISFITTING
-        y, z, box = self._cuts
         # Model.solve returns fresh copies of x and lam: the solution keeps them uncopied.
+        return self._judge(problem, values, x, lam, flag, info["iterations"], solver_time)
+
+    def _judge(
+        self,
+        problem: Problem,
+        values: tuple[float, ...],
+        x: np.ndarray,
+        lam: np.ndarray,
+        flag: int,
+        iterations: int,
+        solver_time: float,
+    ) -> Solution:
+        y, z, box = self._cuts
         return judged(
             problem,
             values,
@@ -252,6 +350,6 @@ class DaqpBackend(StatefulBackend):
             self.name,
             self.tolerance,
             EXIT_FLAGS.get(flag) or str(flag),
-            info["iterations"],
+            iterations,
             solver_time,
         )

@@ -307,9 +307,13 @@ def test_daqp_sets_up_a_new_model_after_a_solve_that_raised() -> None:
     ws = Drift(seed=9)
     backend = make_backend("daqp")
     backend.solve(ws.problem).require()
-    model = backend._model
+
+    def engine() -> Any:  # DAQP's C workspace (solvers.daqp_c), else its daqp.Model
+        return backend._c if backend._c is not None else backend._model
+
+    model = engine()
     ws.q.shape = (ws.q.size, 1)  # the copy raises: a failure of status "exception"
     raised = backend.solve(ws.problem)
     assert not raised.found and raised.status == "exception"
     ws.q.shape = (ws.q.size,)
-    assert backend.solve(ws.problem).found and backend._model is not model
+    assert backend.solve(ws.problem).found and engine() is not model

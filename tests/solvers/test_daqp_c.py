@@ -1,0 +1,179 @@
+"""DAQP's C functions called from compiled code (``solvers.daqp_c``) against ``daqp.Model``.
+
+The two ways to DAQP make the same calls in the same order: every answer, multiplier,
+iteration count and status must be bitwise the same, warm, restarted, after ``P`` changed,
+from a primal start and when the set-up fails.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import importlib.metadata
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+
+from solvers import Problem, Solution, make_backend
+from solvers.stateful import solve_guarded
+from tests.solvers.test_daqp_fast import FIELDS, Drift
+
+daqp = pytest.importorskip("daqp")
+from solvers import daqp_c  # noqa: E402  (after the skip: it imports daqp)
+
+needs_mirror = pytest.mark.skipif(
+    not daqp_c.available(), reason="the installed daqp's layout is not mirrored"
+)
+
+
+@pytest.fixture
+def by_model(monkeypatch: pytest.MonkeyPatch) -> Iterator[Any]:
+    """``solve(backend, problem, how=None)`` with the C functions disabled: daqp.Model."""
+
+    def solve(backend: Any, problem: Problem, how: str | None = None) -> Solution:
+        with monkeypatch.context() as patch:
+            patch.setattr(daqp_c, "available", lambda: False)
+            return call(backend, problem, how)
+
+    yield solve
+
+
+def call(backend: Any, problem: Problem, how: str | None = None) -> Solution:
+    """``backend.solve(problem)``, or one of its paths by name (``"restart"``)."""
+    if how == "restart":
+        return solve_guarded(backend, problem, backend._restart, problem, None)
+    return backend.solve(problem)
+
+
+def assert_same(got: Solution, want: Solution) -> None:
+    for name in ("found", "status", "iterations", "message", "retried"):
+        assert getattr(got, name) == getattr(want, name), name
+    for name in ("x", "y", "z", "z_box"):
+        a, b = getattr(got, name), getattr(want, name)
+        assert (a is None) == (b is None), name
+        if a is not None:
+            np.testing.assert_array_equal(a, b, err_msg=name)
+
+
+@needs_mirror
+def test_the_installed_daqp_is_mirrored_and_solves_through_its_c_functions() -> None:
+    assert importlib.metadata.version("daqp") in daqp_c.KNOWN_VERSIONS
+    backend = make_backend("daqp")
+    backend.solve(Drift(seed=1).problem).require()
+    assert backend._c is not None and backend._model is None
+
+
+@needs_mirror
+def test_compiled_calls_give_daqp_models_answers_bitwise(by_model: Any) -> None:
+    c_side, model_side = Drift(seed=11), Drift(seed=11)
+    in_c, in_model = make_backend("daqp"), make_backend("daqp")
+    for step in range(40):
+        size = 0.3 if step % 10 == 9 else 0.02
+        c_side.move(size)
+        model_side.move(size)
+        if step in (5, 17):  # a new P: H factored again
+            c_side.P[:] += np.eye(c_side.P.shape[0])
+            model_side.P[:] += np.eye(model_side.P.shape[0])
+        how = "restart" if step in (8, 25) else None
+        got = call(in_c, c_side.problem, how)
+        want = by_model(in_model, model_side.problem, how)
+        assert_same(got, want)
+        assert got.found, got.message
+    assert in_c._c is not None and in_model._model is not None
+
+
+@needs_mirror
+def test_a_primal_start_and_a_failed_set_up_are_daqp_models(by_model: Any) -> None:
+    ws = Drift(seed=12)
+    guess = np.linspace(-0.1, 0.1, ws.q.size)
+    in_c, in_model = make_backend("daqp"), make_backend("daqp")
+    assert_same(in_c.solve(ws.fresh(), guess), by_model_initvals(by_model, in_model, ws, guess))
+    indefinite = {name: getattr(ws, name) for name in FIELDS}
+    indefinite["P"] = -np.eye(ws.q.size)
+    bad = Problem(**indefinite)
+    failed_c, failed_model = make_backend("daqp").solve(bad), by_model(make_backend("daqp"), bad)
+    assert not failed_c.found and failed_c.status == "setup failed: nonconvex"
+    assert_same(failed_c, failed_model)
+    again = make_backend("daqp")
+    assert not again.solve(bad).found
+    assert again.solve(ws.fresh()).found  # set up anew after the failure
+
+
+def by_model_initvals(by_model: Any, backend: Any, ws: Drift, guess: np.ndarray) -> Solution:
+    class WithGuess:
+        def solve(self, problem: Problem) -> Solution:
+            return backend.solve(problem, guess)
+
+    return by_model(WithGuess(), ws.fresh())  # type: ignore[no-any-return]
+
+
+@needs_mirror
+def test_a_problem_the_compiled_copy_refuses_is_copied_with_numpy_bitwise(by_model: Any) -> None:
+    c_side, model_side = Drift(seed=13), Drift(seed=13)
+    problems = []
+    for ws in (c_side, model_side):
+        arrays = {name: getattr(ws, name) for name in FIELDS}
+        arrays["G"] = ws.G_fortran = np.asfortranarray(ws.G)  # type: ignore[attr-defined]
+        problems.append(Problem.trusted(**arrays))
+    in_c, in_model = make_backend("daqp"), make_backend("daqp")
+    for step in range(6):
+        for ws in (c_side, model_side):
+            ws.move(0.01)
+            ws.G_fortran[:] = ws.G  # type: ignore[attr-defined]
+            if step == 3:
+                ws.P[:] *= 2.0
+        got, want = in_c.solve(problems[0]), by_model(in_model, problems[1])
+        assert_same(got, want)
+        assert got.found and in_c._stack is None and in_c._c is not None
+
+
+def test_an_unknown_daqp_version_keeps_daqp_model(monkeypatch: pytest.MonkeyPatch) -> None:
+    daqp_c._mirrored.cache_clear()
+    try:
+        monkeypatch.setattr(importlib.metadata, "version", lambda name: "0.0.1")
+        assert not daqp_c.available()
+        backend = make_backend("daqp")
+        assert backend.solve(Drift(seed=2).problem).found
+        assert backend._model is not None and backend._c is None
+        with pytest.raises(daqp_c.LayoutError, match=r"0\.0\.1"):
+            daqp_c.Workspace(
+                *(np.zeros(k) for k in (1, 1)),
+                np.zeros((0, 1)),
+                *(np.zeros(0),) * 2,
+                np.zeros(0, np.intc),
+                {},
+            )
+    finally:
+        monkeypatch.undo()
+        daqp_c._mirrored.cache_clear()
+
+
+@needs_mirror
+def test_a_workspace_frees_once() -> None:
+    ws = Drift(seed=3)
+    backend = make_backend("daqp")
+    backend.solve(ws.problem).require()
+    work = backend._c
+    backend.reset()  # closes it
+    assert work is not None and work._work is None
+    work.close()  # again: nothing to free
+
+
+@needs_mirror
+def test_a_workspace_laid_out_otherwise_is_refused_and_daqp_model_solves(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    fields = list(daqp_c.WorkspaceHead._fields_)
+    fields[1], fields[2] = fields[2], fields[1]  # n and m swapped: the check after set-up
+
+    class Swapped(ctypes.Structure):
+        _fields_ = fields
+
+    monkeypatch.setattr(daqp_c, "_MISMATCHED", [])
+    monkeypatch.setattr(daqp_c, "WorkspaceHead", Swapped)
+    backend = make_backend("daqp")
+    ws = Drift(seed=4)
+    assert backend.solve(ws.problem).found
+    assert backend._c is None and backend._model is not None
+    assert not daqp_c.available() and "name its problem" in daqp_c._MISMATCHED[0]
