@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .residuals import Residuals
 from .solution import Solution
 
 #: qpbenchmark's shift of the shifted geometric mean.
@@ -40,8 +41,12 @@ METRICS = ("primal_residual", "dual_residual", "duality_gap")
 def metrics(solution: Solution) -> tuple[float, float, float] | None:
     """``(r_p, r_d, r_g)`` of an accepted answer; None if it was not accepted or lacks a
     multiplier (it then counts at its tolerance, see :meth:`AccuracyTally.add`)."""
-    res = solution.residuals
-    if not solution.found or res is None or res.stationarity is None or res.duality_gap is None:
+    return metrics_of(solution.residuals) if solution.found else None
+
+
+def metrics_of(res: Residuals | None) -> tuple[float, float, float] | None:
+    """``(r_p, r_d, r_g)`` of an accepted answer's residuals; None without a multiplier."""
+    if res is None or res.stationarity is None or res.duality_gap is None:
         return None
     return max(res.equality, res.inequality, res.bounds), res.stationarity, res.duality_gap
 
@@ -83,10 +88,14 @@ class AccuracyTally:
 
     def add(self, solution: Solution) -> None:
         """Count one backend call: its metrics, or its check's tolerance if unanswered."""
-        values = metrics(solution)
+        self.add_metrics(metrics(solution), solution.tolerance)
+
+    def add_metrics(self, values: tuple[float, float, float] | None, tolerance: float) -> None:
+        """Count one backend call by its :func:`metrics` (None: unanswered, counted at its
+        check's ``tolerance``)."""
         if values is None:
             self.unanswered += 1
-            values = (solution.tolerance,) * 3
+            values = (tolerance,) * 3
         self.solves += 1
         for i, value in enumerate(values):
             self.log_sums[i] += math.log1p(value / SHIFT)

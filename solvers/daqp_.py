@@ -64,7 +64,7 @@ from ._fast import EMPTY_MATRIX, EMPTY_VECTOR, refresh, stack
 from ._kkt import HAS_LB, HAS_UB, MISFITTING, stacked
 from .problem import Problem
 from .solution import Solution, judged
-from .stateful import RawResult, StatefulBackend
+from .stateful import RawResult, StatefulBackend, solve_guarded
 
 #: DAQP exit flags, from DAQP's ``constants.h``.
 EXIT_FLAGS = {
@@ -112,6 +112,7 @@ class DaqpBackend(StatefulBackend):
         self._sense = np.zeros(0, dtype=np.intc)  # the set-up's sense: equality rows flagged
         self._c: daqp_c.Workspace | None = None  # DAQP called from compiled code (daqp_c)
         self._c_args: tuple[Any, ...] | None = None  # solve_stacked's, but the mode and answers
+        self._warm_call: daqp_c.WarmCall | None = None  # compiled_warm's
 
     @classmethod
     def known_settings(cls) -> set[str]:
@@ -122,6 +123,7 @@ class DaqpBackend(StatefulBackend):
         if self._c is not None:
             self._c.close()
         self._model = self._bound = self._stack = self._c = self._c_args = None
+        self._warm_call = None
 
     def _structure_of(self, problem: Problem) -> Hashable:
         """The base key, kept while the same problem object comes back (it holds the same
@@ -135,7 +137,7 @@ class DaqpBackend(StatefulBackend):
         (fixed objects, rewritten in place from one solve to the next), empty placeholders
         for its absent blocks, and the set-up's buffer and sizes."""
         A, G, lb, ub, empty = problem.A, problem.G, problem.lb, problem.ub, EMPTY_VECTOR
-        self._bound, self._c_args = problem, None
+        self._bound, self._c_args, self._warm_call = problem, None, None
         self._stack = (
             problem.P,
             problem.q,
@@ -309,12 +311,60 @@ class DaqpBackend(StatefulBackend):
                 lam,
             )  # the set-up's own buffers: the compiled copy onto themselves changes nothing
         stage, flag, iterations, spent = out[:4]
+        if stage != 2:
+            return self._stage_failure(problem, np.array(out))
+        return self._judge(problem, out[4:], x, lam, int(flag), int(iterations), spent)
+
+    def compiled_warm(self, problem: Problem) -> daqp_c.WarmCall | None:
+        """What compiled code needs to make this backend's next solve of ``problem`` (its warm
+        attempt) itself (:func:`solvers.daqp_c.solve_dropped`), or None if that solve would
+        not be a warm one on DAQP's C functions with the compiled copy (then ``solve``). The
+        same object while nothing changes; finish with :meth:`adopt_warm`."""
+        if self._c is None or not self._warm or problem is not self._bound or self._stack is None:
+            return None
+        if self._warm_call is None or self._warm_call.data is not self._data:
+            n, p, m, ms, flags = self._layout
+            *given, data = self._stack[:9]
+            arrays = [a if a.flags.writeable else np.zeros(a.shape) for a in given]  # packable
+            work = self._c
+            self._warm_call = daqp_c.WarmCall(
+                *arrays,
+                data,
+                work.handles,
+                work.words,
+                n,
+                p,
+                m,
+                ms,
+                flags,
+                np.empty(n),
+                np.empty(ms + p + m),
+                np.empty(12),
+            )
+        return self._warm_call
+
+    def adopt_warm(self, problem: Problem, start: float) -> Solution:
+        """Finish the solve of ``problem`` begun at ``start`` (``perf_counter``) whose warm
+        attempt compiled code made with :meth:`compiled_warm`'s arrays (its values in their
+        ``out``): the answer judged (copied: the buffers are the next attempt's) and, if
+        refused, solved again cold, as :meth:`solve` does."""
+        call = self._warm_call
+        assert call is not None
+        stage, flag, iterations, spent = call.out[:4]
+        if stage == 2:
+            values = tuple(float(v) for v in call.out[4:])
+            x, lam = call.x.copy(), call.lam.copy()
+            solution = self._judge(problem, values, x, lam, int(flag), int(iterations), spent)
+        else:  # a misfit or a failed update: as the warm attempt in solve would say it
+            solution = solve_guarded(self, problem, self._stage_failure, problem, call.out)
+        return self.after_warm(problem, solution, start)
+
+    def _stage_failure(self, problem: Problem, out: np.ndarray) -> RawResult:
+        stage, flag = out[:2]
         if stage == 0:
             self._fill(problem)  # NumPy names the misfit it sees
             raise ValueError("the problem's arrays do not fit the set-up's sizes")
-        if stage == 1:
-            return RawResult(None, f"update failed: {EXIT_FLAGS.get(int(flag), int(flag))}")
-        return self._judge(problem, out[4:], x, lam, int(flag), int(iterations), spent)
+        return RawResult(None, f"update failed: {EXIT_FLAGS.get(int(flag), int(flag))}")
 
     def _run(self, problem: Problem, start: float) -> Solution:
         x, _, flag, info = self._model.solve()

@@ -21,6 +21,7 @@ import ctypes
 import functools
 import importlib.metadata
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -31,7 +32,8 @@ from numba.core.extending import intrinsic
 
 from ._fast import stack_into
 from ._kkt import MISFITTING, stacked_values
-from .jit import compiled_on_first_call
+from .jit import compiled_on_first_call, njit
+from .rows import compact, resized
 
 KNOWN_VERSIONS = ("0.11.0",)
 """The ``daqp`` versions whose ``types.h`` the structures below mirror."""
@@ -436,20 +438,8 @@ _WORDS = types.Array(types.int64, 1, "C")
 SOLVED = types.UniTuple(types.float64, 12)
 
 
-@compiled_on_first_call(
-    SOLVED(
-        *(_MAT_IN, _VEC_IN) * 3,
-        _VEC_IN,
-        _VEC_IN,
-        _VEC_OUT,
-        _WORDS,
-        _WORDS,
-        *(types.int64,) * 6,
-        _VEC_OUT,
-        _VEC_OUT,
-    )
-)
-def solve_stacked(
+@njit
+def stacked_solve(
     P: np.ndarray,
     q: np.ndarray,
     A: np.ndarray,
@@ -516,3 +506,111 @@ def solve_stacked(
     exitflag, iterations = ints[_RES_FLAG], ints[_RES_ITER]
     values = stacked_values(data, x, lam, n, p, m, ms, flags)
     return (2.0, float(exitflag), float(iterations), spent, *values)
+
+
+@compiled_on_first_call(
+    SOLVED(
+        *(_MAT_IN, _VEC_IN) * 3,
+        _VEC_IN,
+        _VEC_IN,
+        _VEC_OUT,
+        _WORDS,
+        _WORDS,
+        *(types.int64,) * 6,
+        _VEC_OUT,
+        _VEC_OUT,
+    )
+)
+def solve_stacked(
+    P: np.ndarray,
+    q: np.ndarray,
+    A: np.ndarray,
+    b: np.ndarray,
+    G: np.ndarray,
+    h: np.ndarray,
+    lb: np.ndarray,
+    ub: np.ndarray,
+    data: np.ndarray,
+    handles: np.ndarray,
+    words: np.ndarray,
+    n: int,
+    p: int,
+    m: int,
+    ms: int,
+    flags: int,
+    mode: int,
+    x: np.ndarray,
+    lam: np.ndarray,
+) -> tuple[float, ...]:
+    """:func:`stacked_solve`, compiled for its one signature, called from Python."""
+    return stacked_solve(
+        P, q, A, b, G, h, lb, ub, data, handles, words, n, p, m, ms, flags, mode, x, lam
+    )
+
+
+@dataclass(frozen=True)
+class WarmCall:
+    """What a warm solve in compiled code needs (:func:`solve_dropped`): the bound problem's
+    arrays (``P`` .. ``ub``, absent blocks as empty arrays), the set-up's ``data``,
+    ``handles`` and ``words``, its sizes and ``flags`` (:func:`stacked_solve`'s), and buffers
+    for the answer ``x`` (n,), ``lam`` (ms + p + m,) and :func:`stacked_solve`'s values
+    ``out`` (12,). Valid while its backend keeps the set-up and the problem it was made for
+    (:meth:`solvers.daqp_.DaqpBackend.compiled_warm`)."""
+
+    P: np.ndarray
+    q: np.ndarray
+    A: np.ndarray
+    b: np.ndarray
+    G: np.ndarray
+    h: np.ndarray
+    lb: np.ndarray
+    ub: np.ndarray
+    data: np.ndarray
+    handles: np.ndarray
+    words: np.ndarray
+    n: int
+    p: int
+    m: int
+    ms: int
+    flags: int
+    x: np.ndarray
+    lam: np.ndarray
+    out: np.ndarray
+
+
+@njit
+def solve_dropped(w) -> bool:  # type: ignore[no-untyped-def]
+    """A :class:`~solvers.rows.RowDropping` solve over DAQP's C functions, in compiled code:
+    ``w`` is its :class:`~solvers.rows.WarmRows` packed into one struct (its ``call`` a packed
+    :class:`WarmCall`). Drops the rows (:func:`~solvers.rows.compact`) and, unless the copy's
+    capacity would change (then False: the backend's ``solve`` takes it from there, the rows
+    dropped again to the same slots), makes the warm attempt (:func:`stacked_solve`), its
+    values in ``w.call.out``; the backend's ``adopt_warm`` finishes it when they are refused."""
+    used = compact(w.G, w.h, w.slot_of, w.row_of, w.Gc, w.hc)
+    if resized(used, w.capacity, w.hc.shape[0]) != w.capacity:
+        return False
+    c = w.call
+    out = stacked_solve(
+        c.P,
+        c.q,
+        c.A,
+        c.b,
+        c.G,
+        c.h,
+        c.lb,
+        c.ub,
+        c.data,
+        c.handles,
+        c.words,
+        c.n,
+        c.p,
+        c.m,
+        c.ms,
+        c.flags,
+        WARM,
+        c.x,
+        c.lam,
+    )
+    for i in range(c.out.shape[0]):
+        c.out[i] = out[i]
+    return True

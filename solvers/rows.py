@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -64,6 +65,33 @@ def spread(z, row_of, out) -> None:  # type: ignore[no-untyped-def]
             out[row_of[s]] = z[s]
 
 
+@njit
+def resized(used: int, capacity: int, rows: int) -> int:
+    """The compact copy's capacity for ``used`` slots: ``capacity`` while they fit and fill
+    at least a quarter of it, else (or with no capacity yet, 0) ``min(rows, max(8, 2 used))``,
+    ``rows`` the given problem's."""
+    if capacity == 0 or used > capacity or 4 * used < capacity:  # 0: none yet
+        return min(rows, max(8, 2 * used))
+    return capacity
+
+
+@dataclass(frozen=True)
+class WarmRows:
+    """What compiled code needs to make a :class:`RowDropping`'s next solve itself: the given
+    problem's ``G``, ``h``, the copy's slots (``slot_of``, ``row_of``), its full-size ``Gc``,
+    ``hc``, its ``capacity`` and the inner backend's warm call on the copy at that capacity
+    (``call``, e.g. :class:`solvers.daqp_c.WarmCall`)."""
+
+    G: np.ndarray
+    h: np.ndarray
+    slot_of: np.ndarray
+    row_of: np.ndarray
+    Gc: np.ndarray
+    hc: np.ndarray
+    capacity: int
+    call: Any
+
+
 @dataclass
 class _Copy:
     """The compact copy of one problem: slots, full-size buffers and the problem at its
@@ -79,11 +107,11 @@ class _Copy:
 
     def sized(self, used: int) -> Problem:
         """The compact problem, its capacity changed if ``used`` slots do not fit or fit in a
-        quarter of it."""
-        if self.problem is None or used > self.capacity or 4 * used < self.capacity:
-            self.capacity = min(self.h.shape[0], max(8, 2 * used))
+        quarter of it (:func:`resized`)."""
+        capacity = resized(used, self.capacity, self.h.shape[0])
+        if self.problem is None or capacity != self.capacity:
+            self.capacity = c = capacity
             s = self.source
-            c = self.capacity
             self.problem = Problem.trusted(s.P, s.q, s.A, s.b, self.G[:c], self.h[:c], s.lb, s.ub)
         return self.problem
 
@@ -96,11 +124,12 @@ class RowDropping:
         self.inner = inner
         self.name, self.tolerance = inner.name, inner.tolerance
         self._copy: _Copy | None = None
+        self._warm: WarmRows | None = None  # compiled_warm's
 
     def reset(self) -> None:
         """Drop the inner backend's warm start and the copy's slots."""
         self.inner.reset()
-        self._copy = None
+        self._copy = self._warm = None
 
     def solve(self, problem: Problem, initvals: np.ndarray | None = None) -> Solution:
         """Solve ``problem`` through its compact copy."""
@@ -117,7 +146,37 @@ class RowDropping:
                 np.full(p, math.inf),
             )
         used = compact(problem.G, problem.h, copy.slot_of, copy.row_of, copy.G, copy.h)
-        solution = self.inner.solve(copy.sized(used), initvals)
+        return self._spread(problem, copy, self.inner.solve(copy.sized(used), initvals))
+
+    def compiled_warm(self, problem: Problem) -> WarmRows | None:
+        """What compiled code needs to make the next solve of ``problem`` itself, its rows
+        dropped and the inner backend's warm attempt on them (e.g.
+        :func:`solvers.daqp_c.solve_dropped`), or None if the inner backend cannot be called so
+        now (no ``compiled_warm`` of its own, or it says None). The same object while nothing
+        changes; finish with :meth:`adopt_warm`. Compiled code must take the path of
+        :meth:`solve` instead when the capacity would change (:func:`resized`)."""
+        copy, warm = self._copy, getattr(self.inner, "compiled_warm", None)
+        if warm is None or copy is None or copy.source is not problem or copy.problem is None:
+            return None
+        call = warm(copy.problem)
+        if call is None:
+            return None
+        if self._warm is None or self._warm.call is not call:
+            G, h = problem.G, problem.h
+            c = copy.capacity
+            self._warm = WarmRows(G, h, copy.slot_of, copy.row_of, copy.G, copy.h, c, call)
+        return self._warm
+
+    def adopt_warm(self, problem: Problem, start: float) -> Solution:
+        """Finish the solve of ``problem`` begun at ``start`` (``perf_counter``) that compiled
+        code made with :meth:`compiled_warm`'s arrays (the rows dropped, the inner backend's
+        warm attempt): as :meth:`solve` would."""
+        copy = self._copy
+        assert copy is not None and copy.problem is not None
+        return self._spread(problem, copy, self.inner.adopt_warm(copy.problem, start))
+
+    def _spread(self, problem: Problem, copy: _Copy, solution: Solution) -> Solution:
+        """The solution of the compact copy as ``problem``'s: ``z`` spread to its rows."""
         z = solution.z
         if z is not None:
             z = np.empty(problem.h.shape[0])

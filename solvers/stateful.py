@@ -205,13 +205,27 @@ class StatefulBackend:
         structure = self._structure_of(problem)
         if structure == self._structure and self._warm:
             solution = solve_guarded(self, problem, self._update, problem, guess)
-            if not solution.found:
-                warm_time = solution.solver_time
-                solution = self._cold(problem, guess, structure)
-                solution.retried = True
-                solution.solver_time += warm_time
-        else:
-            solution = self._cold(problem, guess, structure)
+            return self.after_warm(problem, solution, start, guess)
+        return self._settled(self._cold(problem, guess, structure), start)
+
+    def after_warm(
+        self,
+        problem: Problem,
+        solution: Solution,
+        start: float,
+        guess: np.ndarray | None = None,
+    ) -> Solution:
+        """Finish a solve of ``problem`` begun at ``start`` (``perf_counter``) whose warm attempt
+        gave ``solution``: redone cold if refused (``retried``)."""
+        if not solution.found:
+            warm_time = solution.solver_time
+            solution = self._cold(problem, guess, self._structure)
+            solution.retried = True
+            solution.solver_time += warm_time
+        return self._settled(solution, start)
+
+    def _settled(self, solution: Solution, start: float) -> Solution:
+        """The solve's last word: the next may start warm only from an accepted answer."""
         self._warm = solution.found
         if not solution.found and (not self.restarts or solution.status == "exception"):
             self.reset()  # a solver that raised may be left in any state: set up anew

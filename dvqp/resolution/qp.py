@@ -31,6 +31,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
+from time import perf_counter
 from typing import Any
 
 import numpy as np
@@ -41,8 +42,10 @@ from dvqp.errors import BackendError
 from dvqp.resolution.levels import Levels, load_relaxed, relaxed_problem, strict_problem
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
-from dvqp.workspace import QPBuffers
-from solvers.accuracy import AccuracyTally
+from dvqp.workspace import QPBuffers, as_struct
+from solvers.accuracy import AccuracyTally, metrics_of
+from solvers.daqp_c import solve_dropped
+from solvers.residuals import passing
 
 #: A watcher of the backend calls: ``(kind, problem, solution)``, kind ``"strict"``,
 #: ``"scaled"`` or ``"relaxed"``.
@@ -163,6 +166,8 @@ class QPSolver:
         the strict problem's, or the relaxed one's when the strict one had no accepted answer
         (an infeasible strict problem has no optimum to be accurate about: its refusal is
         counted in :attr:`refusals`); a step with neither counts at the check's tolerance."""
+        self._warm_rows: object = None  # the strict backend's compiled_warm, packed:
+        self._packed: Any = None
         self.watchers: list[Watcher] = []
         """Called after every backend call with ``("strict" | "scaled" | "relaxed", problem,
         solution)``;
@@ -193,7 +198,9 @@ class QPSolver:
             if out.x is not None:
                 return Answer(out.x, out.status, out.iterations, out.solver_time, out.rate)
             return self._brake(out.message, out.iterations, out.solver_time, out.rate)
-        solution = strict.solve(self.strict)
+        solution, accepted = self._strict_solve(strict)
+        if solution is None:
+            return accepted  # type: ignore[return-value]
         self._count("strict", self.strict, solution)
         spent, status, rate = solution.solver_time, "optimal", 1.0
         if not solution.found and not rest and self.feedforward.any():
@@ -208,6 +215,34 @@ class QPSolver:
             x = solution.x[: qp.cost.shape[0]]
             return Answer(x, status, solution.iterations, spent, rate)
         return self._brake(solution.message, solution.iterations, spent, rate)
+
+    def _strict_solve(
+        self, strict: solvers.Backend
+    ) -> tuple[solvers.Solution, None] | tuple[None, Answer]:
+        """The strict problem's backend call, or its accepted answer made in compiled code.
+
+        A backend that can make its next solve's warm attempt in compiled code says so
+        (``compiled_warm``: :class:`solvers.rows.RowDropping` over DAQP's C functions,
+        :func:`solvers.daqp_c.solve_dropped`). Then that attempt is one compiled call, and an
+        answer that passes the residual check (:func:`solvers.residuals.passing`, the check of
+        every solve) is taken without a :class:`solvers.Solution`; a refused one is finished by
+        the backend as its ``solve`` would (``adopt_warm``: the cold retry). Watchers see every
+        call's problem and solution: with them, ``solve``."""
+        start = perf_counter()
+        warm = None if self.watchers else getattr(strict, "compiled_warm", None)
+        rows = None if warm is None else warm(self.strict)
+        if rows is None:
+            return strict.solve(self.strict), None
+        if rows is not self._warm_rows:
+            self._warm_rows, self._packed = rows, as_struct(rows)
+        if not solve_dropped(self._packed):
+            return strict.solve(self.strict), None
+        out = rows.call.out
+        residuals = passing(tuple(out[4:].tolist()), strict.tolerance) if out[0] == 2 else None
+        if residuals is None:
+            return strict.adopt_warm(self.strict, start), None  # type: ignore[attr-defined]
+        self.accuracy.add_metrics(metrics_of(residuals), strict.tolerance)
+        return None, Answer(rows.call.x, "optimal", int(out[2]), float(out[3]))
 
     def _brake(self, message: str, iterations: int | None, spent: float, rate: float) -> Answer:
         """No accepted answer: the velocity closest to rest within the joint bounds

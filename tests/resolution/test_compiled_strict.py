@@ -1,0 +1,61 @@
+"""The strict QP's warm attempt made inside compiled code (``QPSolver._strict_solve`` with
+``RowDropping.compiled_warm`` over DAQP's C functions) against the backend's own ``solve``.
+
+A run whose steps take that path must be the very run whose steps call ``solve`` (a watcher
+of the backend calls turns the path off): the same joint motion bit for bit, the same
+statuses, iterations, refusals and accuracy, on scenes with refused strict problems
+(relaxed steps, the cold retries after them) and with time-scaled ones.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+import dvqp
+from dvqp.resolution import qp
+from tests.runs import SCENES as SCENE_FILES
+
+pytest.importorskip("daqp")
+from solvers import daqp_c
+from solvers.daqp_c import solve_dropped
+
+needs_mirror = pytest.mark.skipif(
+    not daqp_c.available(), reason="the installed daqp's layout is not mirrored"
+)
+
+SCENES = ("paper-two-inlets", "probe-into-clamp", "weld-rush", "joint-limit")
+
+
+def run(scene: dvqp.Scene, monkeypatch: pytest.MonkeyPatch, *, compiled: bool) -> tuple[Any, int]:
+    """The DAQP run, and how many strict solves were made in compiled code."""
+    made = 0
+
+    def counted(packed: Any) -> bool:
+        nonlocal made
+        made += 1
+        return bool(solve_dropped(packed))
+
+    with monkeypatch.context() as patch:
+        patch.setattr(qp, "solve_dropped", counted)
+        watch = None if compiled else (lambda step, kind, problem, solution: None)
+        return dvqp.plan(scene, "daqp", watch=watch), made
+
+
+@needs_mirror
+@pytest.mark.parametrize("name", SCENES)
+def test_a_run_in_compiled_code_is_the_run_through_solve(
+    name: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    scene = dvqp.load_scene(str(SCENE_FILES / f"{name}.toml"))
+    fast, made = run(scene, monkeypatch, compiled=True)
+    slow, none = run(scene, monkeypatch, compiled=False)
+    assert made > 0 and none == 0  # with a watcher, every call is solve's
+    np.testing.assert_array_equal(fast.q, slow.q)
+    np.testing.assert_array_equal(fast.qdot, slow.qdot)
+    assert list(fast.status) == list(slow.status)
+    assert list(fast.iterations) == list(slow.iterations)
+    assert fast.refusals == slow.refusals
+    assert fast.accuracy == slow.accuracy
