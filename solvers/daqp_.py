@@ -256,7 +256,7 @@ class DaqpBackend(StatefulBackend):
         from the equality rows alone, as its set-up does, without its allocations (a refused
         strict solve on probe-into-clamp: ~18 µs, ~50 µs with a set-up). A primal guess needs a
         set-up (``primal_start``)."""
-        if self._model is None or guess is not None:
+        if (self._model is None and self._c is None) or guess is not None:
             self._release()
             return self._setup(problem, guess)
         if self._stack is None:

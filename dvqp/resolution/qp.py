@@ -32,7 +32,7 @@ from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 from time import perf_counter
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -101,6 +101,18 @@ class QPResolver(Resolver):
             factory()  # an unknown name fails here, not in the first step
 
 
+class Taken(NamedTuple):
+    """A backend call's answer taken in compiled code (:meth:`QPSolver._call`): what the
+    resolver reads of a :class:`solvers.Solution`. ``x`` is the backend's buffer, valid until
+    its next call."""
+
+    x: NDArray[np.float64]
+    iterations: int
+    solver_time: float
+    found: bool = True
+    message: str = ""
+
+
 @dataclass
 class Answer:
     """A QP solve: ``x`` (rad/s, None when even braking is impossible), the status
@@ -166,8 +178,7 @@ class QPSolver:
         the strict problem's, or the relaxed one's when the strict one had no accepted answer
         (an infeasible strict problem has no optimum to be accurate about: its refusal is
         counted in :attr:`refusals`); a step with neither counts at the check's tolerance."""
-        self._warm_rows: object = None  # the strict backend's compiled_warm, packed:
-        self._packed: Any = None
+        self._packs: dict[int, tuple[Any, Any]] = {}  # per backend: compiled_warm, packed
         self.watchers: list[Watcher] = []
         """Called after every backend call with ``("strict" | "scaled" | "relaxed", problem,
         solution)``;
@@ -198,28 +209,23 @@ class QPSolver:
             if out.x is not None:
                 return Answer(out.x, out.status, out.iterations, out.solver_time, out.rate)
             return self._brake(out.message, out.iterations, out.solver_time, out.rate)
-        solution, accepted = self._strict_solve(strict)
-        if solution is None:
-            return accepted  # type: ignore[return-value]
-        self._count("strict", self.strict, solution)
+        solution = self._call("strict", strict, self.strict)
         spent, status, rate = solution.solver_time, "optimal", 1.0
         if not solution.found and not rest and self.feedforward.any():
             solution, rate = self._slow_down()
             spent, status = spent + solution.solver_time, "slowed"
         if not solution.found:
             load_relaxed(qp, self.relaxed)
-            solution = relaxed.solve(self.relaxed)
-            self._count("relaxed", self.relaxed, solution)
+            solution = self._call("relaxed", relaxed, self.relaxed)
             spent, status = spent + solution.solver_time, "relaxed"
         if solution.found and solution.x is not None:
             x = solution.x[: qp.cost.shape[0]]
             return Answer(x, status, solution.iterations, spent, rate)
         return self._brake(solution.message, solution.iterations, spent, rate)
 
-    def _strict_solve(
-        self, strict: solvers.Backend
-    ) -> tuple[solvers.Solution, None] | tuple[None, Answer]:
-        """The strict problem's backend call, or its accepted answer made in compiled code.
+    def _call(self, kind: str, backend: solvers.Backend, problem: solvers.Problem) -> Any:
+        """One backend call on ``problem`` (``kind`` ``"strict"``, ``"scaled"`` or
+        ``"relaxed"``), counted: a :class:`solvers.Solution`, or :class:`Taken`.
 
         A backend that can make its next solve's warm attempt in compiled code says so
         (``compiled_warm``: :class:`solvers.rows.RowDropping` over DAQP's C functions,
@@ -229,20 +235,27 @@ class QPSolver:
         the backend as its ``solve`` would (``adopt_warm``: the cold retry). Watchers see every
         call's problem and solution: with them, ``solve``."""
         start = perf_counter()
-        warm = None if self.watchers else getattr(strict, "compiled_warm", None)
-        rows = None if warm is None else warm(self.strict)
-        if rows is None:
-            return strict.solve(self.strict), None
-        if rows is not self._warm_rows:
-            self._warm_rows, self._packed = rows, as_struct(rows)
-        if not solve_dropped(self._packed):
-            return strict.solve(self.strict), None
-        out = rows.call.out
-        residuals = passing(tuple(out[4:].tolist()), strict.tolerance) if out[0] == 2 else None
-        if residuals is None:
-            return strict.adopt_warm(self.strict, start), None  # type: ignore[attr-defined]
-        self.accuracy.add_metrics(metrics_of(residuals), strict.tolerance)
-        return None, Answer(rows.call.x, "optimal", int(out[2]), float(out[3]))
+        warm = None if self.watchers else getattr(backend, "compiled_warm", None)
+        rows = None if warm is None else warm(problem)
+        if rows is not None and solve_dropped(self._packed(backend, rows)):
+            out = rows.call.out
+            residuals = passing(tuple(out[4:].tolist()), backend.tolerance) if out[0] == 2 else None
+            if residuals is not None:
+                self.accuracy.add_metrics(metrics_of(residuals), backend.tolerance)
+                return Taken(rows.call.x, int(out[2]), float(out[3]))
+            solution = backend.adopt_warm(problem, start)  # type: ignore[attr-defined]
+        else:
+            solution = backend.solve(problem)
+        self._count(kind, problem, solution)
+        return solution
+
+    def _packed(self, backend: solvers.Backend, rows: Any) -> Any:
+        """``rows`` (a backend's ``compiled_warm``) packed into one struct, kept while the
+        backend hands the same object."""
+        kept = self._packs.get(id(backend))
+        if kept is None or kept[0] is not rows:
+            kept = self._packs[id(backend)] = (rows, as_struct(rows))
+        return kept[1]
 
     def _brake(self, message: str, iterations: int | None, spent: float, rate: float) -> Answer:
         """No accepted answer: the velocity closest to rest within the joint bounds
@@ -252,7 +265,7 @@ class QPSolver:
             return Answer(None, f"failed: {message}", iterations, spent, 0.0)
         return Answer(np.clip(0.0, qp.lb, qp.ub), "braking", iterations, spent, rate)
 
-    def _slow_down(self) -> tuple[solvers.Solution, float]:
+    def _slow_down(self) -> tuple[Any, float]:
         """Solve the time-scaled problem; leave in ``b`` the task the answer meets (or, if it
         has none, the task of stopping on the path, ``b − v``, for the relaxed problem).
         Returns the solution and ``σ`` (0 if it has no accepted answer)."""
@@ -269,8 +282,7 @@ class QPSolver:
         p.lb[:n], p.ub[:n] = qp.lb, qp.ub
         if p.G is not None:
             p.G[:, :n] = qp.G
-        solution = self._pacer.solve(p)  # type: ignore[union-attr]
-        self._count("scaled", p, solution)
+        solution = self._call("scaled", self._pacer, p)  # type: ignore[arg-type]
         if not (solution.found and solution.x is not None):
             qp.b[:] -= v
             return solution, 0.0

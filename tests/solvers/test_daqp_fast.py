@@ -279,6 +279,12 @@ def test_stacked_refuses_a_misfit_with_nan_values() -> None:
     assert values[0] == -1 and all(math.isnan(v) for v in values[1:])
 
 
+def engine(backend: Any) -> Any:
+    """The DAQP a backend holds: its C workspace (solvers.daqp_c), else its daqp.Model."""
+    assert backend._c is not None or backend._model is not None
+    return backend._c if backend._c is not None else backend._model
+
+
 def test_daqp_restarts_cold_in_its_model_after_a_refused_answer() -> None:
     """An infeasible verdict reached warm is confirmed by a cold restart, and the solve after
     a refusal starts cold too, both in the kept model (no new set-up): the very iterations and
@@ -287,17 +293,17 @@ def test_daqp_restarts_cold_in_its_model_after_a_refused_answer() -> None:
     ws = Drift(seed=8)
     backend = make_backend("daqp")
     backend.solve(ws.problem).require()
-    model = backend._model
+    model = engine(backend)
     ws.G[0] = 0.0
     ws.G[0, 0], ws.h[0] = 1.0, ws.lb[0] - 0.5  # x0 below its own bound
     refused = backend.solve(ws.problem)
-    assert not refused.found and refused.retried and backend._model is model
+    assert not refused.found and refused.retried and engine(backend) is model
     fresh = make_backend("daqp").solve(ws.fresh())
     assert not fresh.found and refused.iterations == fresh.iterations
     ws.move(0.01)
     after = backend.solve(ws.problem)
     cold = make_backend("daqp").solve(ws.fresh())
-    assert after.found and not after.retried and backend._model is model
+    assert after.found and not after.retried and engine(backend) is model
     assert after.iterations == cold.iterations
     np.testing.assert_array_equal(after.require(), cold.require())
 
@@ -307,13 +313,9 @@ def test_daqp_sets_up_a_new_model_after_a_solve_that_raised() -> None:
     ws = Drift(seed=9)
     backend = make_backend("daqp")
     backend.solve(ws.problem).require()
-
-    def engine() -> Any:  # DAQP's C workspace (solvers.daqp_c), else its daqp.Model
-        return backend._c if backend._c is not None else backend._model
-
-    model = engine()
+    model = engine(backend)
     ws.q.shape = (ws.q.size, 1)  # the copy raises: a failure of status "exception"
     raised = backend.solve(ws.problem)
     assert not raised.found and raised.status == "exception"
     ws.q.shape = (ws.q.size,)
-    assert backend.solve(ws.problem).found and engine() is not model
+    assert backend.solve(ws.problem).found and engine(backend) is not model
