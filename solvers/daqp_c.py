@@ -579,16 +579,23 @@ class WarmCall:
 
 
 @njit
-def solve_dropped(w) -> bool:  # type: ignore[no-untyped-def]
+def solve_dropped(w):  # type: ignore[no-untyped-def]
     """A :class:`~solvers.rows.RowDropping` solve over DAQP's C functions, in compiled code:
     ``w`` is its :class:`~solvers.rows.WarmRows` packed into one struct (its ``call`` a packed
     :class:`WarmCall`). Drops the rows (:func:`~solvers.rows.compact`) and, unless the copy's
-    capacity would change (then False: the backend's ``solve`` takes it from there, the rows
-    dropped again to the same slots), makes the warm attempt (:func:`stacked_solve`), its
-    values in ``w.call.out``; the backend's ``adopt_warm`` finishes it when they are refused."""
+    capacity would change, makes the warm attempt (:func:`stacked_solve`).
+
+    Returns
+    -------
+    tuple of 12 floats
+        :func:`stacked_solve`'s values (also written to ``w.call.out``, where the backend's
+        ``adopt_warm`` finishes a refused attempt), or stage −1 when the capacity would change
+        (nothing solved: the backend's ``solve`` takes it from there, the rows dropped again
+        to the same slots).
+    """
     used = compact(w.G, w.h, w.slot_of, w.row_of, w.Gc, w.hc)
     if resized(used, w.capacity, w.hc.shape[0]) != w.capacity:
-        return False
+        return (-1.0, *MISFITTING, 0.0, 0.0, 0.0)
     c = w.call
     out = stacked_solve(
         c.P,
@@ -613,4 +620,4 @@ def solve_dropped(w) -> bool:  # type: ignore[no-untyped-def]
     )
     for i in range(c.out.shape[0]):
         c.out[i] = out[i]
-    return True
+    return out

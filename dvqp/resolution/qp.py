@@ -237,15 +237,15 @@ class QPSolver:
         start = perf_counter()
         warm = None if self.watchers else getattr(backend, "compiled_warm", None)
         rows = None if warm is None else warm(problem)
-        if rows is not None and solve_dropped(self._packed(backend, rows)):
-            out = rows.call.out
-            residuals = passing(tuple(out[4:].tolist()), backend.tolerance) if out[0] == 2 else None
+        out = (-1.0,) if rows is None else solve_dropped(self._packed(backend, rows))
+        if out[0] < 0:  # not made there
+            solution = backend.solve(problem)
+        else:
+            residuals = passing(out[4:], backend.tolerance) if out[0] == 2 else None
             if residuals is not None:
                 self.accuracy.add_metrics(metrics_of(residuals), backend.tolerance)
-                return Taken(rows.call.x, int(out[2]), float(out[3]))
+                return Taken(rows.call.x, int(out[2]), out[3])
             solution = backend.adopt_warm(problem, start)  # type: ignore[attr-defined]
-        else:
-            solution = backend.solve(problem)
         self._count(kind, problem, solution)
         return solution
 

@@ -33,10 +33,10 @@ def run(scene: dvqp.Scene, monkeypatch: pytest.MonkeyPatch, *, compiled: bool) -
     """The DAQP run, and how many strict solves were made in compiled code."""
     made = 0
 
-    def counted(packed: Any) -> bool:
+    def counted(packed: Any) -> Any:
         nonlocal made
         made += 1
-        return bool(solve_dropped(packed))
+        return solve_dropped(packed)
 
     with monkeypatch.context() as patch:
         patch.setattr(qp, "solve_dropped", counted)
