@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from solvers import Problem, Solution, make_backend
 from solvers.stateful import solve_guarded
@@ -81,6 +83,29 @@ def test_compiled_calls_give_daqp_models_answers_bitwise(by_model: Any) -> None:
         assert_same(got, want)
         assert got.found, got.message
     assert in_c._c is not None and in_model._model is not None
+
+
+@needs_mirror
+@settings(max_examples=15, deadline=None)
+@given(
+    seed=st.integers(min_value=0, max_value=2**32 - 1),
+    sizes=st.lists(st.sampled_from([0.0, 0.005, 0.05, 0.5]), min_size=4, max_size=12),
+    rows=st.integers(min_value=0, max_value=12),
+)
+def test_any_drift_is_solved_bitwise_as_daqp_model(
+    seed: int, sizes: list[float], rows: int
+) -> None:
+    c_side, model_side = Drift(seed=seed, p=rows), Drift(seed=seed, p=rows)
+    in_c, in_model = make_backend("daqp"), make_backend("daqp")
+    with pytest.MonkeyPatch.context() as patch:
+        for size in sizes:
+            c_side.move(size)
+            model_side.move(size)
+            got = in_c.solve(c_side.problem)
+            patch.setattr(daqp_c, "available", lambda: False)
+            want = in_model.solve(model_side.problem)
+            patch.undo()
+            assert_same(got, want)
 
 
 @needs_mirror
