@@ -31,7 +31,7 @@ from numba.core import cgutils
 from numba.core.extending import intrinsic
 
 from ._fast import stack_into
-from ._kkt import MISFITTING, stacked_values
+from ._kkt import MISFITTING, _readonly, stacked_values
 from .jit import compiled_on_first_call, njit
 from .rows import compact, resized
 
@@ -438,7 +438,7 @@ _WORDS = types.Array(types.int64, 1, "C")
 SOLVED = types.UniTuple(types.float64, 12)
 
 
-@njit
+@njit(separate=True)
 def stacked_solve(
     P: np.ndarray,
     q: np.ndarray,
@@ -597,15 +597,15 @@ def solve_dropped(w):  # type: ignore[no-untyped-def]
     if resized(used, w.capacity, w.hc.shape[0]) != w.capacity:
         return (-1.0, *MISFITTING, 0.0, 0.0, 0.0)
     c = w.call
-    out = stacked_solve(
-        c.P,
-        c.q,
-        c.A,
-        c.b,
-        c.G,
-        c.h,
-        c.lb,
-        c.ub,
+    out = stacked_solve(  # read-only data: the types solve_stacked declares, one compile
+        _readonly(c.P),
+        _readonly(c.q),
+        _readonly(c.A),
+        _readonly(c.b),
+        _readonly(c.G),
+        _readonly(c.h),
+        _readonly(c.lb),
+        _readonly(c.ub),
         c.data,
         c.handles,
         c.words,
