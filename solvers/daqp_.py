@@ -112,7 +112,7 @@ class DaqpBackend(StatefulBackend):
         self._sense = np.zeros(0, dtype=np.intc)  # the set-up's sense: equality rows flagged
         self._c: daqp_c.Workspace | None = None  # DAQP called from compiled code (daqp_c)
         self._c_args: tuple[Any, ...] | None = None  # solve_stacked's, but the mode and answers
-        self._warm_call: daqp_c.WarmCall | None = None  # compiled_warm's
+        self._warm_call: daqp_c.AttemptCall | None = None  # compiled_attempt's
 
     @classmethod
     def known_settings(cls) -> set[str]:
@@ -312,22 +312,26 @@ class DaqpBackend(StatefulBackend):
             )  # the set-up's own buffers: the compiled copy onto themselves changes nothing
         stage, flag, iterations, spent = out[:4]
         if stage != 2:
-            return self._stage_failure(problem, np.array(out))
+            return self._stage_failure(problem, out)
         return self._judge(problem, out[4:], x, lam, int(flag), int(iterations), spent)
 
-    def compiled_warm(self, problem: Problem) -> daqp_c.WarmCall | None:
-        """What compiled code needs to make this backend's next solve of ``problem`` (its warm
-        attempt) itself (:func:`solvers.daqp_c.solve_dropped`), or None if that solve would
-        not be a warm one on DAQP's C functions with the compiled copy (then ``solve``). The
-        same object while nothing changes; finish with :meth:`adopt_warm`."""
-        if self._c is None or not self._warm or problem is not self._bound or self._stack is None:
+    def compiled_attempt(self, problem: Problem) -> daqp_c.AttemptCall | None:
+        """What compiled code needs to make the first attempt of this backend's next solve of
+        ``problem`` itself (:func:`solvers.daqp_c.solve_dropped`): the warm one, or after a
+        refusal the cold restart in the kept set-up (its ``mode``), as :meth:`solve` would
+        make it; None if that attempt would not be made on DAQP's C functions with the
+        compiled copy (then ``solve``). The same object while nothing changes; finish with
+        :meth:`adopt_attempt`."""
+        if self._c is None or problem is not self._bound or self._stack is None:
             return None
-        if self._warm_call is None or self._warm_call.data is not self._data:
+        if not self._warm and self._structure is None:  # a new set-up: solve
+            return None
+        if self._warm_call is None:
             n, p, m, ms, flags = self._layout
             *given, data = self._stack[:9]
             arrays = [a if a.flags.writeable else np.zeros(a.shape) for a in given]  # packable
             work = self._c
-            self._warm_call = daqp_c.WarmCall(
+            self._warm_call = daqp_c.AttemptCall(
                 *arrays,
                 data,
                 work.handles,
@@ -337,29 +341,32 @@ class DaqpBackend(StatefulBackend):
                 m,
                 ms,
                 flags,
+                np.zeros(1, dtype=np.int64),
                 np.empty(n),
                 np.empty(ms + p + m),
-                np.empty(12),
             )
+        self._warm_call.mode[0] = daqp_c.WARM if self._warm else daqp_c.RESTART
         return self._warm_call
 
-    def adopt_warm(self, problem: Problem, start: float) -> Solution:
-        """Finish the solve of ``problem`` begun at ``start`` (``perf_counter``) whose warm
-        attempt compiled code made with :meth:`compiled_warm`'s arrays (its values in their
-        ``out``): the answer judged (copied: the buffers are the next attempt's) and, if
-        refused, solved again cold, as :meth:`solve` does."""
+    def adopt_attempt(self, problem: Problem, start: float, out: tuple[float, ...]) -> Solution:
+        """Finish the solve of ``problem`` begun at ``start`` (``perf_counter``) whose first
+        attempt compiled code made with :meth:`compiled_attempt`'s arrays (``out``: its
+        values, :func:`~solvers.daqp_c.stacked_solve`'s), as :meth:`solve` would: the answer
+        judged (copied: the buffers are the next attempt's) and, a warm one refused, solved
+        again cold."""
         call = self._warm_call
         assert call is not None
-        stage, flag, iterations, spent = call.out[:4]
+        stage, flag, iterations, spent = out[:4]
         if stage == 2:
-            values = tuple(float(v) for v in call.out[4:])
             x, lam = call.x.copy(), call.lam.copy()
-            solution = self._judge(problem, values, x, lam, int(flag), int(iterations), spent)
-        else:  # a misfit or a failed update: as the warm attempt in solve would say it
-            solution = solve_guarded(self, problem, self._stage_failure, problem, call.out)
+            solution = self._judge(problem, out[4:], x, lam, int(flag), int(iterations), spent)
+        else:  # a misfit or a failed update: as the attempt in solve would say it
+            solution = solve_guarded(self, problem, self._stage_failure, problem, out)
+        if call.mode[0] == daqp_c.RESTART:  # the cold attempt: its answer is the solve's
+            return self._settled(solution, start)
         return self.after_warm(problem, solution, start)
 
-    def _stage_failure(self, problem: Problem, out: np.ndarray) -> RawResult:
+    def _stage_failure(self, problem: Problem, out: Any) -> RawResult:
         stage, flag = out[:2]
         if stage == 0:
             self._fill(problem)  # NumPy names the misfit it sees

@@ -549,13 +549,14 @@ def solve_stacked(
 
 
 @dataclass(frozen=True)
-class WarmCall:
-    """What a warm solve in compiled code needs (:func:`solve_dropped`): the bound problem's
-    arrays (``P`` .. ``ub``, absent blocks as empty arrays), the set-up's ``data``,
-    ``handles`` and ``words``, its sizes and ``flags`` (:func:`stacked_solve`'s), and buffers
-    for the answer ``x`` (n,), ``lam`` (ms + p + m,) and :func:`stacked_solve`'s values
-    ``out`` (12,). Valid while its backend keeps the set-up and the problem it was made for
-    (:meth:`solvers.daqp_.DaqpBackend.compiled_warm`)."""
+class AttemptCall:
+    """What a solve's first attempt in compiled code needs (:func:`solve_dropped`): the bound
+    problem's arrays (``P`` .. ``ub``, absent blocks as empty arrays), the set-up's ``data``,
+    ``handles`` and ``words``, its sizes and ``flags`` (:func:`stacked_solve`'s), the
+    attempt's ``mode`` ((1,): :data:`WARM` or :data:`RESTART`), and buffers for the answer
+    ``x`` (n,) and ``lam`` (ms + p + m,). Valid
+    while its backend keeps the set-up and the problem it was made for
+    (:meth:`solvers.daqp_.DaqpBackend.compiled_attempt`)."""
 
     P: np.ndarray
     q: np.ndarray
@@ -573,25 +574,25 @@ class WarmCall:
     m: int
     ms: int
     flags: int
+    mode: np.ndarray
     x: np.ndarray
     lam: np.ndarray
-    out: np.ndarray
 
 
 @njit
 def solve_dropped(w):  # type: ignore[no-untyped-def]
-    """A :class:`~solvers.rows.RowDropping` solve over DAQP's C functions, in compiled code:
-    ``w`` is its :class:`~solvers.rows.WarmRows` packed into one struct (its ``call`` a packed
-    :class:`WarmCall`). Drops the rows (:func:`~solvers.rows.compact`) and, unless the copy's
-    capacity would change, makes the warm attempt (:func:`stacked_solve`).
+    """A :class:`~solvers.rows.RowDropping` solve's first attempt over DAQP's C functions, in
+    compiled code: ``w`` is its :class:`~solvers.rows.AttemptRows` packed into one struct (its
+    ``call`` a packed :class:`AttemptCall`). Drops the rows (:func:`~solvers.rows.compact`)
+    and, unless the copy's capacity would change, makes the attempt (:func:`stacked_solve`, in
+    the call's ``mode``: warm, or the cold restart after a refusal).
 
     Returns
     -------
     tuple of 12 floats
-        :func:`stacked_solve`'s values (also written to ``w.call.out``, where the backend's
-        ``adopt_warm`` finishes a refused attempt), or stage −1 when the capacity would change
-        (nothing solved: the backend's ``solve`` takes it from there, the rows dropped again
-        to the same slots).
+        :func:`stacked_solve`'s values (the backend's ``adopt_attempt`` finishes an attempt
+        from them), or stage −1 when the capacity would change (nothing solved: the backend's
+        ``solve`` takes it from there, the rows dropped again to the same slots).
     """
     used = compact(w.G, w.h, w.slot_of, w.row_of, w.Gc, w.hc)
     if resized(used, w.capacity, w.hc.shape[0]) != w.capacity:
@@ -614,10 +615,8 @@ def solve_dropped(w):  # type: ignore[no-untyped-def]
         c.m,
         c.ms,
         c.flags,
-        WARM,
+        c.mode[0],
         c.x,
         c.lam,
     )
-    for i in range(c.out.shape[0]):
-        c.out[i] = out[i]
     return out

@@ -76,11 +76,11 @@ def resized(used: int, capacity: int, rows: int) -> int:
 
 
 @dataclass(frozen=True)
-class WarmRows:
+class AttemptRows:
     """What compiled code needs to make a :class:`RowDropping`'s next solve itself: the given
     problem's ``G``, ``h``, the copy's slots (``slot_of``, ``row_of``), its full-size ``Gc``,
     ``hc``, its ``capacity`` and the inner backend's warm call on the copy at that capacity
-    (``call``, e.g. :class:`solvers.daqp_c.WarmCall`)."""
+    (``call``, e.g. :class:`solvers.daqp_c.AttemptCall`)."""
 
     G: np.ndarray
     h: np.ndarray
@@ -124,7 +124,7 @@ class RowDropping:
         self.inner = inner
         self.name, self.tolerance = inner.name, inner.tolerance
         self._copy: _Copy | None = None
-        self._warm: WarmRows | None = None  # compiled_warm's
+        self._warm: AttemptRows | None = None  # compiled_attempt's
 
     def reset(self) -> None:
         """Drop the inner backend's warm start and the copy's slots."""
@@ -148,14 +148,14 @@ class RowDropping:
         used = compact(problem.G, problem.h, copy.slot_of, copy.row_of, copy.G, copy.h)
         return self._spread(problem, copy, self.inner.solve(copy.sized(used), initvals))
 
-    def compiled_warm(self, problem: Problem) -> WarmRows | None:
+    def compiled_attempt(self, problem: Problem) -> AttemptRows | None:
         """What compiled code needs to make the next solve of ``problem`` itself, its rows
         dropped and the inner backend's warm attempt on them (e.g.
         :func:`solvers.daqp_c.solve_dropped`), or None if the inner backend cannot be called so
-        now (no ``compiled_warm`` of its own, or it says None). The same object while nothing
-        changes; finish with :meth:`adopt_warm`. Compiled code must take the path of
+        now (no ``compiled_attempt`` of its own, or it says None). The same object while nothing
+        changes; finish with :meth:`adopt_attempt`. Compiled code must take the path of
         :meth:`solve` instead when the capacity would change (:func:`resized`)."""
-        copy, warm = self._copy, getattr(self.inner, "compiled_warm", None)
+        copy, warm = self._copy, getattr(self.inner, "compiled_attempt", None)
         if warm is None or copy is None or copy.source is not problem or copy.problem is None:
             return None
         call = warm(copy.problem)
@@ -164,16 +164,16 @@ class RowDropping:
         if self._warm is None or self._warm.call is not call:
             G, h = problem.G, problem.h
             c = copy.capacity
-            self._warm = WarmRows(G, h, copy.slot_of, copy.row_of, copy.G, copy.h, c, call)
+            self._warm = AttemptRows(G, h, copy.slot_of, copy.row_of, copy.G, copy.h, c, call)
         return self._warm
 
-    def adopt_warm(self, problem: Problem, start: float) -> Solution:
+    def adopt_attempt(self, problem: Problem, start: float, out: tuple[float, ...]) -> Solution:
         """Finish the solve of ``problem`` begun at ``start`` (``perf_counter``) that compiled
-        code made with :meth:`compiled_warm`'s arrays (the rows dropped, the inner backend's
+        code made with :meth:`compiled_attempt`'s arrays (the rows dropped, the inner backend's
         warm attempt): as :meth:`solve` would."""
         copy = self._copy
         assert copy is not None and copy.problem is not None
-        return self._spread(problem, copy, self.inner.adopt_warm(copy.problem, start))
+        return self._spread(problem, copy, self.inner.adopt_attempt(copy.problem, start, out))
 
     def _spread(self, problem: Problem, copy: _Copy, solution: Solution) -> Solution:
         """The solution of the compact copy as ``problem``'s: ``z`` spread to its rows."""

@@ -276,9 +276,35 @@ def _verdict(solution: Solution, values: tuple[float, ...]) -> Solution:
         solution.y = solution.z = solution.z_box = None
         solution.message = f"{solution.backend} said {solution.status!r} but x is not finite"
         return solution
-    failed = failed_checks(solution.residuals, tolerance, scale)
-    solution.message = f"{solution.backend} said {solution.status!r} but {', '.join(failed)}"
+    solution.message = _Unmet(tolerance, scale)  # type: ignore[assignment]
     return solution
+
+
+@dataclass(frozen=True)
+class _Unmet:
+    """A refused answer's message, formatted when it is read (a refusal is a step's common
+    case on some scenes, its message seldom read): the checks its residuals failed."""
+
+    tolerance: float
+    scale: float
+
+
+def _message(solution: Solution) -> str:
+    text = solution.__dict__.get("_message", "")
+    if isinstance(text, _Unmet):
+        assert solution.residuals is not None
+        failed = failed_checks(solution.residuals, text.tolerance, text.scale)
+        text = f"{solution.backend} said {solution.status!r} but {', '.join(failed)}"
+        solution.__dict__["_message"] = text
+    return text  # type: ignore[no-any-return]
+
+
+def _set_message(solution: Solution, text: str) -> None:
+    solution.__dict__["_message"] = text
+
+
+Solution.message = property(_message, _set_message)  # type: ignore[assignment]
+"""Why the solution was rejected; empty when ``found`` (a refusal's is formatted when read)."""
 
 
 def judged(

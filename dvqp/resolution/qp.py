@@ -44,7 +44,7 @@ from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 from dvqp.workspace import QPBuffers, as_struct
 from solvers.accuracy import AccuracyTally, metrics_of
-from solvers.daqp_c import solve_dropped
+from solvers.daqp_c import WARM, solve_dropped
 from solvers.residuals import passing
 
 #: A watcher of the backend calls: ``(kind, problem, solution)``, kind ``"strict"``,
@@ -178,7 +178,7 @@ class QPSolver:
         the strict problem's, or the relaxed one's when the strict one had no accepted answer
         (an infeasible strict problem has no optimum to be accurate about: its refusal is
         counted in :attr:`refusals`); a step with neither counts at the check's tolerance."""
-        self._packs: dict[int, tuple[Any, Any]] = {}  # per backend: compiled_warm, packed
+        self._packs: dict[int, tuple[Any, Any]] = {}  # per backend: compiled_attempt, packed
         self.watchers: list[Watcher] = []
         """Called after every backend call with ``("strict" | "scaled" | "relaxed", problem,
         solution)``;
@@ -228,29 +228,30 @@ class QPSolver:
         ``"relaxed"``), counted: a :class:`solvers.Solution`, or :class:`Taken`.
 
         A backend that can make its next solve's warm attempt in compiled code says so
-        (``compiled_warm``: :class:`solvers.rows.RowDropping` over DAQP's C functions,
+        (``compiled_attempt``: :class:`solvers.rows.RowDropping` over DAQP's C functions,
         :func:`solvers.daqp_c.solve_dropped`). Then that attempt is one compiled call, and an
         answer that passes the residual check (:func:`solvers.residuals.passing`, the check of
         every solve) is taken without a :class:`solvers.Solution`; a refused one is finished by
-        the backend as its ``solve`` would (``adopt_warm``: the cold retry). Watchers see every
+        the backend as its ``solve`` would (``adopt_attempt``: the cold retry). Watchers see every
         call's problem and solution: with them, ``solve``."""
         start = perf_counter()
-        warm = None if self.watchers else getattr(backend, "compiled_warm", None)
+        warm = None if self.watchers else getattr(backend, "compiled_attempt", None)
         rows = None if warm is None else warm(problem)
         out = (-1.0,) if rows is None else solve_dropped(self._packed(backend, rows))
         if out[0] < 0:  # not made there
             solution = backend.solve(problem)
         else:
-            residuals = passing(out[4:], backend.tolerance) if out[0] == 2 else None
+            warm = out[0] == 2 and rows.call.mode[0] == WARM  # a restart's: the backend's
+            residuals = passing(out[4:], backend.tolerance) if warm else None
             if residuals is not None:
                 self.accuracy.add_metrics(metrics_of(residuals), backend.tolerance)
                 return Taken(rows.call.x, int(out[2]), out[3])
-            solution = backend.adopt_warm(problem, start)  # type: ignore[attr-defined]
+            solution = backend.adopt_attempt(problem, start, out)  # type: ignore[attr-defined]
         self._count(kind, problem, solution)
         return solution
 
     def _packed(self, backend: solvers.Backend, rows: Any) -> Any:
-        """``rows`` (a backend's ``compiled_warm``) packed into one struct, kept while the
+        """``rows`` (a backend's ``compiled_attempt``) packed into one struct, kept while the
         backend hands the same object."""
         kept = self._packs.get(id(backend))
         if kept is None or kept[0] is not rows:

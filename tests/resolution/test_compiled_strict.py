@@ -1,5 +1,5 @@
 """The strict QP's warm attempt made inside compiled code (``QPSolver._strict_solve`` with
-``RowDropping.compiled_warm`` over DAQP's C functions) against the backend's own ``solve``.
+``RowDropping.compiled_attempt`` over DAQP's C functions) against the backend's own ``solve``.
 
 A run whose steps take that path must be the very run whose steps call ``solve`` (a watcher
 of the backend calls turns the path off): the same joint motion bit for bit, the same

@@ -127,3 +127,20 @@ def test_an_answer_without_multipliers_is_not_trusted() -> None:
     assert with_duals.found
     without = Solution.checked(case.problem, case.x, backend="t", tolerance=1e-8, status="solved")
     assert not without.found and "no multipliers" in without.message
+
+
+def test_a_refusals_message_is_the_same_however_it_travels(case: KktCase) -> None:
+    """Formatted when read (solvers.solution._Unmet): the same text read at once, after a
+    pickle round trip, through ``dataclasses.replace``, and set by hand."""
+    import dataclasses
+    import pickle
+
+    x = case.x + 1e-3 * np.random.default_rng(1).standard_normal(case.x.size)
+    fresh, kept = check(case, x), check(case, x)
+    travelled = pickle.loads(pickle.dumps(kept))
+    text = fresh.message
+    assert text.startswith("fake said 'solved' but equality residual ")
+    assert travelled.message == text
+    assert dataclasses.replace(kept).message == text == kept.message
+    kept.message = "mine"
+    assert kept.message == "mine" and repr(kept).count("mine") == 1
