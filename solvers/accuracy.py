@@ -48,7 +48,21 @@ def metrics_of(res: Residuals | None) -> tuple[float, float, float] | None:
     """``(r_p, r_d, r_g)`` of an accepted answer's residuals; None without a multiplier."""
     if res is None or res.stationarity is None or res.duality_gap is None:
         return None
-    return max(res.equality, res.inequality, res.bounds), res.stationarity, res.duality_gap
+    return _metrics(res.equality, res.inequality, res.bounds, res.stationarity, res.duality_gap)
+
+
+def kernel_metrics(values: tuple[float, ...]) -> tuple[float, float, float]:
+    """``(r_p, r_d, r_g)`` of the kernel ``values`` of an answer that passed the check
+    (:func:`solvers.residuals.accepts`: it has every multiplier)."""
+    _, equality, inequality, bounds, stationarity, _, _, gap = values
+    return _metrics(equality, inequality, bounds, stationarity, gap)
+
+
+def _metrics(
+    equality: float, inequality: float, bounds: float, stationarity: float, gap: float
+) -> tuple[float, float, float]:
+    """qpbenchmark's primal residual, dual residual and duality gap."""
+    return max(equality, inequality, bounds), stationarity, gap
 
 
 def shifted_geometric_mean(values: np.ndarray | list[float], shift: float = SHIFT) -> float:

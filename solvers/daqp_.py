@@ -311,7 +311,7 @@ class DaqpBackend(StatefulBackend):
                 lam,
             )  # the set-up's own buffers: the compiled copy onto themselves changes nothing
         stage, flag, iterations, spent = out[:4]
-        if stage != 2:
+        if stage != daqp_c.SOLVED:
             return self._stage_failure(problem, out)
         return self._judge(problem, out[4:], x, lam, int(flag), int(iterations), spent)
 
@@ -342,6 +342,7 @@ class DaqpBackend(StatefulBackend):
                 ms,
                 flags,
                 np.zeros(1, dtype=np.int64),
+                self.tolerance,
                 np.empty(n),
                 np.empty(ms + p + m),
             )
@@ -357,7 +358,7 @@ class DaqpBackend(StatefulBackend):
         call = self._warm_call
         assert call is not None
         stage, flag, iterations, spent = out[:4]
-        if stage == 2:
+        if stage >= daqp_c.SOLVED:  # checked or not, judged as solve judges it
             x, lam = call.x.copy(), call.lam.copy()
             solution = self._judge(problem, out[4:], x, lam, int(flag), int(iterations), spent)
         else:  # a misfit or a failed update: as the attempt in solve would say it
@@ -368,7 +369,7 @@ class DaqpBackend(StatefulBackend):
 
     def _stage_failure(self, problem: Problem, out: Any) -> RawResult:
         stage, flag = out[:2]
-        if stage == 0:
+        if stage == daqp_c.MISFITTED:
             self._fill(problem)  # NumPy names the misfit it sees
             raise ValueError("the problem's arrays do not fit the set-up's sizes")
         return RawResult(None, f"update failed: {EXIT_FLAGS.get(int(flag), int(flag))}")

@@ -33,6 +33,7 @@ from numba.core.extending import intrinsic
 from ._fast import stack_into
 from ._kkt import MISFITTING, _readonly, stacked_values
 from .jit import compiled_on_first_call, njit
+from .residuals import accepts
 from .rows import compact, resized
 
 KNOWN_VERSIONS = ("0.11.0",)
@@ -161,6 +162,8 @@ _QP_SENSE = ProblemData.sense.offset // 8
 _RES_X, _RES_LAM = Result.x.offset // 8, Result.lam.offset // 8
 _RES_FLAG, _RES_ITER = Result.exitflag.offset // 4, Result.iter.offset // 4
 _RES_WORDS = ctypes.sizeof(Result) // 8
+MISFITTED, UPDATE_FAILED, SOLVED, ACCEPTED = 0.0, 1.0, 2.0, 3.0
+"""Stages of :func:`stacked_solve`'s values (and :func:`solve_dropped`'s: ``ACCEPTED``)."""
 H_UPDATE, H_SOLVE, H_CLOCK, H_WORK, H_PROBLEM, H_RESULT, H_SENSE = range(7)
 """Slots of a :class:`Workspace`'s ``handles`` (int64): the addresses of ``daqp_update_ldp``,
 ``daqp_solve`` and the C library's ``clock_gettime``, of the workspace, the ``DAQPProblem``,
@@ -435,7 +438,7 @@ _VEC_IN = types.Array(types.float64, 1, "C", readonly=True)
 _MAT_IN = types.Array(types.float64, 2, "C", readonly=True)
 _VEC_OUT = types.Array(types.float64, 1, "C")
 _WORDS = types.Array(types.int64, 1, "C")
-SOLVED = types.UniTuple(types.float64, 12)
+_VALUES = types.UniTuple(types.float64, 12)
 
 
 @njit(separate=True)
@@ -471,18 +474,19 @@ def stacked_solve(
     Returns
     -------
     tuple of 12 floats
-        ``(stage, flag, iterations, seconds, *values)``: stage 0 a size misfits (nothing
-        done), 1 the update failed (``flag`` its exit flag), 2 solved (``flag`` DAQP's exit
-        flag); ``seconds`` inside DAQP's update and solve; ``values`` those of
+        ``(stage, flag, iterations, seconds, *values)``: stage :data:`MISFITTED` a size
+        misfits (nothing done), :data:`UPDATE_FAILED` (``flag`` its exit flag), or
+        :data:`SOLVED` (``flag`` DAQP's exit flag); ``seconds`` inside DAQP's update and
+        solve; ``values`` those of
         :func:`solvers._kkt.stacked` (NaN unless solved).
     """
     nan = math.nan
     rows = ms + p + m
     if x.shape[0] != n or lam.shape[0] != rows:
-        return (0.0, nan, nan, 0.0, *MISFITTING)
+        return (MISFITTED, nan, nan, 0.0, *MISFITTING)
     changed = 0 if mode & AS_SET_UP else stack_into(P, q, A, b, G, h, lb, ub, data, n, p, m, ms)
     if changed < 0:
-        return (0.0, nan, nan, 0.0, *MISFITTING)
+        return (MISFITTED, nan, nan, 0.0, *MISFITTING)
     work, problem, result = handles[H_WORK], handles[H_PROBLEM], handles[H_RESULT]
     started = _now(handles[H_CLOCK])
     if not mode & AS_SET_UP:
@@ -494,7 +498,7 @@ def stacked_solve(
         flag = _update_ldp(handles[H_UPDATE], mask, work, problem)
         if flag < 0:
             spent = _now(handles[H_CLOCK]) - started
-            return (1.0, float(flag), nan, spent, *MISFITTING)
+            return (UPDATE_FAILED, float(flag), nan, spent, *MISFITTING)
     base = words.shape[0] - _RES_WORDS  # the DAQPResult, after the DAQPProblem
     for i in range(_RES_WORDS):
         words[base + i] = 0
@@ -505,11 +509,11 @@ def stacked_solve(
     ints = words[base:].view(np.int32)
     exitflag, iterations = ints[_RES_FLAG], ints[_RES_ITER]
     values = stacked_values(data, x, lam, n, p, m, ms, flags)
-    return (2.0, float(exitflag), float(iterations), spent, *values)
+    return (SOLVED, float(exitflag), float(iterations), spent, *values)
 
 
 @compiled_on_first_call(
-    SOLVED(
+    _VALUES(
         *(_MAT_IN, _VEC_IN) * 3,
         _VEC_IN,
         _VEC_IN,
@@ -553,7 +557,8 @@ class AttemptCall:
     """What a solve's first attempt in compiled code needs (:func:`solve_dropped`): the bound
     problem's arrays (``P`` .. ``ub``, absent blocks as empty arrays), the set-up's ``data``,
     ``handles`` and ``words``, its sizes and ``flags`` (:func:`stacked_solve`'s), the
-    attempt's ``mode`` ((1,): :data:`WARM` or :data:`RESTART`), and buffers for the answer
+    attempt's ``mode`` ((1,): :data:`WARM` or :data:`RESTART`), the check's ``tolerance``
+    (:func:`solvers.residuals.accepts`), and buffers for the answer
     ``x`` (n,) and ``lam`` (ms + p + m,). Valid
     while its backend keeps the set-up and the problem it was made for
     (:meth:`solvers.daqp_.DaqpBackend.compiled_attempt`)."""
@@ -575,6 +580,7 @@ class AttemptCall:
     ms: int
     flags: int
     mode: np.ndarray
+    tolerance: float
     x: np.ndarray
     lam: np.ndarray
 
@@ -591,8 +597,10 @@ def solve_dropped(w):  # type: ignore[no-untyped-def]
     -------
     tuple of 12 floats
         :func:`stacked_solve`'s values (the backend's ``adopt_attempt`` finishes an attempt
-        from them), or stage −1 when the capacity would change (nothing solved: the backend's
-        ``solve`` takes it from there, the rows dropped again to the same slots).
+        from them), their stage :data:`ACCEPTED` when the answer passes the residual check
+        (:func:`solvers.residuals.accepts`, at the call's ``tolerance``), or stage −1 when the
+        capacity would change (nothing solved: the backend's ``solve`` takes it from there, the
+        rows dropped again to the same slots).
     """
     used = compact(w.G, w.h, w.slot_of, w.row_of, w.Gc, w.hc)
     if resized(used, w.capacity, w.hc.shape[0]) != w.capacity:
@@ -619,4 +627,6 @@ def solve_dropped(w):  # type: ignore[no-untyped-def]
         c.x,
         c.lam,
     )
+    if out[0] == SOLVED and accepts(out[4:], c.tolerance):
+        return (ACCEPTED, *out[1:])
     return out

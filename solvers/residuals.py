@@ -22,6 +22,7 @@ import numpy.typing as npt
 
 from ._kkt import DUALS, FINITE
 from .exceptions import ProblemShapeError
+from .jit import njit
 from .kkt import evaluate
 from .problem import Problem
 
@@ -186,24 +187,37 @@ ACCEPTABLE = FINITE | DUALS
 _new = object.__new__
 
 
-def passing(values: tuple[float, ...], tolerance: float) -> Residuals | None:
-    """The residuals in kernel ``values`` if they pass every check, else None.
+@njit
+def accepts(values: tuple[float, ...], tolerance: float) -> bool:
+    """Whether kernel ``values`` pass every check.
 
     ``values`` are :func:`solvers.kkt.evaluate`'s (or :func:`solvers._kkt.stacked`'s):
     they pass when ``x`` is finite, every needed multiplier was given, and every residual
-    is within its tolerance (as :func:`failed_checks` has it); a NaN never passes.
+    is within its tolerance (as :func:`failed_checks` has it); a NaN never passes. One rule,
+    run by Python (:func:`passing`, the function itself) and by compiled code
+    (:func:`solvers.daqp_c.solve_dropped`).
     """
-    code, equality, inequality, bounds, stationarity, complementarity, scale, gap = values
+    code, equality, inequality, bounds, stationarity, complementarity, scale, _ = values
     dual_tol = tolerance * (1.0 + scale)
-    if not (
+    return (
         code == ACCEPTABLE
         and equality <= tolerance
         and inequality <= tolerance
         and bounds <= tolerance
         and stationarity <= dual_tol
         and complementarity <= dual_tol
-    ):
+    )
+
+
+_accepts = accepts.py_func  # the same rule, run by Python: no compiled call
+
+
+def passing(values: tuple[float, ...], tolerance: float) -> Residuals | None:
+    """The residuals in kernel ``values`` if they pass every check (:func:`accepts`), else
+    None."""
+    if not _accepts(values, tolerance):
         return None
+    _, equality, inequality, bounds, stationarity, complementarity, _, gap = values
     return filled(equality, inequality, bounds, stationarity, complementarity, gap)
 
 

@@ -43,9 +43,8 @@ from dvqp.resolution.levels import Levels, load_relaxed, relaxed_problem, strict
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 from dvqp.workspace import QPBuffers, as_struct
-from solvers.accuracy import AccuracyTally, metrics_of
-from solvers.daqp_c import WARM, solve_dropped
-from solvers.residuals import passing
+from solvers.accuracy import AccuracyTally, kernel_metrics
+from solvers.daqp_c import ACCEPTED, WARM, solve_dropped
 
 #: A watcher of the backend calls: ``(kind, problem, solution)``, kind ``"strict"``,
 #: ``"scaled"`` or ``"relaxed"``.
@@ -230,10 +229,11 @@ class QPSolver:
         A backend that can make its next solve's warm attempt in compiled code says so
         (``compiled_attempt``: :class:`solvers.rows.RowDropping` over DAQP's C functions,
         :func:`solvers.daqp_c.solve_dropped`). Then that attempt is one compiled call, and an
-        answer that passes the residual check (:func:`solvers.residuals.passing`, the check of
-        every solve) is taken without a :class:`solvers.Solution`; a refused one is finished by
-        the backend as its ``solve`` would (``adopt_attempt``: the cold retry). Watchers see every
-        call's problem and solution: with them, ``solve``."""
+        answer that passes the residual check there (:func:`solvers.residuals.accepts`, the
+        check of every solve) is taken without a :class:`solvers.Solution`; any other is
+        finished by the backend as its ``solve`` would (``adopt_attempt``: judged, and a
+        refused warm answer retried cold). Watchers see every call's problem and solution:
+        with them, ``solve``."""
         start = perf_counter()
         warm = None if self.watchers else getattr(backend, "compiled_attempt", None)
         rows = None if warm is None else warm(problem)
@@ -241,10 +241,8 @@ class QPSolver:
         if out[0] < 0:  # not made there
             solution = backend.solve(problem)
         else:
-            warm = out[0] == 2 and rows.call.mode[0] == WARM  # a restart's: the backend's
-            residuals = passing(out[4:], backend.tolerance) if warm else None
-            if residuals is not None:
-                self.accuracy.add_metrics(metrics_of(residuals), backend.tolerance)
+            if out[0] == ACCEPTED and rows.call.mode[0] == WARM:  # a restart's: the backend's
+                self.accuracy.add_metrics(kernel_metrics(out[4:]), backend.tolerance)
                 return Taken(rows.call.x, int(out[2]), out[3])
             solution = backend.adopt_attempt(problem, start, out)  # type: ignore[attr-defined]
         self._count(kind, problem, solution)
