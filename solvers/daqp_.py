@@ -151,6 +151,17 @@ class DaqpBackend(StatefulBackend):
             *self._layout[:4],
         )
 
+    def _fit(self, problem: Problem) -> None:
+        """Refuse arrays whose shapes misfit ``problem``'s sizes (NumPy would broadcast them
+        into the buffers), as the compiled copy refuses them."""
+        n, p, m, ms = self._n, self._p, self._m, self._ms
+        wanted = {"P": (n, n), "q": (n,), "A": (m, n), "b": (m,), "G": (p, n), "h": (p,)}
+        wanted.update(lb=(ms,), ub=(ms,))
+        for name, shape in wanted.items():
+            array = getattr(problem, name)
+            if array is not None and array.shape != shape:
+                raise ValueError("the problem's arrays do not fit the set-up's sizes")
+
     def _fill(self, problem: Problem) -> None:
         """Copy ``q``, ``G``, ``h``, ``A``, ``b``, ``lb``, ``ub`` into the set-up's buffers."""
         ms, p = self._ms, self._p
@@ -182,6 +193,7 @@ class DaqpBackend(StatefulBackend):
         self._upper[:], self._lower[:] = np.inf, -np.inf
         self._bound = None
         if daqp_c.available():  # copied with NumPy: the solves' compiled call copies, not stack
+            self._fit(problem)
             self._fill(problem)
             self._H[:] = problem.P  # DAQP's, and the reference that tells P changed
         else:
@@ -276,9 +288,9 @@ class DaqpBackend(StatefulBackend):
         if problem is not self._bound:
             self._bind(problem)
         n, p, m, ms, flags = self._layout
-        x, lam = np.empty(n), np.empty(ms + p + m)
         work = self._c
         assert work is not None
+        x, lam = work.x, work.lam  # kept from solve to solve, as daqp.Model's (see Workspace)
         if self._stack is not None:
             if self._c_args is None:
                 self._c_args = (*self._stack[:9], work.handles, work.words, *self._layout)
@@ -313,27 +325,31 @@ class DaqpBackend(StatefulBackend):
         stage, flag, iterations, spent = out[:4]
         if stage != daqp_c.SOLVED:
             return self._stage_failure(problem, out)
+        # copies, as Model.solve returns them: the solution keeps them uncopied
+        x, lam = x.copy(), lam.copy()
         return self._judge(problem, out[4:], x, lam, int(flag), int(iterations), spent)
 
-    def compiled_attempt(self, problem: Problem) -> daqp_c.AttemptCall | None:
+    def compiled_call(self, problem: Problem) -> daqp_c.AttemptCall | None:
         """What compiled code needs to make the first attempt of this backend's next solve of
-        ``problem`` itself (:func:`solvers.daqp_c.solve_dropped`): the warm one, or after a
-        refusal the cold restart in the kept set-up (its ``mode``), as :meth:`solve` would
-        make it; None if that attempt would not be made on DAQP's C functions with the
-        compiled copy (then ``solve``). The same object while nothing changes; finish with
-        :meth:`adopt_attempt`."""
+        ``problem`` itself (for :meth:`solvers.rows.RowDropping.compiled_attempt`): the warm
+        one, or after a refusal the cold restart in the kept set-up (its ``mode``), as
+        :meth:`solve` would make it; None if that attempt would not be made on DAQP's C
+        functions with the compiled copy, or the problem's arrays cannot be packed into one
+        struct (a read-only one: a validated problem's). The same object while nothing
+        changes; finish with :meth:`adopt_call`."""
         if self._c is None or problem is not self._bound or self._stack is None:
             return None
         if not self._warm and self._structure is None:  # a new set-up: solve
             return None
         if self._warm_call is None:
+            given = self._stack[:8]
+            if not all(a.flags.writeable or a.size == 0 for a in given):
+                return None
             n, p, m, ms, flags = self._layout
-            *given, data = self._stack[:9]
-            arrays = [a if a.flags.writeable else np.zeros(a.shape) for a in given]  # packable
             work = self._c
             self._warm_call = daqp_c.AttemptCall(
-                *arrays,
-                data,
+                *(a if a.flags.writeable else np.zeros(a.shape) for a in given),  # placeholders
+                self._data,
                 work.handles,
                 work.words,
                 n,
@@ -343,15 +359,15 @@ class DaqpBackend(StatefulBackend):
                 flags,
                 np.zeros(1, dtype=np.int64),
                 self.tolerance,
-                np.empty(n),
-                np.empty(ms + p + m),
+                work.x,
+                work.lam,
             )
         self._warm_call.mode[0] = daqp_c.WARM if self._warm else daqp_c.RESTART
         return self._warm_call
 
-    def adopt_attempt(self, problem: Problem, start: float, out: tuple[float, ...]) -> Solution:
+    def adopt_call(self, problem: Problem, start: float, out: tuple[float, ...]) -> Solution:
         """Finish the solve of ``problem`` begun at ``start`` (``perf_counter``) whose first
-        attempt compiled code made with :meth:`compiled_attempt`'s arrays (``out``: its
+        attempt compiled code made with :meth:`compiled_call`'s arrays (``out``: its
         values, :func:`~solvers.daqp_c.stacked_solve`'s), as :meth:`solve` would: the answer
         judged (copied: the buffers are the next attempt's) and, a warm one refused, solved
         again cold."""

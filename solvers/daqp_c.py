@@ -265,6 +265,10 @@ class Workspace:
 
     Attributes
     ----------
+    x, lam : ndarray
+        (n,), (ms + rows,): where every solve writes its answer, zeros at first and kept from
+        solve to solve, as ``daqp.Model``'s: DAQP leaves them as they were when it has no
+        answer (exit flag <= 0).
     words : ndarray of int64
         The ``DAQPProblem`` and then the ``DAQPResult`` :func:`solve_stacked` writes.
     flag : int
@@ -289,6 +293,7 @@ class Workspace:
             raise LayoutError(f"daqp {importlib.metadata.version('daqp')} is not mirrored here")
         lib = _library()
         self._kept = [H, f, M, upper, lower, sense]
+        self.x, self.lam = np.zeros(f.shape[0]), np.zeros(upper.shape[0])
         given = sense.copy() if primal_start is not None else sense  # DAQP marks the start's
         self.words = np.zeros(ctypes.sizeof(ProblemData) // 8 + _RES_WORDS, dtype=np.int64)
         p = self.problem = ProblemData.from_buffer(self.words)
@@ -306,10 +311,12 @@ class Workspace:
             lib.daqp_primal_init_active(ctypes.byref(p), start.ctypes.data_as(_c_float_p))
         setup_time = ctypes.c_double(0.0)
         kept = Settings.from_buffer_copy(head.settings.contents)
+        given_settings = ctypes.cast(head.settings, ctypes.c_void_p).value
         self.flag = int(
             lib.setup_daqp_main(ctypes.byref(p), self._work, ctypes.byref(setup_time), 0)
         )
-        if self.flag < 0:  # DAQP freed its settings: as daqp.Model, allocate them again
+        if self.flag < 0:  # DAQP let go of the settings it was given (not freed: daqp.Model
+            _libc().free(given_settings)  # leaks them), then as daqp.Model allocate them again
             lib.allocate_daqp_settings(self._work)
         ctypes.memmove(head.settings, ctypes.byref(kept), ctypes.sizeof(Settings))
         if self.flag < 0:
@@ -345,8 +352,10 @@ class Workspace:
         if np.flatnonzero(words).tolist() != [WorkspaceHead.settings.offset // 8]:
             self._mismatch("the settings are not where expected")
         head = WorkspaceHead.from_address(self._work)
+        kinds = dict(Settings._fields_)
         for key, value in settings.items():
-            setattr(head.settings.contents, key, value)
+            whole = kinds[key] is ctypes.c_int and isinstance(value, float) and value.is_integer()
+            setattr(head.settings.contents, key, int(value) if whole else value)  # as Cython
         return head
 
     def _mismatch(self, why: str) -> None:
@@ -355,9 +364,18 @@ class Workspace:
         self.close()
         raise LayoutError(f"DAQP's workspace is laid out otherwise: {why}")
 
+    def __copy__(self) -> Workspace:
+        raise TypeError("a DAQP workspace cannot be copied (it owns DAQP's memory)")
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> Workspace:
+        raise TypeError("a DAQP workspace cannot be copied (it owns DAQP's memory)")
+
+    def __reduce__(self) -> Any:
+        raise TypeError("a DAQP workspace cannot be pickled (it owns DAQP's memory)")
+
     def close(self) -> None:
         """Free DAQP's memory (as ``daqp.Model``'s deallocation does); idempotent."""
-        if self._work:
+        if getattr(self, "_work", None):
             free_workspace, free_ldp, free = self._frees
             free_workspace(self._work)
             free_ldp(self._work)

@@ -152,17 +152,20 @@ class RowDropping:
         """What compiled code needs to make the next solve of ``problem`` itself, its rows
         dropped and the inner backend's warm attempt on them (e.g.
         :func:`solvers.daqp_c.solve_dropped`), or None if the inner backend cannot be called so
-        now (no ``compiled_attempt`` of its own, or it says None). The same object while nothing
+        now (no ``compiled_call`` of its own, or it says None) or the problem's ``G``, ``h``
+        cannot be packed into a struct (read-only, not C-contiguous). The same object while nothing
         changes; finish with :meth:`adopt_attempt`. Compiled code must take the path of
         :meth:`solve` instead when the capacity would change (:func:`resized`)."""
-        copy, warm = self._copy, getattr(self.inner, "compiled_attempt", None)
-        if warm is None or copy is None or copy.source is not problem or copy.problem is None:
+        copy, inner = self._copy, getattr(self.inner, "compiled_call", None)
+        if inner is None or copy is None or copy.source is not problem or copy.problem is None:
             return None
-        call = warm(copy.problem)
+        G, h = problem.G, problem.h
+        if not (G.flags.writeable and h.flags.writeable and G.flags.c_contiguous):  # type: ignore[union-attr]
+            return None  # not packable into a struct: solve
+        call = inner(copy.problem)
         if call is None:
             return None
         if self._warm is None or self._warm.call is not call:
-            G, h = problem.G, problem.h
             c = copy.capacity
             self._warm = AttemptRows(G, h, copy.slot_of, copy.row_of, copy.G, copy.h, c, call)
         return self._warm
@@ -173,7 +176,8 @@ class RowDropping:
         warm attempt): as :meth:`solve` would."""
         copy = self._copy
         assert copy is not None and copy.problem is not None
-        return self._spread(problem, copy, self.inner.adopt_attempt(copy.problem, start, out))
+        finish = self.inner.adopt_call  # type: ignore[attr-defined]
+        return self._spread(problem, copy, finish(copy.problem, start, out))
 
     def _spread(self, problem: Problem, copy: _Copy, solution: Solution) -> Solution:
         """The solution of the compact copy as ``problem``'s: ``z`` spread to its rows."""

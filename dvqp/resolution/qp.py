@@ -318,6 +318,7 @@ class QPSolver:
         """Forget the backends' warm starts, the refusals and accuracy counted (a run starts)."""
         self.refusals.clear()
         self.accuracy = AccuracyTally()
+        self._packs.clear()
         for backend in (*self.backends, self._pacer):
             if backend is not None:
                 backend.reset()

@@ -202,3 +202,102 @@ def test_a_workspace_laid_out_otherwise_is_refused_and_daqp_model_solves(
     assert backend.solve(ws.problem).found
     assert backend._c is None and backend._model is not None
     assert not daqp_c.available() and "name its problem" in daqp_c._MISMATCHED[0]
+
+
+def refusing_sequence(backend: Any) -> list[tuple[Any, ...]]:
+    """Feasible, infeasible, feasible, infeasible: DAQP leaves its multipliers as they were
+    when it has no answer, so a refusal's show what the buffers held."""
+    n = 3
+    P, q = np.eye(n) * 2.0, np.array([1.0, -1.0, 0.5])
+    G = np.array([[1.0, 1.0, 0.0], [-1.0, -1.0, 0.0], [0.0, 1.0, 1.0]])
+    h = np.ones(3)
+    problem = Problem.trusted(P, q, None, None, G, h, None, None)
+    seen = []
+    for rows in ([1.0, 1.0, 1.0], [-1.0, -1.0, 1.0], [1.0, 1.0, 1.0], [-2.0, 1.0, 1.0]):
+        np.full(3, 1e300)  # memory that a fresh buffer could take over
+        h[:] = rows
+        s = backend.solve(problem)
+        seen.append((s.found, s.status, s.retried, None if s.z is None else s.z.tolist()))
+        seen.append(s.message)
+    return seen
+
+
+@needs_mirror
+def test_a_refusals_multipliers_are_daqp_models(by_model: Any) -> None:
+    in_c, in_model = make_backend("daqp"), make_backend("daqp")
+    got = refusing_sequence(in_c)
+
+    class ByModel:
+        def solve(self, problem: Problem) -> Solution:
+            return by_model(in_model, problem)  # type: ignore[no-any-return]
+
+    assert got == refusing_sequence(ByModel())
+    assert any(not found for found, *_ in got[::2])
+
+
+@needs_mirror
+def test_read_only_or_fortran_arrays_are_solved_not_packed() -> None:
+    """A trusted problem may mix read-only and Fortran arrays: the compiled attempt declines
+    them (None), and solve answers right."""
+    from solvers.rows import RowDropping
+
+    ws = Drift(seed=21)
+    for name in ("q", "lb", "G"):
+        arrays = {k: getattr(ws, k) for k in FIELDS}
+        if name == "G":
+            arrays[name] = np.asfortranarray(ws.G)
+        else:
+            arrays[name] = arrays[name].copy()
+            arrays[name].flags.writeable = False
+        problem = Problem.trusted(**arrays)
+        backend = RowDropping(make_backend("daqp"))
+        for _ in range(3):
+            solution = backend.solve(problem)
+            assert backend.compiled_attempt(problem) is None
+            want = make_backend("daqp").solve(Problem(**arrays)).require()
+            np.testing.assert_allclose(solution.require(), want, atol=2e-6)
+
+
+@needs_mirror
+def test_a_resolver_over_bare_daqp_backends_takes_the_python_path() -> None:
+    from dvqp.resolution.qp import QPSolver
+    from dvqp.workspace import QPBuffers
+
+    qp = QPBuffers(
+        P=np.eye(2),
+        cost=np.zeros(2),
+        A=np.array([[1.0, 1.0]]),
+        b=np.array([1.0]),
+        G=np.array([[1.0, 0.0]]),
+        h=np.array([0.8]),
+        lb=-np.ones(2),
+        ub=np.ones(2),
+    )
+    solver = QPSolver(lambda: make_backend("daqp"), qp, task_weight=1e4)
+    for step in range(4):
+        qp.b[0] = 1.0 + 0.01 * step
+        answer = solver.solve()
+        assert answer.status == "optimal" and answer.x is not None
+        assert abs(answer.x.sum() - qp.b[0]) < 1e-9
+
+
+@needs_mirror
+def test_settings_and_sizes_are_taken_as_daqp_model_takes_them() -> None:
+    ws = Drift(seed=22)
+    assert make_backend("daqp", iter_limit=1e4).solve(ws.problem).found  # a float, whole
+    arrays = {k: getattr(ws, k) for k in FIELDS}
+    arrays["lb"] = ws.lb[:1].copy()  # breaks the trusted contract: refused, not broadcast
+    refused = make_backend("daqp").solve(Problem.trusted(**arrays))
+    assert not refused.found and "do not fit" in refused.message
+
+
+@needs_mirror
+def test_a_workspace_is_neither_copied_nor_pickled() -> None:
+    import copy
+    import pickle
+
+    backend = make_backend("daqp")
+    backend.solve(Drift(seed=23).problem).require()
+    for attempt in (copy.copy, copy.deepcopy, pickle.dumps):
+        with pytest.raises(TypeError, match="DAQP workspace"):
+            attempt(backend._c)
