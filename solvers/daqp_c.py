@@ -417,6 +417,12 @@ def _now(typingctx, function):  # type: ignore[no-untyped-def]
     return types.float64(types.int64), codegen
 
 
+@njit(inline="always")
+def monotonic(handles):  # type: ignore[no-untyped-def]
+    """``time.perf_counter``'s clock (s) in compiled code, ``handles`` a :class:`Workspace`'s."""
+    return _now(handles[H_CLOCK])
+
+
 @intrinsic
 def _update_ldp(typingctx, function, mask, work, problem):  # type: ignore[no-untyped-def]
     """``daqp_update_ldp(mask, work, problem)`` at the address ``function``."""
@@ -603,7 +609,7 @@ class AttemptCall:
     lam: np.ndarray
 
 
-@njit
+@njit(separate=True, python=True)  # dvqp's step calls it, and its resolver from Python
 def solve_dropped(w):  # type: ignore[no-untyped-def]
     """A :class:`~solvers.rows.RowDropping` solve's first attempt over DAQP's C functions, in
     compiled code: ``w`` is its :class:`~solvers.rows.AttemptRows` packed into one struct (its

@@ -183,13 +183,34 @@ class QPSolver:
         solution)``;
         the problem's arrays are rewritten by the next step: a watcher copies what it keeps."""
 
-    def solve(self, rest: bool = False) -> Answer:
+    def fused_attempt(self) -> Any:
+        """The strict backend's packed ``compiled_attempt`` of its next solve, for a caller
+        that makes the attempt in a compiled call of its own (:func:`dvqp.step.stages.
+        resolve_move`), then hands its values to :meth:`took` (taken) or :meth:`solve`
+        (``attempted``); None when the step is not one strict problem made that way (levels,
+        watchers, a backend without compiled attempts)."""
+        if self.levels is not None or self.watchers:
+            return None
+        strict = self.backends[0]
+        attempt = getattr(strict, "compiled_attempt", None)
+        rows = None if attempt is None else attempt(self.strict)
+        return None if rows is None else self._packed(strict, rows)
+
+    def took(self, out: tuple[float, ...]) -> Taken:
+        """The strict attempt made and taken in compiled code (its values ``out``), counted."""
+        strict = self.backends[0]
+        return self._took(strict, self._packs[id(strict)][0], out)
+
+    def solve(self, rest: bool = False, attempted: tuple[float, ...] | None = None) -> Answer:
         """Strict, else relaxed, else braking (``x`` a view, valid until the next solve).
 
         ``rest``: a step of a stop, whose cost has no linear part and whose tasks ask for no
         motion (``b = 0``). If ``Q̇ = 0`` is then feasible (every ``lb ≤ 0 ≤ ub``, ``h ≥ 0``)
         it is the exact minimiser of ``½ Q̇ᵀPQ̇`` (``P`` positive definite), taken without a
         backend: a backend's answer would be 0 only to its tolerance.
+
+        ``attempted``: the values of the strict problem's first attempt, made in compiled code
+        with :meth:`fused_attempt`'s struct and not taken there; the solve goes on from them.
         """
         qp = self.qp
         if rest and not (np.any(qp.lb > 0.0) or np.any(qp.ub < 0.0) or np.any(qp.h < 0.0)):
@@ -208,7 +229,7 @@ class QPSolver:
             if out.x is not None:
                 return Answer(out.x, out.status, out.iterations, out.solver_time, out.rate)
             return self._brake(out.message, out.iterations, out.solver_time, out.rate)
-        solution = self._call("strict", strict, self.strict)
+        solution = self._call("strict", strict, self.strict, attempted)
         spent, status, rate = solution.solver_time, "optimal", 1.0
         if not solution.found and not rest and self.feedforward.any():
             solution, rate = self._slow_down()
@@ -222,7 +243,13 @@ class QPSolver:
             return Answer(x, status, solution.iterations, spent, rate)
         return self._brake(solution.message, solution.iterations, spent, rate)
 
-    def _call(self, kind: str, backend: solvers.Backend, problem: solvers.Problem) -> Any:
+    def _call(
+        self,
+        kind: str,
+        backend: solvers.Backend,
+        problem: solvers.Problem,
+        attempted: tuple[float, ...] | None = None,
+    ) -> Any:
         """One backend call on ``problem`` (``kind`` ``"strict"``, ``"scaled"`` or
         ``"relaxed"``), counted: a :class:`solvers.Solution`, or :class:`Taken`.
 
@@ -235,18 +262,25 @@ class QPSolver:
         refused warm answer retried cold). Watchers see every call's problem and solution:
         with them, ``solve``."""
         start = perf_counter()
-        warm = None if self.watchers else getattr(backend, "compiled_attempt", None)
-        rows = None if warm is None else warm(problem)
-        out = (-1.0,) if rows is None else solve_dropped(self._packed(backend, rows))
+        if attempted is not None:  # made by the caller (fused_attempt)
+            rows, out = self._packs[id(backend)][0], attempted
+        else:
+            warm = None if self.watchers else getattr(backend, "compiled_attempt", None)
+            rows = None if warm is None else warm(problem)
+            out = (-1.0,) if rows is None else solve_dropped(self._packed(backend, rows))
         if out[0] < 0:  # not made there
             solution = backend.solve(problem)
         else:
             if out[0] == ACCEPTED and rows.call.mode[0] == WARM:  # a restart's: the backend's
-                self.accuracy.add_metrics(kernel_metrics(out[4:]), backend.tolerance)
-                return Taken(rows.call.x, int(out[2]), out[3])
+                return self._took(backend, rows, out)
             solution = backend.adopt_attempt(problem, start, out)  # type: ignore[attr-defined]
         self._count(kind, problem, solution)
         return solution
+
+    def _took(self, backend: solvers.Backend, rows: Any, out: tuple[float, ...]) -> Taken:
+        """A warm attempt's answer, accepted in compiled code, counted and taken as it is."""
+        self.accuracy.add_metrics(kernel_metrics(out[4:]), backend.tolerance)
+        return Taken(rows.call.x, int(out[2]), out[3])
 
     def _packed(self, backend: solvers.Backend, rows: Any) -> Any:
         """``rows`` (a backend's ``compiled_attempt``) packed into one struct, kept while the

@@ -102,7 +102,7 @@ def _attempt(
     halvings: int,
 ) -> Advance:
     """A step of ``dt`` from ``q`` (loaded), halved while it breaks a limit."""
-    found = stepper.resolve(command, dt)
+    found, reached = stepper.resolve_and_move(command, dt)
     if not found.success:
         stepper.observe(np.zeros_like(q), dt)
         failed = Step(
@@ -116,7 +116,8 @@ def _attempt(
             0.0,
         )
         return Advance(failed, 1)
-    reached = stepper.move()
+    if reached is None:  # not made with it
+        reached = stepper.move()
     motion, levels = stepper.motion, stepper.level_error
     step = Step(
         stepper.x.copy(),

@@ -25,7 +25,7 @@ from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState, singular_frame
 from dvqp.limits import Bounds, Constraint, Limit, VelocityDamper
 from dvqp.objective import Term
-from dvqp.resolution.qp import QPResolver, QPSolver
+from dvqp.resolution.qp import Answer, QPResolver, QPSolver
 from dvqp.resolution.spec import unmeetable
 from dvqp.resolution.step import Resolver
 from dvqp.step import stages
@@ -240,19 +240,52 @@ class Stepper(Verification):
         started = time.perf_counter()
         status = self.prepare(command, dt)
         prepared = time.perf_counter()
-        a = self.arrays
         if self.solver is None:
             if status != -1:
                 raise self._pinv_error(status)
             return Resolution(True, "optimal", None, prepared - started, prepared - started)
         if status != -1:
-            lb, ub = a.qp.lb[status], a.qp.ub[status]
-            why = (
-                f"failed: the bounds on joint{status + 1}'s velocity cross "
-                f"({lb:.4g} > {ub:.4g} rad/s)"
-            )
-            return Resolution(False, why, None, 0.0, time.perf_counter() - started)
-        answer = self.solver.solve(rest=self.stopping)
+            return self._crossed(status, started)
+        return self._resolved(self.solver.solve(rest=self.stopping), started)
+
+    def resolve_and_move(self, command: Array, dt: float) -> tuple[Resolution, bool | None]:
+        """:meth:`resolve`, and when its answer is taken in the compiled call that wrote the
+        QP (the strict problem's warm attempt accepted: :func:`~dvqp.step.stages.
+        resolve_move`), :meth:`move` made in that call too: its result, else None (then
+        call :meth:`move`). A run with parts of your own, a stop's steps, levels or watched
+        backend calls resolve as :meth:`resolve` does."""
+        packed = None if self.hooks.active or self.stopping else self._fused_attempt()
+        if packed is None:
+            return self.resolve(command, dt), None
+        started = time.perf_counter()
+        self._command(command, dt)
+        out = stages.resolve_move(self.struct, packed)
+        status = int(out[0])
+        solver = self.solver
+        assert solver is not None
+        if status == stages.MOVED:  # the resolution's time without the evaluation's
+            taken = solver.took(out[3:])
+            spent = time.perf_counter() - started - out[2]
+            return Resolution(True, "optimal", taken.iterations, taken.solver_time, spent), out[
+                1
+            ] == -1
+        if status == stages.BAD_COMMAND:
+            raise ParameterError("command", "must be finite (no NaN or inf)")
+        if status != stages.ATTEMPTED:
+            return self._crossed(status, started), None
+        return self._resolved(solver.solve(attempted=out[3:]), started), None
+
+    def _fused_attempt(self) -> object:
+        return None if self.solver is None else self.solver.fused_attempt()
+
+    def _crossed(self, joint: int, started: float) -> Resolution:
+        """The step whose bounds on ``joint`` cross: failed."""
+        lb, ub = self.arrays.qp.lb[joint], self.arrays.qp.ub[joint]
+        why = f"failed: the bounds on joint{joint + 1}'s velocity cross ({lb:.4g} > {ub:.4g} rad/s)"
+        return Resolution(False, why, None, 0.0, time.perf_counter() - started)
+
+    def _resolved(self, answer: Answer, started: float) -> Resolution:
+        """The resolver's ``answer`` as the step's :attr:`x` and resolution."""
         if answer.x is not None:
             self.x[:] = answer.x
         return Resolution(
@@ -282,10 +315,7 @@ class Stepper(Verification):
         (s), without solving it (:meth:`resolve` solves it): −1, or the first joint whose
         bounds cross (QP), or a status of the baseline (its step is then not defined)."""
         a, s, hooks = self.arrays, self.struct, self.hooks
-        if np.shape(command) != (4,):
-            raise ShapeError("command", (4,), np.shape(command))
-        a.command[:] = command
-        a.dt[0] = dt
+        self._command(command, dt)
         split = bool(hooks.prepared) or self.stopping
         status = int(self._prepare(s, stages.ROWS, stages.ROWS if split else stages.CLOSE))
         if status == stages.BAD_COMMAND:
@@ -299,6 +329,13 @@ class Stepper(Verification):
                 np.maximum(held, 0.0, out=held)
             status = int(self._prepare(s, stages.CLOSE, stages.CLOSE))
         return status
+
+    def _command(self, command: Array, dt: float) -> None:
+        """The step's command (4,) and ``dt`` (s), written for the compiled stages."""
+        if np.shape(command) != (4,):
+            raise ShapeError("command", (4,), np.shape(command))
+        self.arrays.command[:] = command
+        self.arrays.dt[0] = dt
 
     def _pinv_error(self, status: int) -> SingularConfigurationError:
         if status == stages.INDEFINITE_METRIC:

@@ -31,6 +31,7 @@ from dvqp.resolution.pinv import NOT_DEFINITE, pinv_step
 from dvqp.tasks.point import point_rows
 from dvqp.tasks.posture import posture_rows
 from dvqp.tasks.tool_dv import tool_rows
+from solvers.daqp_c import ACCEPTED, WARM, monotonic, solve_dropped
 from solvers.jit import njit
 
 MEASURE, LINKS, OBJECTIVE, DAMPERS, CONCLUDE = 0, 1, 2, 3, 4
@@ -41,12 +42,17 @@ ASSESS = LINKS
 assess after :data:`DAMPERS`."""
 ROWS, CLOSE = 0, 1
 """Stages of :func:`prepare`."""
+NOT_ATTEMPTED = (-1.0,) + (math.nan,) * 11
+""":func:`resolve_move`'s attempt values when it made none."""
 SINGULAR_TASK, INDEFINITE_METRIC, BAD_COMMAND = -2, -3, -4
 """Statuses of :func:`prepare`: the baseline's Gram matrix or metric is singular; the command
 is not finite."""
+MOVED, ATTEMPTED = -5, -6
+"""Statuses of :func:`resolve_move`: the step resolved and made; the strict problem's first
+attempt made, not taken as it is."""
 
 
-@njit
+@njit(separate=True)
 def evaluate(s, integrate, first, last) -> int:  # type: ignore[no-untyped-def]
     """Evaluate the state at ``s.state.q`` (first ``q += dt·x`` if ``integrate``), stages
     ``first`` to ``last``; returns −1, or the index of a singular guarded frame."""
@@ -222,7 +228,7 @@ def _sample(s) -> None:  # type: ignore[no-untyped-def]
         c.lowest[i] = c.values[i] if c.values[i] < c.settled[i] else c.settled[i]
 
 
-@njit
+@njit(separate=True)
 def prepare(s, first, last) -> int:  # type: ignore[no-untyped-def]
     """Write this step's QP (stage ``ROWS``: the tasks' rows, the cost, the bounds reset and
     every box intersected, the damper rows) and close it (``CLOSE``): returns −1, the first
@@ -291,3 +297,33 @@ def _rows(s) -> bool:  # type: ignore[no-untyped-def]
     for i in range(qp.cost.shape[0]):
         qp.cost[i] = -gain * s.objective.gradient[i]
     return True
+
+
+@njit
+def resolve_move(s, w):  # type: ignore[no-untyped-def]
+    """A common QP step in one call: write the QP (:func:`prepare`), make the strict
+    problem's first attempt (``w``: its backend's packed ``compiled_attempt``,
+    :func:`solvers.daqp_c.solve_dropped`) and, if it was warm and its answer passed the
+    check, take it as ``s.x`` and evaluate the state it reaches (:func:`evaluate`, as
+    :meth:`~dvqp.step.Stepper.move`).
+
+    Returns
+    -------
+    tuple of 15 floats
+        ``(status, singular, moving, *attempt)``: status :data:`MOVED` (``singular``: −1 or
+        the guarded frame on the pipe axis; ``moving``: the seconds the evaluation took, not
+        the resolution's), :data:`ATTEMPTED` (the resolver finishes the solve from the
+        attempt's values), or :func:`prepare`'s status when it is not −1 (nothing
+        attempted); ``attempt`` the values of :func:`~solvers.daqp_c.solve_dropped`.
+    """
+    status = prepare(s, ROWS, CLOSE)
+    if status != -1:
+        return (float(status), 0.0, 0.0, *NOT_ATTEMPTED)
+    out = solve_dropped(w)
+    if out[0] != ACCEPTED or w.call.mode[0] != WARM:
+        return (float(ATTEMPTED), 0.0, 0.0, *out)
+    for i in range(s.x.shape[0]):
+        s.x[i] = w.call.x[i]
+    started = monotonic(w.call.handles)
+    singular = evaluate(s, True, MEASURE, CONCLUDE)
+    return (float(MOVED), float(singular), monotonic(w.call.handles) - started, *out)
