@@ -27,11 +27,12 @@ from typing import Any
 import numpy as np
 from llvmlite import ir
 from numba import types
-from numba.core import cgutils
 from numba.core.extending import intrinsic
 
+from . import clock
 from ._fast import stack_into
 from ._kkt import MISFITTING, _readonly, stacked_values
+from .clock import now
 from .jit import compiled_on_first_call, njit
 from .residuals import accepts
 from .rows import compact, resized
@@ -168,8 +169,6 @@ H_UPDATE, H_SOLVE, H_CLOCK, H_WORK, H_PROBLEM, H_RESULT, H_SENSE = range(7)
 """Slots of a :class:`Workspace`'s ``handles`` (int64): the addresses of ``daqp_update_ldp``,
 ``daqp_solve`` and the C library's ``clock_gettime``, of the workspace, the ``DAQPProblem``,
 the ``DAQPResult`` and the set-up's ``sense``."""
-_CLOCK_MONOTONIC = 1
-"""Linux's ``CLOCK_MONOTONIC``, the clock of ``time.perf_counter``."""
 
 
 class LayoutError(RuntimeError):
@@ -329,7 +328,7 @@ class Workspace:
             [
                 ctypes.cast(lib.daqp_update_ldp, ctypes.c_void_p).value,
                 ctypes.cast(lib.daqp_solve, ctypes.c_void_p).value,
-                ctypes.cast(_libc().clock_gettime, ctypes.c_void_p).value,
+                clock.address(),
                 self._work,
                 ctypes.addressof(p),
                 self.words.ctypes.data + ctypes.sizeof(ProblemData),
@@ -395,32 +394,6 @@ def _read_word(typingctx, address):  # type: ignore[no-untyped-def]
         return builder.load(pointer)
 
     return types.int64(types.int64), codegen
-
-
-@intrinsic
-def _now(typingctx, function):  # type: ignore[no-untyped-def]
-    """``clock_gettime(CLOCK_MONOTONIC)`` (``function``: its address) in seconds."""
-
-    def codegen(context, builder, sig, args):  # type: ignore[no-untyped-def]
-        i64 = ir.IntType(64)
-        spec = cgutils.alloca_once(builder, ir.ArrayType(i64, 2))
-        fnty = ir.FunctionType(ir.IntType(32), [ir.IntType(32), spec.type])
-        callee = builder.inttoptr(args[0], fnty.as_pointer())
-        builder.call(callee, [ir.Constant(ir.IntType(32), _CLOCK_MONOTONIC), spec])
-        zero = ir.Constant(ir.IntType(32), 0)
-        parts = [
-            builder.load(builder.gep(spec, [zero, ir.Constant(ir.IntType(32), i)])) for i in (0, 1)
-        ]
-        seconds, nanoseconds = (builder.sitofp(v, ir.DoubleType()) for v in parts)
-        return builder.fadd(seconds, builder.fmul(nanoseconds, ir.Constant(ir.DoubleType(), 1e-9)))
-
-    return types.float64(types.int64), codegen
-
-
-@njit(inline="always")
-def monotonic(handles):  # type: ignore[no-untyped-def]
-    """``time.perf_counter``'s clock (s) in compiled code, ``handles`` a :class:`Workspace`'s."""
-    return _now(handles[H_CLOCK])
 
 
 @intrinsic
@@ -512,7 +485,7 @@ def stacked_solve(
     if changed < 0:
         return (MISFITTED, nan, nan, 0.0, *MISFITTING)
     work, problem, result = handles[H_WORK], handles[H_PROBLEM], handles[H_RESULT]
-    started = _now(handles[H_CLOCK])
+    started = now(handles[H_CLOCK])
     if not mode & AS_SET_UP:
         mask = UPDATE_M | UPDATE_V | UPDATE_SENSE
         if changed or mode & (RESTART | REFACTOR):
@@ -521,7 +494,7 @@ def stacked_solve(
         words[_QP_SENSE] = handles[H_SENSE] if restart else _read_word(work + _SENSE_AT)
         flag = _update_ldp(handles[H_UPDATE], mask, work, problem)
         if flag < 0:
-            spent = _now(handles[H_CLOCK]) - started
+            spent = now(handles[H_CLOCK]) - started
             return (UPDATE_FAILED, float(flag), nan, spent, *MISFITTING)
     base = words.shape[0] - _RES_WORDS  # the DAQPResult, after the DAQPProblem
     for i in range(_RES_WORDS):
@@ -529,7 +502,7 @@ def stacked_solve(
     words[base + _RES_X] = x.ctypes.data
     words[base + _RES_LAM] = lam.ctypes.data if rows else 0
     _solve(handles[H_SOLVE], result, work)
-    spent = _now(handles[H_CLOCK]) - started
+    spent = now(handles[H_CLOCK]) - started
     ints = words[base:].view(np.int32)
     exitflag, iterations = ints[_RES_FLAG], ints[_RES_ITER]
     values = stacked_values(data, x, lam, n, p, m, ms, flags)

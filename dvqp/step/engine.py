@@ -33,6 +33,7 @@ from dvqp.step.arrays import RecordArrays
 from dvqp.step.build import lay_out
 from dvqp.step.verification import Verification
 from dvqp.workspace import as_struct
+from solvers import clock
 from solvers.rows import RowDropping
 
 Array = NDArray[np.float64]
@@ -254,7 +255,11 @@ class Stepper(Verification):
         resolve_move`), :meth:`move` made in that call too: its result, else None (then
         call :meth:`move`). A run with parts of your own, a stop's steps, levels or watched
         backend calls resolve as :meth:`resolve` does."""
-        packed = None if self.hooks.active or self.stopping else self._fused_attempt()
+        if self.hooks.active or self.stopping:
+            return self.resolve(command, dt), None
+        if self.solver is None:
+            return self._baseline_move(command, dt)
+        packed = self.solver.fused_attempt()
         if packed is None:
             return self.resolve(command, dt), None
         started = time.perf_counter()
@@ -275,8 +280,17 @@ class Stepper(Verification):
             return self._crossed(status, started), None
         return self._resolved(solver.solve(attempted=out[3:]), started), None
 
-    def _fused_attempt(self) -> object:
-        return None if self.solver is None else self.solver.fused_attempt()
+    def _baseline_move(self, command: Array, dt: float) -> tuple[Resolution, bool | None]:
+        """The baseline's :meth:`resolve_and_move`: its step and the move in one call."""
+        started = time.perf_counter()
+        self._command(command, dt)
+        status, singular, moving = stages.resolve_move_baseline(self.struct, clock.address())
+        spent = time.perf_counter() - started - moving
+        if status == stages.MOVED:
+            return Resolution(True, "optimal", None, spent, spent), singular == -1
+        if status == stages.BAD_COMMAND:
+            raise ParameterError("command", "must be finite (no NaN or inf)")
+        raise self._pinv_error(int(status))
 
     def _crossed(self, joint: int, started: float) -> Resolution:
         """The step whose bounds on ``joint`` cross: failed."""

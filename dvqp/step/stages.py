@@ -31,7 +31,8 @@ from dvqp.resolution.pinv import NOT_DEFINITE, pinv_step
 from dvqp.tasks.point import point_rows
 from dvqp.tasks.posture import posture_rows
 from dvqp.tasks.tool_dv import tool_rows
-from solvers.daqp_c import ACCEPTED, WARM, monotonic, solve_dropped
+from solvers.clock import now
+from solvers.daqp_c import ACCEPTED, H_CLOCK, WARM, solve_dropped
 from solvers.jit import njit
 
 MEASURE, LINKS, OBJECTIVE, DAMPERS, CONCLUDE = 0, 1, 2, 3, 4
@@ -253,7 +254,7 @@ def prepare(s, first, last) -> int:  # type: ignore[no-untyped-def]
     return -1
 
 
-@njit
+@njit(separate=True)
 def prepare_baseline(s, first, last) -> int:  # type: ignore[no-untyped-def]
     """:func:`prepare` for the baseline (its own function: neither compiles the other's code),
     its step in ``s.pinv.x``: −1, :data:`SINGULAR_TASK`, :data:`INDEFINITE_METRIC` or
@@ -324,6 +325,26 @@ def resolve_move(s, w):  # type: ignore[no-untyped-def]
         return (float(ATTEMPTED), 0.0, 0.0, *out)
     for i in range(s.x.shape[0]):
         s.x[i] = w.call.x[i]
-    started = monotonic(w.call.handles)
+    clock = w.call.handles[H_CLOCK]
+    started = now(clock)
     singular = evaluate(s, True, MEASURE, CONCLUDE)
-    return (float(MOVED), float(singular), monotonic(w.call.handles) - started, *out)
+    return (float(MOVED), float(singular), now(clock) - started, *out)
+
+
+@njit
+def resolve_move_baseline(s, clock):  # type: ignore[no-untyped-def]
+    """:func:`resolve_move` for the baseline: its step (:func:`prepare_baseline`) and, if it
+    has one, the state it reaches evaluated. ``clock``: :func:`solvers.clock.address`.
+
+    Returns
+    -------
+    tuple of 3 floats
+        ``(status, singular, moving)``: :data:`MOVED` (as :func:`resolve_move`'s), or
+        :func:`prepare_baseline`'s status when it is not −1.
+    """
+    status = prepare_baseline(s, ROWS, CLOSE)
+    if status != -1:
+        return (float(status), 0.0, 0.0)
+    started = now(clock)
+    singular = evaluate(s, True, MEASURE, CONCLUDE)
+    return (float(MOVED), float(singular), now(clock) - started)

@@ -65,3 +65,34 @@ def test_a_run_in_compiled_code_is_the_run_through_solve(
     assert list(fast.iterations) == list(slow.iterations)
     assert fast.refusals == slow.refusals
     assert fast.accuracy == slow.accuracy
+
+
+@pytest.mark.parametrize("name", ["paper-two-inlets", "fold"])
+def test_a_baseline_run_in_one_call_a_step_is_the_run_through_resolve(
+    name: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The baseline's step and move made in one compiled call
+    (:func:`dvqp.step.stages.resolve_move_baseline`) against :meth:`Stepper.resolve` then
+    :meth:`Stepper.move`."""
+    from dvqp.step.engine import Stepper
+
+    scene = dvqp.load_scene(str(SCENE_FILES / f"{name}.toml"))
+    made = 0
+    kernel = stages.resolve_move_baseline
+
+    def counted(*args: Any) -> Any:
+        nonlocal made
+        made += 1
+        return kernel(*args)
+
+    with monkeypatch.context() as patch:
+        patch.setattr(stages, "resolve_move_baseline", counted)
+        fast = dvqp.plan(scene, "pinv")
+    with monkeypatch.context() as patch:
+        patch.setattr(Stepper, "_baseline_move", lambda self, c, dt: (self.resolve(c, dt), None))
+        slow = dvqp.plan(scene, "pinv")
+    assert made > 0.9 * fast.n_steps  # all but a stop's steps
+    np.testing.assert_array_equal(fast.q, slow.q)
+    np.testing.assert_array_equal(fast.qdot, slow.qdot)
+    np.testing.assert_array_equal(fast.limit_excess, slow.limit_excess)
+    assert list(fast.status) == list(slow.status)
