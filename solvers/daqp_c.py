@@ -162,6 +162,7 @@ _SENSE_AT = WorkspaceHead.sense.offset
 _QP_SENSE = ProblemData.sense.offset // 8
 _RES_X, _RES_LAM = Result.x.offset // 8, Result.lam.offset // 8
 _RES_FLAG, _RES_ITER = Result.exitflag.offset // 4, Result.iter.offset // 4
+assert _RES_FLAG % 2 == 0 and _RES_ITER == _RES_FLAG + 1  # one int64 word: read as one
 _RES_WORDS = ctypes.sizeof(Result) // 8
 MISFITTED, UPDATE_FAILED, SOLVED, ACCEPTED = 0.0, 1.0, 2.0, 3.0
 """Stages of :func:`stacked_solve`'s values (and :func:`solve_dropped`'s: ``ACCEPTED``)."""
@@ -503,8 +504,8 @@ def stacked_solve(
     words[base + _RES_LAM] = lam.ctypes.data if rows else 0
     _solve(handles[H_SOLVE], result, work)
     spent = now(handles[H_CLOCK]) - started
-    ints = words[base:].view(np.int32)
-    exitflag, iterations = ints[_RES_FLAG], ints[_RES_ITER]
+    both = words[base + _RES_FLAG // 2]  # exitflag and iter, one word (little-endian)
+    exitflag, iterations = np.int32(both & 0xFFFFFFFF), both >> 32
     values = stacked_values(data, x, lam, n, p, m, ms, flags)
     return (SOLVED, float(exitflag), float(iterations), spent, *values)
 
