@@ -341,7 +341,7 @@ class DaqpBackend(StatefulBackend):
             return None
         if not self._warm and self._structure is None:  # a new set-up: solve
             return None
-        if self._warm_call is None:
+        if self._warm_call is None or self._warm_call.tolerance != self.tolerance:
             given = self._stack[:8]
             if not all(a.flags.writeable or a.size == 0 for a in given):
                 return None

@@ -301,3 +301,17 @@ def test_a_workspace_is_neither_copied_nor_pickled() -> None:
     for attempt in (copy.copy, copy.deepcopy, pickle.dumps):
         with pytest.raises(TypeError, match="DAQP workspace"):
             attempt(backend._c)
+
+
+@needs_mirror
+def test_the_compiled_check_follows_a_changed_tolerance() -> None:
+    from solvers.rows import RowDropping
+
+    ws = Drift(seed=24)
+    backend = RowDropping(make_backend("daqp"))
+    backend.solve(ws.problem).require()
+    first = backend.compiled_attempt(ws.problem)
+    assert first is not None and first.call.tolerance == 1e-6
+    backend.inner.tolerance = 1e-3
+    again = backend.compiled_attempt(ws.problem)
+    assert again is not None and again.call.tolerance == 1e-3
