@@ -59,7 +59,7 @@ from typing import Any, ClassVar
 import daqp
 import numpy as np
 
-from . import daqp_c
+from . import daqp_abi, daqp_c
 from ._fast import EMPTY_MATRIX, EMPTY_VECTOR, refresh, stack
 from ._kkt import HAS_LB, HAS_UB, MISFITTING, stacked
 from .problem import Problem
@@ -110,7 +110,7 @@ class DaqpBackend(StatefulBackend):
         self._bound: Problem | None = None  # the problem whose arguments of stack are kept
         self._stack: tuple[Any, ...] | None = None  # None: copy _bound with NumPy
         self._sense = np.zeros(0, dtype=np.intc)  # the set-up's sense: equality rows flagged
-        self._c: daqp_c.Workspace | None = None  # DAQP called from compiled code (daqp_c)
+        self._c: daqp_abi.Workspace | None = None  # DAQP called from compiled code (daqp_c)
         self._c_args: tuple[Any, ...] | None = None  # solve_stacked's, but the mode and answers
         self._warm_call: daqp_c.AttemptCall | None = None  # compiled_attempt's
 
@@ -192,7 +192,7 @@ class DaqpBackend(StatefulBackend):
         self._H, self._M = data[:f].reshape(n, n), data[M:up].reshape(p + m, n)
         self._upper[:], self._lower[:] = np.inf, -np.inf
         self._bound = None
-        if daqp_c.available():  # copied with NumPy: the solves' compiled call copies, not stack
+        if daqp_abi.available():  # copied with NumPy: the solves' compiled call copies, not stack
             self._fit(problem)
             self._fill(problem)
             self._H[:] = problem.P  # DAQP's, and the reference that tells P changed
@@ -201,10 +201,10 @@ class DaqpBackend(StatefulBackend):
         sense = self._sense = np.zeros(rows, dtype=np.intc)
         sense[rows - m :] = _SENSE_EQUALITY
         work = None
-        if daqp_c.available():
+        if daqp_abi.available():
             start = perf_counter()
-            with contextlib.suppress(daqp_c.LayoutError):  # then never again: daqp.Model
-                work = daqp_c.Workspace(
+            with contextlib.suppress(daqp_abi.LayoutError):  # then never again: daqp.Model
+                work = daqp_abi.Workspace(
                     self._H, self._f, self._M, self._upper, self._lower, sense, self.settings, guess
                 )
         if work is not None:

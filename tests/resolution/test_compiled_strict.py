@@ -20,11 +20,11 @@ from dvqp.step import stages
 from tests.runs import SCENES as SCENE_FILES
 
 pytest.importorskip("daqp")
-from solvers import daqp_c
+from solvers import daqp_abi
 from solvers.daqp_c import solve_dropped
 
 needs_mirror = pytest.mark.skipif(
-    not daqp_c.available(), reason="the installed daqp's layout is not mirrored"
+    not daqp_abi.available(), reason="the installed daqp's layout is not mirrored"
 )
 
 SCENES = ("paper-two-inlets", "probe-into-clamp", "weld-rush", "joint-limit")

@@ -22,10 +22,10 @@ from solvers.stateful import solve_guarded
 from tests.solvers.test_daqp_fast import FIELDS, Drift
 
 daqp = pytest.importorskip("daqp")
-from solvers import daqp_c  # noqa: E402  (after the skip: it imports daqp)
+from solvers import daqp_abi  # noqa: E402  (after the skip: it reads daqp's version)
 
 needs_mirror = pytest.mark.skipif(
-    not daqp_c.available(), reason="the installed daqp's layout is not mirrored"
+    not daqp_abi.available(), reason="the installed daqp's layout is not mirrored"
 )
 
 
@@ -35,7 +35,7 @@ def by_model(monkeypatch: pytest.MonkeyPatch) -> Iterator[Any]:
 
     def solve(backend: Any, problem: Problem, how: str | None = None) -> Solution:
         with monkeypatch.context() as patch:
-            patch.setattr(daqp_c, "available", lambda: False)
+            patch.setattr(daqp_abi, "available", lambda: False)
             return call(backend, problem, how)
 
     yield solve
@@ -60,7 +60,7 @@ def assert_same(got: Solution, want: Solution) -> None:
 
 @needs_mirror
 def test_the_installed_daqp_is_mirrored_and_solves_through_its_c_functions() -> None:
-    assert importlib.metadata.version("daqp") in daqp_c.KNOWN_VERSIONS
+    assert importlib.metadata.version("daqp") in daqp_abi.KNOWN_VERSIONS
     backend = make_backend("daqp")
     backend.solve(Drift(seed=1).problem).require()
     assert backend._c is not None and backend._model is None
@@ -102,7 +102,7 @@ def test_any_drift_is_solved_bitwise_as_daqp_model(
             c_side.move(size)
             model_side.move(size)
             got = in_c.solve(c_side.problem)
-            patch.setattr(daqp_c, "available", lambda: False)
+            patch.setattr(daqp_abi, "available", lambda: False)
             want = in_model.solve(model_side.problem)
             patch.undo()
             assert_same(got, want)
@@ -154,15 +154,15 @@ def test_a_problem_the_compiled_copy_refuses_is_copied_with_numpy_bitwise(by_mod
 
 
 def test_an_unknown_daqp_version_keeps_daqp_model(monkeypatch: pytest.MonkeyPatch) -> None:
-    daqp_c._mirrored.cache_clear()
+    daqp_abi._mirrored.cache_clear()
     try:
         monkeypatch.setattr(importlib.metadata, "version", lambda name: "0.0.1")
-        assert not daqp_c.available()
+        assert not daqp_abi.available()
         backend = make_backend("daqp")
         assert backend.solve(Drift(seed=2).problem).found
         assert backend._model is not None and backend._c is None
-        with pytest.raises(daqp_c.LayoutError, match=r"0\.0\.1"):
-            daqp_c.Workspace(
+        with pytest.raises(daqp_abi.LayoutError, match=r"0\.0\.1"):
+            daqp_abi.Workspace(
                 *(np.zeros(k) for k in (1, 1)),
                 np.zeros((0, 1)),
                 *(np.zeros(0),) * 2,
@@ -171,7 +171,7 @@ def test_an_unknown_daqp_version_keeps_daqp_model(monkeypatch: pytest.MonkeyPatc
             )
     finally:
         monkeypatch.undo()
-        daqp_c._mirrored.cache_clear()
+        daqp_abi._mirrored.cache_clear()
 
 
 @needs_mirror
@@ -189,19 +189,19 @@ def test_a_workspace_frees_once() -> None:
 def test_a_workspace_laid_out_otherwise_is_refused_and_daqp_model_solves(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    fields = list(daqp_c.WorkspaceHead._fields_)
+    fields = list(daqp_abi.WorkspaceHead._fields_)
     fields[1], fields[2] = fields[2], fields[1]  # n and m swapped: the check after set-up
 
     class Swapped(ctypes.Structure):
         _fields_ = fields
 
-    monkeypatch.setattr(daqp_c, "_MISMATCHED", [])
-    monkeypatch.setattr(daqp_c, "WorkspaceHead", Swapped)
+    monkeypatch.setattr(daqp_abi, "_MISMATCHED", [])
+    monkeypatch.setattr(daqp_abi, "WorkspaceHead", Swapped)
     backend = make_backend("daqp")
     ws = Drift(seed=4)
     assert backend.solve(ws.problem).found
     assert backend._c is None and backend._model is not None
-    assert not daqp_c.available() and "name its problem" in daqp_c._MISMATCHED[0]
+    assert not daqp_abi.available() and "name its problem" in daqp_abi._MISMATCHED[0]
 
 
 def refusing_sequence(backend: Any) -> list[tuple[Any, ...]]:

@@ -99,11 +99,11 @@ def test_a_change_of_p_alone_is_noticed(name: str, module: str) -> None:
 
 def test_daqp_passes_h_only_when_p_changed(monkeypatch: pytest.MonkeyPatch) -> None:
     pytest.importorskip("daqp")
-    from solvers import daqp_c
+    from solvers import daqp_abi
 
     # daqp.Model's path (its calls can be spied on); DAQP's C functions are called with the
     # same mask (tests/solvers/test_daqp_c.py: bitwise the same answers as P changes)
-    monkeypatch.setattr(daqp_c, "available", lambda: False)
+    monkeypatch.setattr(daqp_abi, "available", lambda: False)
     ws = Workspace(seed=3)
     backend = make_backend("daqp")
     backend.solve(ws.problem).require()

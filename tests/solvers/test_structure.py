@@ -64,7 +64,8 @@ for name in ("daqp", "osqp"):
             solvers.residuals(problem, solution.x, solution.y, solution.z, solution.z_box)
     report[name] = state()
 report["can_compile"] = {name: d._can_compile for name, d in kernels.items()}
-report["daqp_c"] = daqp_c.available()
+from solvers import daqp_abi
+report["daqp_c"] = daqp_abi.available()
 print(json.dumps(report))
 """
 
