@@ -19,8 +19,10 @@ first timed run), medians in µs:
   obstacles (the rest of the measure stage: every shape's distances, the link pairs, and the
   real links), objective, dampers (their distances), QP assembly (``Stepper.prepare``: the task
   rows, cost, bounds and damper rows; the baseline's includes its whole eq. 18), solve (the time
-  inside DAQP's calls, ``solver_time``), the backend layer (the rest of ``solve_time``: the
-  row dropping, the data copy, the residual check of the answer), the exact verification
+  inside DAQP's calls, ``solver_time``), the backend layer (the rest of ``solve_time``, the
+  resolution's time without the evaluation of the state reached: the row dropping, the data
+  copy, the residual check of the answer, the structs' crossing into compiled code and the
+  resolver's Python around it), the exact verification
   (the conclusion without a sample) and recording (what the sample adds); "rest" is the step
   less those (Python: ``advance``, the schedule, the recorder). The stages are timed on the
   run's own states, one at a time (each is a call into compiled code of its own, about
