@@ -112,7 +112,7 @@ class DaqpBackend(StatefulBackend):
         self._sense = np.zeros(0, dtype=np.intc)  # the set-up's sense: equality rows flagged
         self._c: daqp_abi.Workspace | None = None  # DAQP called from compiled code (daqp_c)
         self._c_args: tuple[Any, ...] | None = None  # solve_stacked's, but the mode and answers
-        self._warm_call: daqp_c.AttemptCall | None = None  # compiled_attempt's
+        self._attempt_call: daqp_c.AttemptCall | None = None  # compiled_attempt's
 
     @classmethod
     def known_settings(cls) -> set[str]:
@@ -123,7 +123,7 @@ class DaqpBackend(StatefulBackend):
         if self._c is not None:
             self._c.close()
         self._model = self._bound = self._stack = self._c = self._c_args = None
-        self._warm_call = None
+        self._attempt_call = None
 
     def _structure_of(self, problem: Problem) -> Hashable:
         """The base key, kept while the same problem object comes back (it holds the same
@@ -137,7 +137,7 @@ class DaqpBackend(StatefulBackend):
         (fixed objects, rewritten in place from one solve to the next), empty placeholders
         for its absent blocks, and the set-up's buffer and sizes."""
         A, G, lb, ub, empty = problem.A, problem.G, problem.lb, problem.ub, EMPTY_VECTOR
-        self._bound, self._c_args, self._warm_call = problem, None, None
+        self._bound, self._c_args, self._attempt_call = problem, None, None
         self._stack = (
             problem.P,
             problem.q,
@@ -341,13 +341,13 @@ class DaqpBackend(StatefulBackend):
             return None
         if not self._warm and self._structure is None:  # a new set-up: solve
             return None
-        if self._warm_call is None or self._warm_call.tolerance != self.tolerance:
+        if self._attempt_call is None or self._attempt_call.tolerance != self.tolerance:
             given = self._stack[:8]
             if not all(a.flags.writeable or a.size == 0 for a in given):
                 return None
             n, p, m, ms, flags = self._layout
             work = self._c
-            self._warm_call = daqp_c.AttemptCall(
+            self._attempt_call = daqp_c.AttemptCall(
                 *(a if a.flags.writeable else np.zeros(a.shape) for a in given),  # placeholders
                 self._data,
                 work.handles,
@@ -362,8 +362,8 @@ class DaqpBackend(StatefulBackend):
                 work.x,
                 work.lam,
             )
-        self._warm_call.mode[0] = daqp_c.WARM if self._warm else daqp_c.RESTART
-        return self._warm_call
+        self._attempt_call.mode[0] = daqp_c.WARM if self._warm else daqp_c.RESTART
+        return self._attempt_call
 
     def adopt_call(self, problem: Problem, start: float, out: tuple[float, ...]) -> Solution:
         """Finish the solve of ``problem`` begun at ``start`` (``perf_counter``) whose first
@@ -371,7 +371,7 @@ class DaqpBackend(StatefulBackend):
         values, :func:`~solvers.daqp_c.stacked_solve`'s), as :meth:`solve` would: the answer
         judged (copied: the buffers are the next attempt's) and, a warm one refused, solved
         again cold."""
-        call = self._warm_call
+        call = self._attempt_call
         assert call is not None
         stage, flag, iterations, spent = out[:4]
         if stage >= daqp_c.SOLVED:  # checked or not, judged as solve judges it

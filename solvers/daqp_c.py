@@ -143,8 +143,7 @@ def stacked_solve(
         ``(stage, flag, iterations, seconds, *values)``: stage :data:`MISFITTED` a size
         misfits (nothing done), :data:`UPDATE_FAILED` (``flag`` its exit flag), or
         :data:`SOLVED` (``flag`` DAQP's exit flag); ``seconds`` inside DAQP's update and
-        solve; ``values`` those of
-        :func:`solvers._kkt.stacked` (NaN unless solved).
+        solve; ``values`` those of :func:`solvers._kkt.stacked_values` (NaN unless solved).
     """
     nan = math.nan
     rows = ms + p + m

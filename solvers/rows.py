@@ -124,12 +124,12 @@ class RowDropping:
         self.inner = inner
         self.name, self.tolerance = inner.name, inner.tolerance
         self._copy: _Copy | None = None
-        self._warm: AttemptRows | None = None  # compiled_attempt's
+        self._attempt: AttemptRows | None = None  # compiled_attempt's
 
     def reset(self) -> None:
         """Drop the inner backend's warm start and the copy's slots."""
         self.inner.reset()
-        self._copy = self._warm = None
+        self._copy = self._attempt = None
 
     def solve(self, problem: Problem, initvals: np.ndarray | None = None) -> Solution:
         """Solve ``problem`` through its compact copy."""
@@ -159,16 +159,17 @@ class RowDropping:
         copy, inner = self._copy, getattr(self.inner, "compiled_call", None)
         if inner is None or copy is None or copy.source is not problem or copy.problem is None:
             return None
-        G, h = problem.G, problem.h
-        if not (G.flags.writeable and h.flags.writeable and G.flags.c_contiguous):  # type: ignore[union-attr]
-            return None  # not packable into a struct: solve
         call = inner(copy.problem)
         if call is None:
             return None
-        if self._warm is None or self._warm.call is not call:
-            c = copy.capacity
-            self._warm = AttemptRows(G, h, copy.slot_of, copy.row_of, copy.G, copy.h, c, call)
-        return self._warm
+        kept, G, h = self._attempt, problem.G, problem.h
+        if kept is not None and kept.call is call and kept.G is G:
+            return kept
+        if not (G.flags.writeable and h.flags.writeable and G.flags.c_contiguous):  # type: ignore[union-attr]
+            return None  # not packable into a struct: solve
+        c = copy.capacity
+        self._attempt = AttemptRows(G, h, copy.slot_of, copy.row_of, copy.G, copy.h, c, call)
+        return self._attempt
 
     def adopt_attempt(self, problem: Problem, start: float, out: tuple[float, ...]) -> Solution:
         """Finish the solve of ``problem`` begun at ``start`` (``perf_counter``) that compiled

@@ -55,6 +55,11 @@ def paced_rows(tool: NDArray[np.int64]) -> tuple[NDArray[np.intp], NDArray[np.in
     )
 
 
+def _bad_command() -> ParameterError:
+    """The error of a step command with a NaN or an infinity."""
+    return ParameterError("command", "must be finite (no NaN or inf)")
+
+
 class Resolution(NamedTuple):
     """How a step's joint velocity (:attr:`Stepper.x`) was found: ``success``, ``status``
     (``"optimal"``, ``"slowed"``, ``"relaxed"``, ``"braking"`` or why it failed), the
@@ -255,27 +260,25 @@ class Stepper(Verification):
         resolve_move`), :meth:`move` made in that call too: its result, else None (then
         call :meth:`move`). A run with parts of your own, a stop's steps, levels or watched
         backend calls resolve as :meth:`resolve` does."""
+        solver = self.solver
         if self.hooks.active or self.stopping:
             return self.resolve(command, dt), None
-        if self.solver is None:
+        if solver is None:
             return self._baseline_move(command, dt)
-        packed = self.solver.fused_attempt()
+        packed = solver.fused_attempt()
         if packed is None:
             return self.resolve(command, dt), None
         started = time.perf_counter()
         self._command(command, dt)
         out = stages.resolve_move(self.struct, packed)
         status = int(out[0])
-        solver = self.solver
-        assert solver is not None
         if status == stages.MOVED:  # the resolution's time without the evaluation's
             taken = solver.took(out[3:])
             spent = time.perf_counter() - started - out[2]
-            return Resolution(True, "optimal", taken.iterations, taken.solver_time, spent), out[
-                1
-            ] == -1
+            found = Resolution(True, "optimal", taken.iterations, taken.solver_time, spent)
+            return found, out[1] == -1
         if status == stages.BAD_COMMAND:
-            raise ParameterError("command", "must be finite (no NaN or inf)")
+            raise _bad_command()
         if status != stages.ATTEMPTED:
             return self._crossed(status, started), None
         return self._resolved(solver.solve(attempted=out[3:]), started), None
@@ -289,7 +292,7 @@ class Stepper(Verification):
         if status == stages.MOVED:
             return Resolution(True, "optimal", None, spent, spent), singular == -1
         if status == stages.BAD_COMMAND:
-            raise ParameterError("command", "must be finite (no NaN or inf)")
+            raise _bad_command()
         raise self._pinv_error(int(status))
 
     def _crossed(self, joint: int, started: float) -> Resolution:
@@ -333,7 +336,7 @@ class Stepper(Verification):
         split = bool(hooks.prepared) or self.stopping
         status = int(self._prepare(s, stages.ROWS, stages.ROWS if split else stages.CLOSE))
         if status == stages.BAD_COMMAND:
-            raise ParameterError("command", "must be finite (no NaN or inf)")
+            raise _bad_command()
         if split:
             for hook in hooks.prepared:
                 hook()
