@@ -17,16 +17,17 @@ first timed run), medians in µs:
 - **dvqp's step**, the whole step of ``dvqp.plan`` (``Trajectory.step_time``), DAQP and the
   baseline (``pinv``), and its stages: kinematics (the compiled kinematics kernel alone),
   obstacles (the rest of the measure stage: every shape's distances, the link pairs, and the
-  real links), objective, dampers (their distances), QP assembly (``Stepper.prepare``: the task
-  rows, cost, bounds and damper rows; the baseline's includes its whole eq. 18), solve (the time
-  inside DAQP's calls, ``solver_time``), the backend layer (the rest of ``solve_time``, the
-  resolution's time without the evaluation of the state reached: the row dropping, the data
-  copy, the residual check of the answer, the structs' crossing into compiled code and the
-  resolver's Python around it), the exact verification
-  (the conclusion without a sample) and recording (what the sample adds); "rest" is the step
-  less those (Python: ``advance``, the schedule, the recorder). The stages are timed on the
-  run's own states, one at a time (each is a call into compiled code of its own, about
-  0.3 µs of which is the call); the step, solve and layer are the run's own timers.
+  real links), objective, dampers (their distances), QP assembly (:func:`dvqp.step.stages.
+  prepare`: the task rows, cost, bounds and damper rows; the baseline's includes its whole
+  eq. 18), solve (the time inside DAQP's calls, ``solver_time``), the backend layer (the rest
+  of ``solve_time``, the resolution's time without the evaluation of the state reached: the
+  schedule's command, the row dropping, the data copy, the residual check of the answer),
+  the exact verification (the conclusion without a sample) and recording (what the sample
+  adds); "rest" is the step less those: the run's compiled loop (:mod:`dvqp.motion.follow`:
+  the step's record and count) and the Python of the steps it hands over (refused, split).
+  The stages are timed on the run's own states, one compiled call at a time, less the time of
+  a call that runs no stage (about 0.3 µs); the step, solve and layer are the run's own
+  timers, read inside the loop.
 - **Per bundled scene**, pinv's and DAQP's median step and its ratio to the paper scene's
   (bracketed: the mean of the paper scene's runs just before and after it, this machine's
   speed drifting; median over the repeats), and, within each DAQP run, the median of its
@@ -146,23 +147,29 @@ def stage_times(scene: dvqp.Scene, backend: str, traj: dvqp.Trajectory) -> dict[
     found: dict[str, list[float]] = {k: [] for k in STAGES}
     evaluate = stages.evaluate
     OBJECTIVE, DAMPERS, CONCLUDE = stages.OBJECTIVE, stages.DAMPERS, stages.CONCLUDE
+    prepare = stages.prepare_baseline if a.pinv.baseline else stages.prepare
+    nothing = CONCLUDE + 1  # a stage past the last: the call alone
     for k in range(traj.n_steps):
         stepper.observe(traj.qdot[k - 1] if k else np.zeros(scene.robot.n), dt)
         stepper.load(traj.q[k])
-        kin = timed(lambda: kinematics(model, scene.pipe_radius, state))
-        measure = timed(lambda: evaluate(s, False, stages.MEASURE, stages.MEASURE))
+        call = timed(lambda: evaluate(s, False, nothing, nothing))
+        kin = timed(lambda: kinematics(model, scene.pipe_radius, state)) - call
+        measure = timed(lambda: evaluate(s, False, stages.MEASURE, stages.MEASURE)) - call
         found["kinematics"].append(kin)
-        links = timed(lambda: evaluate(s, False, stages.LINKS, stages.LINKS))
+        links = timed(lambda: evaluate(s, False, stages.LINKS, stages.LINKS)) - call
         found["obstacles"].append(measure - kin + links)
-        found["objective"].append(timed(lambda: evaluate(s, False, OBJECTIVE, OBJECTIVE)))
-        found["dampers"].append(timed(lambda: evaluate(s, False, DAMPERS, DAMPERS)))
+        found["objective"].append(timed(lambda: evaluate(s, False, OBJECTIVE, OBJECTIVE)) - call)
+        found["dampers"].append(timed(lambda: evaluate(s, False, DAMPERS, DAMPERS)) - call)
         stepper.record_at[0] = -1
-        verify = timed(lambda: evaluate(s, False, CONCLUDE, CONCLUDE))
+        verify = timed(lambda: evaluate(s, False, CONCLUDE, CONCLUDE)) - call
         found["verification"].append(verify)
         stepper.record_at[0] = k
-        found["recording"].append(timed(lambda: evaluate(s, False, CONCLUDE, CONCLUDE)) - verify)
+        found["recording"].append(
+            timed(lambda: evaluate(s, False, CONCLUDE, CONCLUDE)) - call - verify
+        )
         stepper.record_at[0] = -1
-        found["QP assembly"].append(timed(lambda: stepper.prepare(command, dt)))
+        stepper.prepare(command, dt)  # the command and dt written
+        found["QP assembly"].append(timed(lambda: prepare(s, stages.ROWS, stages.CLOSE)) - call)
     return {k: float(np.median(v)) for k, v in found.items() if v}
 
 

@@ -27,6 +27,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba.extending import register_jitable
 
 from .residuals import Residuals
 from .solution import Solution
@@ -51,6 +52,7 @@ def metrics_of(res: Residuals | None) -> tuple[float, float, float] | None:
     return _metrics(res.equality, res.inequality, res.bounds, res.stationarity, res.duality_gap)
 
 
+@register_jitable
 def kernel_metrics(values: tuple[float, ...]) -> tuple[float, float, float]:
     """``(r_p, r_d, r_g)`` of the kernel ``values`` of an answer that passed the check
     (:func:`solvers.residuals.accepts`: it has every multiplier)."""
@@ -58,11 +60,29 @@ def kernel_metrics(values: tuple[float, ...]) -> tuple[float, float, float]:
     return _metrics(equality, inequality, bounds, stationarity, gap)
 
 
+@register_jitable
 def _metrics(
     equality: float, inequality: float, bounds: float, stationarity: float, gap: float
 ) -> tuple[float, float, float]:
     """qpbenchmark's primal residual, dual residual and duality gap."""
     return max(equality, inequality, bounds), stationarity, gap
+
+
+@register_jitable
+def log_term(value: float) -> float:
+    """A metric's term in its running sum (:attr:`AccuracyTally.log_sums`):
+    ``log1p(value / SHIFT)``."""
+    return math.log1p(value / SHIFT)
+
+
+@register_jitable
+def add_kernel_metrics(log_sums: np.ndarray, values: tuple[float, ...]) -> None:
+    """:meth:`AccuracyTally.add_metrics` of an accepted answer's kernel ``values``
+    (:func:`kernel_metrics`) made in compiled code: its terms added to ``log_sums`` (3,), the
+    tally's sums, in place (the caller counts the solve)."""
+    metrics = kernel_metrics(values)
+    for i in range(3):
+        log_sums[i] += log_term(metrics[i])
 
 
 def shifted_geometric_mean(values: np.ndarray | list[float], shift: float = SHIFT) -> float:
@@ -112,7 +132,7 @@ class AccuracyTally:
             values = (tolerance,) * 3
         self.solves += 1
         for i, value in enumerate(values):
-            self.log_sums[i] += math.log1p(value / SHIFT)
+            self.log_sums[i] += log_term(value)
 
     def merge(self, other: AccuracyTally) -> None:
         """Add another tally's solves (e.g. another run's)."""

@@ -76,6 +76,11 @@ class AccelerationLimit(Limit):
         place."""
         np.copyto(self._previous, qdot)
 
+    def observed_into(self) -> NDArray[np.float64] | None:
+        """:attr:`previous`: :meth:`observe` copies the velocity there, and a run's compiled
+        loop may do the same (None if a subclass observes otherwise)."""
+        return None if overrides(self, AccelerationLimit, "observe") else self._previous
+
     def compute(self, state: KinematicState, dt: float) -> Bounds:
         """The box :func:`acceleration_bounds` intersects at ``state`` for a step of ``dt`` s
         (after the velocity last observed)."""

@@ -150,5 +150,12 @@ class Limit:
         """The joint velocity (rad/s) applied over the step just taken (a limit that remembers
         motion keeps it; the default forgets it)."""
 
+    def observed_into(self) -> NDArray[np.float64] | None:
+        """Where a run's compiled loop may write the joint velocity (rad/s, (n,)) applied
+        over a step instead of calling :meth:`observe` (an array the limit reads), or None:
+        its steps call :meth:`observe` from Python. The default, which forgets what it is
+        shown, needs neither."""
+        return None
+
     def reset(self) -> None:
         """A run starts (at rest): forget what was observed."""

@@ -12,6 +12,7 @@ reference ``x_d`` is interpolated linearly between its samples.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -19,6 +20,8 @@ from numpy.typing import NDArray
 from dvqp.errors import ParameterError
 from dvqp.kinematics.developed_view import wrap_period
 from dvqp.motion.deviation import path_deviation
+from dvqp.workspace import as_struct
+from solvers.jit import njit
 
 Array = NDArray[np.float64]
 
@@ -26,7 +29,15 @@ MAX_SLOWDOWN = 4.0
 """A time-scaled run takes at most this many times its nominal steps; a path not finished by
 then is reported as not reached (:func:`dvqp.run.planning.check_run`)."""
 
-__all__ = ["MAX_SLOWDOWN", "TIMINGS", "Schedule", "dv_error", "path_deviation"]
+__all__ = [
+    "MAX_SLOWDOWN",
+    "TIMINGS",
+    "Schedule",
+    "ScheduleArrays",
+    "command_into",
+    "dv_error",
+    "path_deviation",
+]
 
 TIMINGS = ("fixed", "scaled")
 """How a path's progress is timed: the nominal schedule, or slowed where the limits bind."""
@@ -38,6 +49,24 @@ def dv_error(reference: Array, actual: Array, radius: float) -> Array:
     # l and α (components 0 and 3) in one call: periods 2πR and 2π (wrap, wrap_angle)
     e[..., ::3] = wrap_period(e[..., ::3], np.array([2.0 * math.pi * radius, 2.0 * math.pi]))
     return e
+
+
+@dataclass(frozen=True)
+class ScheduleArrays:
+    """A :class:`Schedule` as compiled code reads it (:func:`command_into`): ``commands``
+    (N, 4), ``reference`` (N, 4; (0, 4) without feedback), the time-scaled path's ``nodes``
+    (N + 1, 4; (0, 4) at fixed timing), the gain ``K`` (1/s), ``dt`` (s), the pipe's
+    ``radius`` (m), ``n = N`` and the two flags."""
+
+    commands: Array
+    reference: Array
+    nodes: Array
+    gain: float
+    dt: float
+    radius: float
+    n: int
+    feedback: bool
+    scaled: bool
 
 
 class Schedule:
@@ -76,6 +105,20 @@ class Schedule:
         self.budget = math.ceil(MAX_SLOWDOWN * self.n) if scaled else self.n
         """The most steps the run takes."""
         self.nodes = np.vstack([reference, reference[-1:] + dt * commands[-1:]]) if scaled else None
+        none = np.zeros((0, 4))
+        self.arrays = ScheduleArrays(
+            np.ascontiguousarray(commands, dtype=np.float64),
+            none if reference is None else np.ascontiguousarray(reference, dtype=np.float64),
+            none if self.nodes is None else np.ascontiguousarray(self.nodes),
+            float(gain),
+            float(dt),
+            float(radius),
+            int(self.n),
+            bool(self.feedback),
+            bool(scaled),
+        )
+        """The schedule for compiled code (:func:`command_into`)."""
+        self.struct = as_struct(self.arrays)
 
     def done(self, u: float) -> bool:
         """The nominal schedule has run to its end at progress ``u``."""
@@ -83,22 +126,64 @@ class Schedule:
 
     def position(self, u: float) -> Array:
         """``x_d(u)``, shape (4,): the reference at progress ``u`` (time-scaled runs)."""
-        nodes = self.nodes
-        assert nodes is not None
-        i = min(int(u), self.n - 1)
-        return nodes[i] + (u - i) * (nodes[i + 1] - nodes[i])
+        assert self.nodes is not None
+        out = np.empty(4)
+        _position(self.struct, u, out)
+        return out
+
+    def span(self, u: float) -> float:
+        """The progress a step from ``u`` makes at full rate: 1, less at a time-scaled run's
+        last step."""
+        return min(1.0, self.n - u) if self.scaled else 1.0
 
     def command(self, u: float, tool: Array) -> tuple[Array, Array | None, float]:
         """The tool command at progress ``u`` with the tool at ``tool`` (4,): the command (4,),
         its feed-forward for :meth:`dvqp.step.Stepper.pace` (None: fixed timing) and the
-        progress the step makes at full rate (1, less at a time-scaled run's last step)."""
-        if not self.scaled:
-            k = int(u)
-            xdot = self.commands[k]
-            if self.feedback:
-                xdot = xdot + self.gain * dv_error(self.reference[k], tool, self.radius)  # type: ignore[index]
-            return xdot, None, 1.0
-        span = min(1.0, self.n - u)
-        here = self.position(u)
-        feedforward = (self.position(u + span) - here) / self.dt
-        return feedforward + self.gain * dv_error(here, tool, self.radius), feedforward, span
+        progress the step makes at full rate (:meth:`span`)."""
+        xdot, feedforward = np.empty(4), np.empty(4)
+        span = command_into(self.struct, u, np.array(tool, dtype=np.float64), xdot, feedforward)
+        return xdot, feedforward if self.scaled else None, span
+
+
+@njit(inline="always")
+def _position(a, u, out):  # type: ignore[no-untyped-def]
+    """``x_d(u)`` into ``out`` (4,): the path's nodes interpolated linearly."""
+    i = min(int(u), a.n - 1)
+    for c in range(4):
+        out[c] = a.nodes[i, c] + (u - i) * (a.nodes[i + 1, c] - a.nodes[i, c])
+
+
+@njit
+def command_into(a, u, tool, xdot, feedforward):  # type: ignore[no-untyped-def]
+    """The tool command of the schedule ``a`` (:class:`ScheduleArrays`) at progress ``u`` with
+    the tool at ``tool`` (4,), written into ``xdot`` (4,), and at a time-scaled run its
+    feed-forward into ``feedforward`` (4,; untouched at fixed timing); returns the progress
+    the step makes at full rate.
+
+    Fixed timing: command ``k = int(u)``, plus ``K (x_d[k] − x)`` with feedback. Time-scaled:
+    the nominal motion from ``x_d(u)`` to ``x_d(u + span)`` over ``dt``, plus
+    ``K (x_d(u) − x)``. ``x_d − x`` wraps l modulo 2πR and α modulo 2π (:func:`dv_error`).
+    """
+    periods = (2.0 * math.pi * a.radius, 0.0, 0.0, 2.0 * math.pi)
+    if not a.scaled:
+        k = int(u)
+        for c in range(4):
+            xdot[c] = a.commands[k, c]
+        if a.feedback:
+            for c in range(4):
+                e = a.reference[k, c] - tool[c]
+                if c == 0 or c == 3:
+                    e = wrap_period(e, periods[c])
+                xdot[c] = xdot[c] + a.gain * e
+        return 1.0
+    span = min(1.0, a.n - u)
+    here, ahead = np.empty(4), np.empty(4)
+    _position(a, u, here)
+    _position(a, u + span, ahead)
+    for c in range(4):
+        feedforward[c] = (ahead[c] - here[c]) / a.dt
+        e = here[c] - tool[c]
+        if c == 0 or c == 3:
+            e = wrap_period(e, periods[c])
+        xdot[c] = feedforward[c] + a.gain * e
+    return span

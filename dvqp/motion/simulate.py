@@ -22,6 +22,7 @@ from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
+from dvqp.motion.follow import Follower
 from dvqp.motion.recorder import TrajectoryRecorder
 from dvqp.motion.schedule import Schedule, dv_error
 from dvqp.motion.stop import brake, room
@@ -159,17 +160,13 @@ def simulate(
     record = TrajectoryRecorder(
         cmd.shape[0] + reserved, robot.n, robot.n_points, robot.has_rail, len(levels)
     )
+    schedule = Schedule(cmd, ref, gain, dt, radius, time_scaling)
     with _noticed(notice):
         stepper = Stepper(robot, radius, resolver, q_start, dt, obstacles, record.arrays)
-        stepper.start(q_start)
-        if cmd.shape[0]:  # compile (or load) the step's every call now, then start afresh
-            stepper.resolve(cmd[0], dt)
-            stepper.record_at[0] = 0
-            stepper.start(q_start)
+        follower = _compiled(stepper, Follower(stepper, record, schedule, check), q_start)
     if watch is not None and stepper.solver is not None:
         stepper.solver.watchers.append(lambda kind, p, s: watch(record.steps, kind, p, s))
-    schedule = Schedule(cmd, ref, gain, dt, radius, time_scaling)
-    n, path_time = _follow(stepper, record, schedule, check, max_halvings, progress)
+    n, path_time = _follow(stepper, record, schedule, follower, check, max_halvings, progress)
     steps = brake(stepper, record, n, dt, verify=check, max_halvings=max_halvings) if stop else 0
     solver = stepper.solver
     refused = {} if solver is None else dict(solver.refusals)
@@ -190,34 +187,68 @@ def simulate(
     return dataclasses.replace(traj, path_time=np.concatenate([path_time, held]))
 
 
+def _compiled(stepper: Stepper, follower: Follower, q0: Array) -> Follower:
+    """Compile (or load) every call of the run's step and loop (a step of its first command,
+    none of the loop), then start afresh from ``q0``."""
+    stepper.start(q0)
+    schedule = follower.schedule
+    if schedule.n:
+        stepper.resolve(schedule.commands[0], schedule.dt)
+        follower.compile()
+        stepper.record_at[0] = 0
+        stepper.start(q0)
+    return follower
+
+
 def _follow(
     stepper: Stepper,
     record: TrajectoryRecorder,
     schedule: Schedule,
+    follower: Follower,
     check: bool,
     max_halvings: int,
     progress: Progress | None,
 ) -> tuple[int, Array]:
-    """Run the schedule's commands; the steps taken and the nominal time (s) at each sample."""
+    """Run the schedule's commands; the steps taken and the nominal time (s) at each sample.
+
+    The common steps run in the compiled loop (:mod:`dvqp.motion.follow`), the others here:
+    the step it hands over (made, not taken), or each step when it cannot run (parts of
+    your own, watched backend calls)."""
     u, k, dt = 0.0, 0, schedule.dt
-    reached = [0.0]
     started = time.perf_counter()
     while not schedule.done(u) and k < schedule.budget:
         if k >= record.arrays["qdot"].shape[0]:  # a slowed run outgrew its room
             record.extend(schedule.n)
             stepper.record_into(record.arrays)
-        xdot, feedforward, span = schedule.command(u, stepper.state.tool)
-        if schedule.scaled:  # fixed timing: the feed-forward stays 0, nothing to write
-            stepper.pace(feedforward)
-        moved = advance(stepper, xdot, dt, verify=check, max_halvings=max_halvings, record=k + 1)
+        first = k
+        k, u, started, made = follower.run(k, u, started)
+        if progress is not None:
+            for j in range(first + 1, k + 1):
+                progress(_done(schedule, follower.progress[j], j), schedule.n)
+        if made is None:
+            if k > first:
+                continue  # stopped before step k: the schedule's end, its budget, or no room
+            xdot, feedforward, span = schedule.command(u, stepper.state.tool)
+            if schedule.scaled:  # fixed timing: the feed-forward stays 0, nothing to write
+                stepper.pace(feedforward)
+        else:  # step k, made by the loop from its command
+            xdot, span = stepper.arrays.command.copy(), schedule.span(u)
+        moved = advance(
+            stepper, xdot, dt, verify=check, max_halvings=max_halvings, record=k + 1, made=made
+        )
         now = time.perf_counter()
         record.step(k, moved, now - started)
         started = now
         u += (moved.step.rate if schedule.scaled else 1.0) * span
         k += 1
-        reached.append(min(u, schedule.n) * dt)
+        follower.progress[k] = u
         if progress is not None:
-            progress(min(round(u), schedule.n) if schedule.scaled else k, schedule.n)
+            progress(_done(schedule, u, k), schedule.n)
     if schedule.scaled:
         stepper.pace(None)  # the stop, and whatever runs next, at fixed timing
-    return k, np.asarray(reached)
+    return k, np.minimum(follower.progress[: k + 1], schedule.n) * dt
+
+
+def _done(schedule: Schedule, u: float, k: int) -> int:
+    """The nominal steps done after step ``k`` at progress ``u`` (for ``progress``)."""
+    return min(round(float(u)), schedule.n) if schedule.scaled else k

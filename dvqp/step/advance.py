@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 from dvqp.limits import NO_EXCESS, Excess
 from dvqp.resolution.step import Step
-from dvqp.step.engine import Stepper
+from dvqp.step.engine import Made, Stepper
 
 MAX_HALVINGS = 5
 """A step is split into at most 2⁵ = 32 substeps before it is declared failed."""
@@ -54,6 +54,7 @@ def advance(
     verify: bool = True,
     max_halvings: int = MAX_HALVINGS,
     record: int = -1,
+    made: Made | None = None,
 ) -> Advance:
     """Resolve and integrate one step of ``dt`` seconds from the stepper's loaded state.
 
@@ -72,10 +73,14 @@ def advance(
         Most times a step is halved, >= 0.
     record
         The trajectory sample the state reached is written to (−1: none).
+    made
+        The step's compiled call, already made for ``command`` and ``dt`` by a run's compiled
+        loop (:func:`dvqp.motion.follow.follow`) from ``made.start``, loaded then: the step
+        goes on from its values.
     """
-    start = stepper.state.q.copy()
+    start = stepper.state.q.copy() if made is None else made.start
     stepper.record_at[0] = record
-    moved = _attempt(stepper, start, command, dt, 0, verify, max_halvings)
+    moved = _attempt(stepper, start, command, dt, 0, verify, max_halvings, made)
     if moved.substeps > 1 and moved.step.success:
         end = stepper.state.q.copy()
         stepper.record_at[0] = -1
@@ -100,9 +105,10 @@ def _attempt(
     depth: int,
     verify: bool,
     halvings: int,
+    made: Made | None = None,
 ) -> Advance:
-    """A step of ``dt`` from ``q`` (loaded), halved while it breaks a limit."""
-    found, reached = stepper.resolve_and_move(command, dt)
+    """A step of ``dt`` from ``q`` (loaded, or ``made``'s), halved while it breaks a limit."""
+    found, reached = stepper.resolve_and_move(command, dt, made)
     if not found.success:
         stepper.observe(np.zeros_like(q), dt)
         failed = Step(

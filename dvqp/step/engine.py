@@ -13,7 +13,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import replace
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -55,9 +55,35 @@ def paced_rows(tool: NDArray[np.int64]) -> tuple[NDArray[np.intp], NDArray[np.in
     )
 
 
+def observing(limits: tuple[Limit, ...]) -> list[Limit]:
+    """The ``limits`` that keep the velocity they are shown (:meth:`Limit.observe`)."""
+    return [limit for limit in limits if type(limit).observe is not Limit.observe]
+
+
+def observed_into(observers: list[Limit]) -> Array | None:
+    """The one array where compiled code writes the velocity the ``observers`` (limits that
+    observe it) are shown (size 0 without observers), or None when one observes it only in
+    Python (:meth:`Limit.observed_into`) or there are several."""
+    if not observers:
+        return np.zeros(0)
+    into = [limit.observed_into() for limit in observers]
+    return into[0] if len(into) == 1 else None
+
+
 def _bad_command() -> ParameterError:
     """The error of a step command with a NaN or an infinity."""
     return ParameterError("command", "must be finite (no NaN or inf)")
+
+
+class Made(NamedTuple):
+    """A step's compiled call made by a run's compiled loop and handed back to Python to
+    finish (:meth:`Stepper.resolve_and_move`): the configuration it started from (rad, (n,)),
+    when its resolution started (``time.perf_counter``'s s) and the call's values
+    (:func:`~dvqp.step.stages.resolve_move`'s, or the baseline's)."""
+
+    start: Array
+    started: float
+    values: tuple[float, ...]
 
 
 class Resolution(NamedTuple):
@@ -143,18 +169,18 @@ class Stepper(Verification):
         """(L,): each level's ``‖A_k x − b_k‖∞`` of the last :meth:`move` (task units per s),
         levels by priority (1 first)."""
         self.limits: tuple[Limit, ...] = spec.limits
-        self._observers = [
-            lim
-            for lim in spec.limits
-            if type(lim).observe is not Limit.observe and resolver.holds_limits
-        ]
+        self._observers = observing(spec.limits) if resolver.holds_limits else []
+        self.observed = observed_into(self._observers)
+        """Where the velocity of a step is observed in compiled code (:meth:`Limit.
+        observed_into`; size 0: nowhere), or None: only :meth:`observe` observes it."""
         self.stopping = False
         """Braking steps: the hard tasks' right sides and the cost's linear part are 0 (the
         tool and every task held still, λ = 0), a damper holds a drift below its safe value
         instead of pulling it back (right side at least 0), and Q̇ = 0 is taken when it is
         feasible (:meth:`~dvqp.resolution.qp.QPSolver.solve`)."""
-        self._paced = paced_rows(tasks.tool)
-        """The tool tasks' rows and the command's components they take (:meth:`pace`)."""
+        self.paced = paced_rows(tasks.tool)
+        """The tool tasks' rows and the command's components they take (:meth:`pace`), two
+        index arrays."""
         if tasks.levels.shape[0] > 2:
             self._check_levels(q0, dt)
 
@@ -254,23 +280,56 @@ class Stepper(Verification):
             return self._crossed(status, started)
         return self._resolved(self.solver.solve(rest=self.stopping), started)
 
-    def resolve_and_move(self, command: Array, dt: float) -> tuple[Resolution, bool | None]:
+    def resolve_and_move(
+        self, command: Array, dt: float, made: Made | None = None
+    ) -> tuple[Resolution, bool | None]:
         """:meth:`resolve`, and when its answer is taken in the compiled call that wrote the
         QP (the strict problem's warm attempt accepted: :func:`~dvqp.step.stages.
         resolve_move`), :meth:`move` made in that call too: its result, else None (then
         call :meth:`move`). A run with parts of your own, a stop's steps, levels or watched
-        backend calls resolve as :meth:`resolve` does."""
+        backend calls resolve as :meth:`resolve` does.
+
+        ``made``: that compiled call already made, for ``command`` and ``dt``, by a run's
+        compiled loop (:func:`dvqp.motion.follow.follow`, which stops at a step it cannot
+        take as it is): this finishes the step from its values."""
         solver = self.solver
+        if made is not None:
+            if solver is None:
+                return self._baseline_moved(made.values, made.started)
+            return self._fused(solver, made.values, made.started)
         if self.hooks.active or self.stopping:
             return self.resolve(command, dt), None
         if solver is None:
-            return self._baseline_move(command, dt)
+            started = time.perf_counter()
+            self._command(command, dt)
+            values = stages.resolve_move_baseline(self.struct, clock.address())
+            return self._baseline_moved(values, started)
         packed = solver.fused_attempt()
         if packed is None:
             return self.resolve(command, dt), None
         started = time.perf_counter()
         self._command(command, dt)
-        out = stages.resolve_move(self.struct, packed)
+        return self._fused(solver, stages.resolve_move(self.struct, packed), started)
+
+    def fused(self) -> tuple[Any, bool] | None:
+        """What a run's compiled loop resolves its common steps with, when it may
+        (:func:`dvqp.motion.follow.follow`): ``(packed, True)``, the strict backend's packed
+        attempt (:meth:`~dvqp.resolution.qp.QPSolver.fused_attempt`), or ``(clock, False)``
+        for the baseline (:func:`solvers.clock.address`); None when the steps resolve in
+        Python (parts of your own, a stop's steps, levels, watched backend calls, a limit
+        that observes the velocity only in Python)."""
+        if self.hooks.active or self.stopping or self.observed is None:
+            return None
+        if self.solver is None:
+            return clock.address(), False
+        packed = self.solver.fused_attempt()
+        return None if packed is None else (packed, True)
+
+    def _fused(
+        self, solver: QPSolver, out: tuple[float, ...], started: float
+    ) -> tuple[Resolution, bool | None]:
+        """The step whose strict attempt :func:`~dvqp.step.stages.resolve_move` made (its
+        values ``out``; the resolution started at ``started``, ``time.perf_counter``'s s)."""
         status = int(out[0])
         if status == stages.MOVED:  # the resolution's time without the evaluation's
             taken = solver.took(out[3:])
@@ -283,11 +342,12 @@ class Stepper(Verification):
             return self._crossed(status, started), None
         return self._resolved(solver.solve(attempted=out[3:]), started), None
 
-    def _baseline_move(self, command: Array, dt: float) -> tuple[Resolution, bool | None]:
-        """The baseline's :meth:`resolve_and_move`: its step and the move in one call."""
-        started = time.perf_counter()
-        self._command(command, dt)
-        status, singular, moving = stages.resolve_move_baseline(self.struct, clock.address())
+    def _baseline_moved(
+        self, values: tuple[float, ...], started: float
+    ) -> tuple[Resolution, bool | None]:
+        """The baseline's step made by :func:`~dvqp.step.stages.resolve_move_baseline` (its
+        ``values``), as :meth:`resolve_and_move` returns it."""
+        status, singular, moving = values[:3]
         spent = time.perf_counter() - started - moving
         if status == stages.MOVED:
             return Resolution(True, "optimal", None, spent, spent), singular == -1
@@ -324,7 +384,7 @@ class Stepper(Verification):
         v = self.solver.feedforward
         v[:] = 0.0
         if feedforward is not None:
-            rows, components = self._paced
+            rows, components = self.paced
             v[rows] = feedforward[components]
 
     def prepare(self, command: Array, dt: float) -> int:
