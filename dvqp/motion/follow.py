@@ -16,7 +16,6 @@ from the same clock, ``time.perf_counter``'s, in compiled code).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -37,6 +36,8 @@ from solvers.jit import njit
 Array = NDArray[np.float64]
 Index = NDArray[np.int64]
 
+MADE = 15
+"""The values of a step's compiled call (:func:`~dvqp.step.stages.resolve_move`'s)."""
 STOPPED, HANDED = 0.0, 1.0
 """How :func:`follow` returns: it stopped before a step (the schedule's end, ``until``), or
 it hands a step it made but cannot take as it is to Python."""
@@ -54,8 +55,9 @@ class FollowArrays:
     and command components it paces (:meth:`dvqp.step.Stepper.pace`); where the velocity is
     observed (``observed`` (n,), size 0: nowhere); the accuracy tally's ``log_sums`` (3,) and
     ``solves`` (1,) counted here; ``start`` (n,) the configuration the last step started
-    from; ``nominal`` (4,) scratch; ``verify`` (check every limit) and ``stride`` (rad, the
-    largest joint motion of a step checked at its end only)."""
+    from and ``made`` (15,) its compiled call's values; ``nominal`` (4,) scratch; ``verify``
+    (check every limit) and ``stride`` (rad, the largest joint motion of a step checked at
+    its end only)."""
 
     schedule: ScheduleArrays
     solve_time: Array
@@ -75,6 +77,7 @@ class FollowArrays:
     log_sums: Array
     solves: Index
     start: Array
+    made: Array
     nominal: Array
     verify: bool
     stride: float
@@ -138,6 +141,7 @@ class Follower:
             np.zeros(3),
             np.zeros(1, np.int64),
             np.zeros(stepper.robot.n),
+            np.zeros(MADE),
             np.zeros(4),
             bool(self.verify),
             float(JOINT_STRIDE),
@@ -177,7 +181,7 @@ class Follower:
             record.steps = reached
         if out[0] != HANDED:
             return Followed(reached, float(out[2]), float(out[3]), None)
-        made = Made(arrays.start.copy(), float(out[4]), tuple(float(v) for v in out[5:]))
+        made = Made(arrays.start.copy(), float(out[4]), tuple(arrays.made.tolist()))
         return Followed(reached, float(out[2]), float(out[3]), made)
 
 
@@ -204,7 +208,9 @@ def _loop(resolve, s, handle, clock, f, k, u, started, until, counted):  # type:
             or out[1] != -1.0
             or (f.verify and (not s.checks.excess[1] <= 1.0 or s.motion[1] > f.stride))
         ):
-            return (HANDED, float(k), u, started, begun, *out)
+            for i in range(MADE):
+                f.made[i] = out[i]
+            return (HANDED, float(k), u, started, begun)
         ended = now(clock)
         x = s.x
         for i in range(x.shape[0]):
@@ -232,11 +238,7 @@ def _loop(resolve, s, handle, clock, f, k, u, started, until, counted):  # type:
         u += span
         k += 1
         f.progress[k] = u
-    return (STOPPED, float(k), u, started, 0.0, *NOT_MADE)
-
-
-NOT_MADE = (math.nan,) * 3 + NOT_ATTEMPTED
-"""The values of a step not made."""
+    return (STOPPED, float(k), u, started, 0.0)
 
 
 @njit(inline="always")
@@ -256,10 +258,10 @@ def follow(s, w, f, k, u, started, until):  # type: ignore[no-untyped-def]
 
     Returns
     -------
-    tuple of 20 floats
-        ``(how, k, u, started, begun, *values)``: :data:`STOPPED` before step ``k``, or
-        :data:`HANDED` with step ``k`` made, its resolution begun at ``begun`` and its
-        compiled call's ``values`` (:func:`~dvqp.step.stages.resolve_move`'s).
+    tuple of 5 floats
+        ``(how, k, u, started, begun)``: :data:`STOPPED` before step ``k``, or
+        :data:`HANDED` with step ``k`` made, its resolution begun at ``begun``, its compiled
+        call's values (:func:`~dvqp.step.stages.resolve_move`'s) in ``f.made``.
     """
     return _loop(resolve_move, s, w, w.call.handles[H_CLOCK], f, k, u, started, until, True)
 

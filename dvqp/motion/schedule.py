@@ -124,13 +124,6 @@ class Schedule:
         """The nominal schedule has run to its end at progress ``u``."""
         return u >= self.n - 1e-9
 
-    def position(self, u: float) -> Array:
-        """``x_d(u)``, shape (4,): the reference at progress ``u`` (time-scaled runs)."""
-        assert self.nodes is not None
-        out = np.empty(4)
-        _position(self.struct, u, out)
-        return out
-
     def span(self, u: float) -> float:
         """The progress a step from ``u`` makes at full rate: 1, less at a time-scaled run's
         last step."""
@@ -146,11 +139,20 @@ class Schedule:
 
 
 @njit(inline="always")
-def _position(a, u, out):  # type: ignore[no-untyped-def]
-    """``x_d(u)`` into ``out`` (4,): the path's nodes interpolated linearly."""
+def _position(a, u, c):  # type: ignore[no-untyped-def]
+    """Component ``c`` of ``x_d(u)``: the path's nodes interpolated linearly."""
     i = min(int(u), a.n - 1)
-    for c in range(4):
-        out[c] = a.nodes[i, c] + (u - i) * (a.nodes[i + 1, c] - a.nodes[i, c])
+    return a.nodes[i, c] + (u - i) * (a.nodes[i + 1, c] - a.nodes[i, c])
+
+
+@njit(inline="always")
+def _wrapped(a, e, c):  # type: ignore[no-untyped-def]
+    """Component ``c`` of a DV difference ``e``, l wrapped modulo 2πR and α modulo 2π."""
+    if c == 0:
+        return wrap_period(e, 2.0 * math.pi * a.radius)
+    if c == 3:
+        return wrap_period(e, 2.0 * math.pi)
+    return e
 
 
 @njit
@@ -164,26 +166,16 @@ def command_into(a, u, tool, xdot, feedforward):  # type: ignore[no-untyped-def]
     the nominal motion from ``x_d(u)`` to ``x_d(u + span)`` over ``dt``, plus
     ``K (x_d(u) − x)``. ``x_d − x`` wraps l modulo 2πR and α modulo 2π (:func:`dv_error`).
     """
-    periods = (2.0 * math.pi * a.radius, 0.0, 0.0, 2.0 * math.pi)
     if not a.scaled:
         k = int(u)
         for c in range(4):
             xdot[c] = a.commands[k, c]
-        if a.feedback:
-            for c in range(4):
-                e = a.reference[k, c] - tool[c]
-                if c == 0 or c == 3:
-                    e = wrap_period(e, periods[c])
-                xdot[c] = xdot[c] + a.gain * e
+            if a.feedback:
+                xdot[c] = xdot[c] + a.gain * _wrapped(a, a.reference[k, c] - tool[c], c)
         return 1.0
     span = min(1.0, a.n - u)
-    here, ahead = np.empty(4), np.empty(4)
-    _position(a, u, here)
-    _position(a, u + span, ahead)
     for c in range(4):
-        feedforward[c] = (ahead[c] - here[c]) / a.dt
-        e = here[c] - tool[c]
-        if c == 0 or c == 3:
-            e = wrap_period(e, periods[c])
-        xdot[c] = feedforward[c] + a.gain * e
+        here = _position(a, u, c)
+        feedforward[c] = (_position(a, u + span, c) - here) / a.dt
+        xdot[c] = feedforward[c] + a.gain * _wrapped(a, here - tool[c], c)
     return span
