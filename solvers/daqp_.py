@@ -63,6 +63,7 @@ from . import daqp_abi, daqp_c
 from ._fast import EMPTY_MATRIX, EMPTY_VECTOR, refresh, stack
 from ._kkt import HAS_LB, HAS_UB, MISFITTING, stacked
 from .problem import Problem
+from .refusal import refusal
 from .solution import Solution, judged
 from .stateful import RawResult, StatefulBackend, solve_guarded
 
@@ -382,6 +383,21 @@ class DaqpBackend(StatefulBackend):
         if call.mode[0] == daqp_c.RESTART:  # the cold attempt: its answer is the solve's
             return self._settled(solution, start)
         return self.after_warm(problem, solution, start)
+
+    def settle_mode(self) -> None:
+        """Take the warm state that compiled code left in :meth:`compiled_call`'s ``mode``
+        after making this backend's attempts itself (a run's compiled loop also restarts it
+        cold after a refused warm answer, as :meth:`after_warm` does, and leaves ``mode``
+        :data:`~solvers.daqp_c.WARM` after an accepted answer, else
+        :data:`~solvers.daqp_c.RESTART`): the next solve starts warm only from an accepted
+        answer."""
+        if self._attempt_call is not None:
+            self._warm = bool(self._attempt_call.mode[0] == daqp_c.WARM)
+
+    def refusal_of(self, flag: float) -> str:
+        """The refusal (:func:`solvers.refusal.refusal`) a refused answer with DAQP's exit
+        ``flag`` counts as: its solution's :attr:`~solvers.Solution.refusal`."""
+        return refusal(EXIT_FLAGS.get(int(flag)) or str(int(flag)), True)
 
     def _stage_failure(self, problem: Problem, out: Any) -> RawResult:
         stage, flag = out[:2]

@@ -270,7 +270,16 @@ def solve_dropped(w):  # type: ignore[no-untyped-def]
     used = compact(w.G, w.h, w.slot_of, w.row_of, w.Gc, w.hc)
     if resized(used, w.capacity, w.hc.shape[0]) != w.capacity:
         return (-1.0, *MISFITTING, 0.0, 0.0, 0.0)
-    c = w.call
+    return attempt(w.call)
+
+
+@njit(inline="always")
+def attempt(c):  # type: ignore[no-untyped-def]
+    """The attempt of the packed :class:`AttemptCall` ``c`` on its set-up's rows as they
+    are, in its ``mode`` (:func:`stacked_solve`), its answer checked: stage
+    :data:`ACCEPTED` when it passes (:func:`solvers.residuals.accepts`). A caller that made
+    a warm attempt and saw it refused makes the backend's cold restart so, in mode
+    :data:`RESTART` (what the backend's ``after_warm`` makes)."""
     out = stacked_solve(  # read-only data: the types solve_stacked declares, one compile
         _readonly(c.P),
         _readonly(c.q),

@@ -180,6 +180,15 @@ class RowDropping:
         finish = self.inner.adopt_call  # type: ignore[attr-defined]
         return self._spread(problem, copy, finish(copy.problem, start, out))
 
+    def settle_mode(self) -> None:
+        """The inner backend's ``settle_mode`` (the warm state compiled code left it in)."""
+        self.inner.settle_mode()  # type: ignore[attr-defined]
+
+    def refusal_of(self, flag: float) -> str:
+        """The inner backend's ``refusal_of``: the refusal a refused answer with its exit
+        ``flag`` counts as."""
+        return self.inner.refusal_of(flag)  # type: ignore[attr-defined,no-any-return]
+
     def _spread(self, problem: Problem, copy: _Copy, solution: Solution) -> Solution:
         """The solution of the compact copy as ``problem``'s: ``z`` spread to its rows."""
         z = solution.z

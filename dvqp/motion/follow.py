@@ -3,12 +3,16 @@
 Most steps of a run are common: the command of the schedule, the strict QP's warm attempt
 accepted (or the baseline's step), the state reached regular and within every verified limit,
 its largest joint motion below :data:`~dvqp.step.JOINT_STRIDE` (no interior point to check).
+So is a step of a relaxed streak at fixed timing: the strict problem's cold attempt refused
+(the backend restarts cold after a refusal), the relaxed problem's warm attempt accepted.
 :func:`follow` runs such steps one after another in compiled code, each exactly as
-:func:`dvqp.step.advance` would (the same compiled calls, :func:`~dvqp.step.stages.
-resolve_move` and :func:`~dvqp.motion.schedule.command_into`), and writes each into the
-recorder's arrays. At the first step that is not common (a refused attempt, a singular
-state, a broken limit, a large step) it returns with that step's compiled call made, and
-Python finishes the step from its values (:class:`~dvqp.step.engine.Made`): judged, retried,
+:func:`dvqp.step.advance` and :meth:`~dvqp.resolution.qp.QPSolver.solve` would (the same
+compiled calls, :func:`~dvqp.step.stages.resolve_move`, :func:`~dvqp.motion.schedule.
+command_into`, :func:`~dvqp.resolution.levels.load_columns`), and writes each into the
+recorder's arrays, its accuracy and refusal counted. At the first step that is not common (a
+refused warm attempt, a time-scaled run's refusal, a relaxed attempt refused, a singular
+state, a broken limit, a large step) it returns with what it made of that step, and Python
+finishes the step from those values (:class:`~dvqp.step.engine.Made`): judged, retried,
 slowed, relaxed, split or failed as :func:`~dvqp.step.advance` does it. A run's trajectory is
 the same, bit for bit, with the loop or without it; only the times differ (the loop's are read
 from the same clock, ``time.perf_counter``'s, in compiled code).
@@ -16,6 +20,7 @@ from the same clock, ``time.perf_counter``'s, in compiled code).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -24,13 +29,24 @@ from numpy.typing import NDArray
 
 from dvqp.motion.recorder import TrajectoryRecorder
 from dvqp.motion.schedule import Schedule, ScheduleArrays, command_into
+from dvqp.resolution.levels import load_columns
 from dvqp.step import JOINT_STRIDE, Stepper
 from dvqp.step.engine import Made
-from dvqp.step.stages import MOVED, NOT_ATTEMPTED, resolve_move, resolve_move_baseline
+from dvqp.step.stages import (
+    ATTEMPTED,
+    CONCLUDE,
+    MEASURE,
+    MOVED,
+    NOT_ATTEMPTED,
+    evaluate,
+    resolve_move,
+    resolve_move_baseline,
+)
 from dvqp.workspace import as_struct
+from solvers._kkt import MISFIT
 from solvers.accuracy import add_kernel_metrics
 from solvers.clock import now
-from solvers.daqp_c import H_CLOCK
+from solvers.daqp_c import ACCEPTED, H_CLOCK, RESTART, SOLVED, WARM, attempt, solve_dropped
 from solvers.jit import njit
 
 Array = NDArray[np.float64]
@@ -38,9 +54,13 @@ Index = NDArray[np.int64]
 
 MADE = 15
 """The values of a step's compiled call (:func:`~dvqp.step.stages.resolve_move`'s)."""
+ATTEMPT = 12
+"""The values of a backend's attempt (:func:`solvers.daqp_c.solve_dropped`'s)."""
 STOPPED, HANDED = 0.0, 1.0
 """How :func:`follow` returns: it stopped before a step (the schedule's end, ``until``), or
 it hands a step it made but cannot take as it is to Python."""
+OPTIMAL, RELAXED = 0, 1
+"""The kinds of step the loop takes (``FollowArrays.kinds``)."""
 
 
 @dataclass(frozen=True)
@@ -50,14 +70,18 @@ class FollowArrays:
     ``schedule`` the run's commands; the recorder's per-step arrays (N steps, n joints, L
     levels: ``solve_time``, ``solver_time``, ``step_time``, ``task_error`` (N,) s and task
     units per s, ``level_error`` (N, L), ``iterations`` (N,), ``substeps`` (N,), ``success``
-    (N,), ``qdot`` (N, n) rad/s); ``progress`` (B + 1,): the schedule's progress ``u`` at each
-    sample; the strict problem's ``feedforward`` (m,; size 0 for the baseline) and the rows
-    and command components it paces (:meth:`dvqp.step.Stepper.pace`); where the velocity is
-    observed (``observed`` (n,), size 0: nowhere); the accuracy tally's ``log_sums`` (3,) and
-    ``solves`` (1,) counted here; ``start`` (n,) the configuration the last step started
-    from and ``made`` (15,) its compiled call's values; ``nominal`` (4,) scratch; ``verify``
-    (check every limit) and ``stride`` (rad, the largest joint motion of a step checked at
-    its end only)."""
+    (N,), ``qdot`` (N, n) rad/s); each step's ``kinds`` (N,: :data:`OPTIMAL`,
+    :data:`RELAXED`) and a relaxed step's strict refusal, its exit ``flags`` (N,);
+    ``progress`` (B + 1,): the schedule's progress ``u`` at each sample; the strict
+    problem's ``feedforward`` (m,; size 0 for the baseline) and the rows and command
+    components it paces (:meth:`dvqp.step.Stepper.pace`); the relaxed problem's arrays
+    (``relaxed_P`` .. ``relaxed_ub``; size 0 for the baseline); where the velocity is
+    observed (``observed`` (n,), size 0: nowhere); the accuracy tally's ``log_sums`` (3,)
+    and ``solves`` (1,) counted here; ``start`` (n,) the configuration the last step started
+    from, ``made`` (15,) its compiled call's values, ``relaxed_made`` (12,) its relaxed
+    attempt's (NaN: none) and ``moved`` (2,) its move's; ``nominal`` (4,) scratch;
+    ``verify`` (check every limit) and ``stride`` (rad, the largest joint motion of a step
+    checked at its end only)."""
 
     schedule: ScheduleArrays
     solve_time: Array
@@ -69,15 +93,25 @@ class FollowArrays:
     substeps: Index
     success: NDArray[np.bool_]
     qdot: Array
+    kinds: Index
+    flags: Array
     progress: Array
     feedforward: Array
     paced_rows: Index
     paced_components: Index
+    relaxed_P: Array
+    relaxed_q: Array
+    relaxed_A: Array
+    relaxed_G: Array
+    relaxed_lb: Array
+    relaxed_ub: Array
     observed: Array
     log_sums: Array
     solves: Index
     start: Array
     made: Array
+    relaxed_made: Array
+    moved: Array
     nominal: Array
     verify: bool
     stride: float
@@ -110,8 +144,8 @@ class Follower:
     ) -> None:
         self.stepper, self.record, self.schedule, self.verify = stepper, record, schedule, verify
         self.progress = np.zeros(schedule.budget + 1)
-        """The schedule's progress ``u`` at each sample, (B + 1,) (written by the loop and by
-        :meth:`took` for the steps Python takes)."""
+        """The schedule's progress ``u`` at each sample, (B + 1,) (written by the loop and,
+        for the steps Python takes, by the run)."""
         self._packed: tuple[FollowArrays, Any] | None = None  # the arrays and their struct
 
     def _struct(self) -> tuple[FollowArrays, Any]:
@@ -122,9 +156,13 @@ class Follower:
         stepper = self.stepper
         solver = stepper.solver
         rows, components = stepper.paced
-        if solver is None:  # the baseline is not paced (Stepper.pace)
+        if solver is None:  # the baseline is neither paced (Stepper.pace) nor relaxed
             rows, components = rows[:0], components[:0]
-        observed = stepper.observed
+            relaxed = (np.zeros((0, 0)), np.zeros(0), np.zeros((0, 0)), None, np.zeros(0))
+        else:
+            p = solver.relaxed
+            relaxed = (p.P, p.q, p.A, p.G, p.lb)
+        observed, steps = stepper.observed, a["qdot"].shape[0]
         arrays = FollowArrays(
             self.schedule.arrays,
             *(a[name] for name in ("solve_time", "solver_time", "step_time", "task_error")),
@@ -133,15 +171,25 @@ class Follower:
             a["substeps"],
             a["success"],
             a["qdot"],
+            np.zeros(steps, np.int64),
+            np.zeros(steps),
             self.progress,
             np.zeros(0) if solver is None else solver.feedforward,
             rows.astype(np.int64),
             components.astype(np.int64),
+            relaxed[0],
+            relaxed[1],
+            relaxed[2],
+            np.zeros((0, relaxed[0].shape[1])) if relaxed[3] is None else relaxed[3],
+            relaxed[4],
+            np.zeros(0) if solver is None else solver.relaxed.ub,
             np.zeros(0) if observed is None else observed,
             np.zeros(3),
             np.zeros(1, np.int64),
             np.zeros(stepper.robot.n),
             np.zeros(MADE),
+            np.zeros(ATTEMPT),
+            np.zeros(2),
             np.zeros(4),
             bool(self.verify),
             float(JOINT_STRIDE),
@@ -156,84 +204,236 @@ class Follower:
     def run(self, k: int, u: float, started: float, until: int | None = None) -> Followed:
         """The common steps from step ``k`` at progress ``u`` (the step starting at
         ``started``), until the schedule's end, its budget, the recorder's room or ``until``
-        steps; each recorded (status ``"optimal"``) and counted. The step after them, made,
-        is handed over when it is not common."""
+        steps; each recorded and counted. The step after them, made, is handed over when it
+        is not common."""
         stepper, record, schedule = self.stepper, self.record, self.schedule
-        fused = stepper.fused()
-        if fused is None:
+        handle = stepper.fused()
+        if handle is None:
             return Followed(k, u, started, None)
-        handle, qp = fused
         room = min(schedule.budget, record.arrays["qdot"].shape[0])
         stop = room if until is None else min(until, room)
         arrays, f = self._struct()
-        tally = None if stepper.solver is None else stepper.solver.accuracy
-        if tally is not None:
-            arrays.log_sums[:] = tally.log_sums
+        solver = stepper.solver
+        if solver is None:
+            out = follow_baseline(stepper.struct, handle, f, k, u, started, stop)
+        else:
+            arrays.log_sums[:] = solver.accuracy.log_sums
             arrays.solves[0] = 0
-        kernel = follow if qp else follow_baseline
-        out = kernel(stepper.struct, handle, f, k, u, started, stop)
+            relaxed = solver.relaxed_attempt()
+            r = handle if relaxed is None else relaxed
+            out = follow(stepper.struct, handle, r, f, k, u, started, stop, relaxed is not None)
+            solver.followed()
+            solver.accuracy.log_sums = [float(v) for v in arrays.log_sums]
+            solver.accuracy.solves += int(arrays.solves[0])
         reached = int(out[1])
-        if tally is not None:
-            tally.log_sums = [float(v) for v in arrays.log_sums]
-            tally.solves += int(arrays.solves[0])
         if reached > k:
-            record.status[k:reached] = "optimal"
-            record.steps = reached
+            self._taken(k, reached)
         if out[0] != HANDED:
             return Followed(reached, float(out[2]), float(out[3]), None)
-        made = Made(arrays.start.copy(), float(out[4]), tuple(arrays.made.tolist()))
+        relaxed_made, (singular, moving) = arrays.relaxed_made, arrays.moved.tolist()
+        made = Made(
+            arrays.start.copy(),
+            float(out[4]),
+            tuple(arrays.made.tolist()),
+            None if math.isnan(relaxed_made[0]) else tuple(relaxed_made.tolist()),
+            None if math.isnan(singular) else (singular, moving),
+        )
         return Followed(reached, float(out[2]), float(out[3]), made)
+
+    def _taken(self, first: int, end: int) -> None:
+        """Steps ``first`` to ``end`` (excluded), taken by the loop: their statuses, and the
+        refusals of the relaxed ones' strict problems."""
+        record, (arrays, _) = self.record, self._struct()
+        record.status[first:end] = "optimal"
+        record.steps = end
+        relaxed = arrays.kinds[first:end] == RELAXED
+        if relaxed.any():
+            record.status[first:end][relaxed] = "relaxed"
+            assert self.stepper.solver is not None
+            self.stepper.solver.count_relaxed(arrays.flags[first:end][relaxed])
 
 
 @njit(inline="always")
-def _loop(resolve, s, handle, clock, f, k, u, started, until, counted):  # type: ignore[no-untyped-def]
-    """The loop of :func:`follow` and :func:`follow_baseline` (``resolve`` the step's
-    compiled call, 15 values; ``counted``: its values carry a solve to count)."""
+def _begin(s, f, k, u):  # type: ignore[no-untyped-def]
+    """Step ``k`` at progress ``u`` set up as Python sets it up: its start kept, the
+    schedule's command and ``dt`` written, a time-scaled run paced (as
+    :meth:`dvqp.step.Stepper.pace`), the sample it reaches named; returns its span."""
     a = f.schedule
+    for i in range(f.start.shape[0]):
+        f.start[i] = s.state.q[i]
+    span = command_into(a, u, s.state.tool, s.command, f.nominal)
+    s.dt[0] = a.dt
+    if a.scaled:
+        for i in range(f.feedforward.shape[0]):
+            f.feedforward[i] = 0.0
+        for j in range(f.paced_rows.shape[0]):
+            f.feedforward[f.paced_rows[j]] = f.nominal[f.paced_components[j]]
+    s.record.index[0] = k + 1
+    return span
+
+
+@njit(inline="always")
+def _kept(s, f) -> bool:  # type: ignore[no-untyped-def]
+    """The state reached keeps every verified limit (if verified) and the step moved no
+    joint farther than the stride (no interior point to check): :func:`~dvqp.step.advance`
+    takes it as it is."""
+    return not f.verify or (s.checks.excess[1] <= 1.0 and s.motion[1] <= f.stride)
+
+
+@njit(inline="always")
+def _record(s, f, k, spent, iterations, solver_time, step_time, kind):  # type: ignore[no-untyped-def]
+    """Step ``k`` taken as :func:`~dvqp.step.advance` and the recorder take it: its
+    velocity observed and recorded with its errors, times (s) and kind."""
+    x = s.x
+    for i in range(x.shape[0]):
+        f.qdot[k, i] = x[i]
+    for i in range(f.observed.shape[0]):
+        f.observed[i] = x[i]
+    f.success[k] = True
+    f.substeps[k] = 1
+    f.task_error[k] = s.motion[0]
+    levels = s.tasks.level_error
+    for i in range(f.level_error.shape[1]):
+        f.level_error[k, i] = levels[i] if levels.shape[0] > 1 else s.motion[0]
+    f.solve_time[k] = spent
+    f.iterations[k] = iterations
+    f.solver_time[k] = solver_time
+    f.step_time[k] = step_time
+    f.kinds[k] = kind
+
+
+@njit(inline="always")
+def _handed(f, out, k, u, started, begun):  # type: ignore[no-untyped-def]
+    """Step ``k`` handed to Python with its compiled call's values ``out`` (nothing else
+    made)."""
+    for i in range(MADE):
+        f.made[i] = out[i]
+    f.relaxed_made[0] = f.moved[0] = math.nan
+    return (HANDED, float(k), u, started, begun)
+
+
+@njit(inline="always")
+def _checked(a) -> bool:  # type: ignore[no-untyped-def]
+    """An attempt's values ``a`` (12) hold an answer the check judged (accepted or refused;
+    not a misfit, a failed update or rows that outgrew their copy)."""
+    return (a[0] == SOLVED or a[0] == ACCEPTED) and a[4] != MISFIT
+
+
+@njit(inline="always")
+def _paced(f) -> bool:  # type: ignore[no-untyped-def]
+    """This step is paced (time scaling): its refusal slows down before it relaxes."""
+    paced = False
+    for i in range(f.feedforward.shape[0]):
+        paced = paced or f.feedforward[i] != 0.0
+    return paced
+
+
+@njit(inline="always")
+def _move(s, f, x, clock):  # type: ignore[no-untyped-def]
+    """The step ``x`` taken and the state it reaches evaluated (as :meth:`dvqp.step.
+    Stepper.move`), kept in ``f.moved`` as ``(singular, seconds)``; whether it is taken as
+    it is (regular and kept, :func:`_kept`)."""
+    for i in range(s.x.shape[0]):
+        s.x[i] = x[i]
+    started = now(clock)
+    singular = evaluate(s, True, MEASURE, CONCLUDE)
+    f.moved[0], f.moved[1] = float(singular), now(clock) - started
+    return singular == -1 and _kept(s, f)
+
+
+@njit
+def follow(s, w, r, f, k, u, started, until, relaxing):  # type: ignore[no-untyped-def]
+    """A QP run's common steps from step ``k`` at progress ``u`` (the step starting at
+    ``started``, s of ``time.perf_counter``'s clock), on the step's struct ``s``, the strict
+    backend's packed attempt ``w`` (:meth:`~dvqp.resolution.qp.QPSolver.fused_attempt`), the
+    relaxed backend's ``r`` (:meth:`~dvqp.resolution.qp.QPSolver.relaxed_attempt`; used if
+    ``relaxing``) and the loop's arrays ``f`` (:class:`FollowArrays`), up to step ``until``
+    (excluded).
+
+    Each step's strict problem is solved as :meth:`~dvqp.resolution.qp.QPSolver.solve` and
+    its backend solve it: the warm attempt, and if it is refused the cold restart (the
+    backend's ``after_warm``); after a refusal the next step's first attempt is the cold
+    one. Refused, at fixed timing, the step is relaxed: the relaxed problem loaded and its
+    warm attempt made. A step is taken here when its answer was accepted (strict, or the
+    relaxed one's warm attempt) and the state it reaches is regular and kept; else it is
+    handed to Python with what was made of it, the strict backend's ``mode`` as it was
+    before the step (Python makes its cold restart again: a restart re-forms DAQP's problem
+    from its data alone, the same answer).
+
+    Returns
+    -------
+    tuple of 5 floats
+        ``(how, k, u, started, begun)``: :data:`STOPPED` before step ``k``, or
+        :data:`HANDED` with step ``k`` made, its resolution begun at ``begun``, its compiled
+        call's values (:func:`~dvqp.step.stages.resolve_move`'s) in ``f.made``, and if its
+        relaxed attempt was made too, that attempt's values in ``f.relaxed_made`` (NaN:
+        not made), and the move's ``(singular, seconds)`` in ``f.moved`` (NaN: not moved).
+    """
+    clock = w.call.handles[H_CLOCK]
+    a, qp, mode = f.schedule, s.qp, w.call.mode
     while k < until and not u >= a.n - 1e-9:
-        for i in range(f.start.shape[0]):
-            f.start[i] = s.state.q[i]
         begun = now(clock)
-        span = command_into(a, u, s.state.tool, s.command, f.nominal)
-        s.dt[0] = a.dt
-        if a.scaled:  # pace: the tool rows' nominal motion
-            for i in range(f.feedforward.shape[0]):
-                f.feedforward[i] = 0.0
-            for j in range(f.paced_rows.shape[0]):
-                f.feedforward[f.paced_rows[j]] = f.nominal[f.paced_components[j]]
-        s.record.index[0] = k + 1
-        out = resolve(s, handle)
-        if (
-            out[0] != MOVED
-            or out[1] != -1.0
-            or (f.verify and (not s.checks.excess[1] <= 1.0 or s.motion[1] > f.stride))
-        ):
-            for i in range(MADE):
-                f.made[i] = out[i]
-            return (HANDED, float(k), u, started, begun)
-        ended = now(clock)
-        x = s.x
-        for i in range(x.shape[0]):
-            f.qdot[k, i] = x[i]
-        for i in range(f.observed.shape[0]):
-            f.observed[i] = x[i]
-        f.success[k] = True
-        f.substeps[k] = 1
-        f.task_error[k] = s.motion[0]
-        levels = s.tasks.level_error
-        for i in range(f.level_error.shape[1]):
-            f.level_error[k, i] = levels[i] if levels.shape[0] > 1 else s.motion[0]
-        spent = ended - begun - out[2]
-        f.solve_time[k] = spent
-        if counted:
-            f.iterations[k] = int(out[5])
-            f.solver_time[k] = out[6]
+        span = _begin(s, f, k, u)
+        first = mode[0]
+        out = resolve_move(s, w)
+        if out[0] == MOVED:  # the warm answer accepted, its state evaluated
+            if out[1] != -1.0 or not _kept(s, f):
+                return _handed(f, out, k, u, started, begun)
+            kind, iterations, solver_time, moving = OPTIMAL, int(out[5]), out[6], out[2]
             add_kernel_metrics(f.log_sums, out[7:15])
-            f.solves[0] += 1
         else:
-            f.iterations[k] = -1
-            f.solver_time[k] = spent
-        f.step_time[k] = ended - started
+            if out[0] != ATTEMPTED or not _checked(out[3:15]):
+                return _handed(f, out, k, u, started, begun)
+            answer, warm = out[3:15], 0.0
+            if first == WARM:  # refused warm: the cold restart, its time the warm one's too
+                mode[0] = RESTART
+                answer, warm = attempt(w.call), out[6]
+                if not _checked(answer):
+                    mode[0] = first
+                    return _handed(f, out, k, u, started, begun)
+            _handed(f, out, k, u, started, begun)  # what Python finishes if it must
+            solver_time = answer[3] + warm
+            if answer[0] == ACCEPTED:  # the strict answer, cold
+                mode[0] = WARM
+                if not _move(s, f, w.call.x, clock):
+                    mode[0] = first
+                    return (HANDED, float(k), u, started, begun)
+                kind, iterations, moving = OPTIMAL, int(answer[2]), f.moved[1]
+                add_kernel_metrics(f.log_sums, answer[4:12])
+            else:  # refused: relaxed, at fixed timing
+                if not relaxing or _paced(f):
+                    mode[0] = first
+                    return (HANDED, float(k), u, started, begun)
+                load_columns(
+                    qp.P,
+                    qp.cost,
+                    qp.A,
+                    qp.G,
+                    qp.lb,
+                    qp.ub,
+                    f.relaxed_P,
+                    f.relaxed_q,
+                    f.relaxed_A,
+                    f.relaxed_G,
+                    f.relaxed_lb,
+                    f.relaxed_ub,
+                )
+                again = solve_dropped(r)
+                for i in range(ATTEMPT):
+                    f.relaxed_made[i] = again[i]
+                if again[0] != ACCEPTED or r.call.mode[0] != WARM:
+                    mode[0] = first
+                    return (HANDED, float(k), u, started, begun)
+                if not _move(s, f, r.call.x, clock):
+                    mode[0] = first
+                    return (HANDED, float(k), u, started, begun)
+                kind, iterations, moving = RELAXED, int(again[2]), f.moved[1]
+                solver_time += again[3]
+                f.flags[k] = answer[1]
+                add_kernel_metrics(f.log_sums, again[4:12])
+        f.solves[0] += 1
+        ended = now(clock)
+        _record(s, f, k, ended - begun - moving, iterations, solver_time, ended - started, kind)
         started = ended
         u += span
         k += 1
@@ -241,33 +441,23 @@ def _loop(resolve, s, handle, clock, f, k, u, started, until, counted):  # type:
     return (STOPPED, float(k), u, started, 0.0)
 
 
-@njit(inline="always")
-def _baseline(s, clock):  # type: ignore[no-untyped-def]
-    """The baseline's step and move (:func:`~dvqp.step.stages.resolve_move_baseline`), its
-    values padded to :func:`~dvqp.step.stages.resolve_move`'s 15."""
-    status, singular, moving = resolve_move_baseline(s, clock)
-    return (status, singular, moving, *NOT_ATTEMPTED)
-
-
-@njit
-def follow(s, w, f, k, u, started, until):  # type: ignore[no-untyped-def]
-    """A QP run's common steps from step ``k`` at progress ``u`` (the step starting at
-    ``started``, s of ``time.perf_counter``'s clock), on the step's struct ``s``, the strict
-    backend's packed attempt ``w`` (:meth:`~dvqp.resolution.qp.QPSolver.fused_attempt`) and
-    the loop's arrays ``f`` (:class:`FollowArrays`), up to step ``until`` (excluded).
-
-    Returns
-    -------
-    tuple of 5 floats
-        ``(how, k, u, started, begun)``: :data:`STOPPED` before step ``k``, or
-        :data:`HANDED` with step ``k`` made, its resolution begun at ``begun``, its compiled
-        call's values (:func:`~dvqp.step.stages.resolve_move`'s) in ``f.made``.
-    """
-    return _loop(resolve_move, s, w, w.call.handles[H_CLOCK], f, k, u, started, until, True)
-
-
 @njit
 def follow_baseline(s, clock, f, k, u, started, until):  # type: ignore[no-untyped-def]
-    """:func:`follow` for the baseline (``clock``: :func:`solvers.clock.address`); a handed
-    step's values are :func:`~dvqp.step.stages.resolve_move_baseline`'s, then NaN."""
-    return _loop(_baseline, s, clock, clock, f, k, u, started, until, False)
+    """:func:`follow` for the baseline (``clock``: :func:`solvers.clock.address`): its
+    step and move in one call (:func:`~dvqp.step.stages.resolve_move_baseline`); a handed
+    step's values are that call's three, then NaN."""
+    a = f.schedule
+    while k < until and not u >= a.n - 1e-9:
+        begun = now(clock)
+        span = _begin(s, f, k, u)
+        status, singular, moving = resolve_move_baseline(s, clock)
+        if status != MOVED or singular != -1 or not _kept(s, f):
+            return _handed(f, (status, singular, moving, *NOT_ATTEMPTED), k, u, started, begun)
+        ended = now(clock)
+        spent = ended - begun - moving
+        _record(s, f, k, spent, -1, spent, ended - started, OPTIMAL)
+        started = ended
+        u += span
+        k += 1
+        f.progress[k] = u
+    return (STOPPED, float(k), u, started, 0.0)

@@ -49,6 +49,7 @@ from numpy.typing import NDArray
 
 import solvers
 from dvqp.workspace import QPBuffers
+from solvers.jit import njit
 
 Array = NDArray[np.float64]
 
@@ -95,13 +96,42 @@ def relaxed_problem(
 
 def load_relaxed(qp: QPBuffers, problem: solvers.Problem) -> None:
     """Copy this step's cost, task rows, constraints and bounds into ``problem``'s ``Q̇``
-    columns (a :func:`relaxed_problem`)."""
-    n, rows = qp.cost.shape[0], problem.b.shape[0]  # type: ignore[union-attr]
-    problem.P[:n, :n], problem.q[:n] = qp.P, qp.cost
-    problem.A[:, :n] = qp.A[:rows]  # type: ignore[index]
-    problem.lb[:n], problem.ub[:n] = qp.lb, qp.ub  # type: ignore[index]
-    if problem.G is not None:
-        problem.G[:, :n] = qp.G
+    columns (a :func:`relaxed_problem`; :func:`load_columns`)."""
+    G = problem.G if problem.G is not None else np.zeros((0, problem.P.shape[0]))
+    load_columns(
+        qp.P,
+        qp.cost,
+        qp.A,
+        qp.G,
+        qp.lb,
+        qp.ub,
+        problem.P,
+        problem.q,
+        problem.A,
+        G,
+        problem.lb,
+        problem.ub,
+    )
+
+
+@njit(separate=True, python=True)  # a run's compiled loop calls it, and load_relaxed
+def load_columns(P, cost, A, G, lb, ub, into_P, into_q, into_A, into_G, into_lb, into_ub):  # type: ignore[no-untyped-def]
+    """The step's ``P`` (n, n), ``cost`` (n,), task rows ``A``, constraints ``G`` and bounds
+    ``lb``, ``ub`` (n,) copied into the first n columns of a relaxed problem's (``into_A``
+    takes the first rows of ``A``; ``into_G`` (0, n + m) without constraints)."""
+    n = cost.shape[0]
+    for i in range(n):
+        for j in range(n):
+            into_P[i, j] = P[i, j]
+        into_q[i] = cost[i]
+        into_lb[i] = lb[i]
+        into_ub[i] = ub[i]
+    for i in range(into_A.shape[0]):
+        for j in range(n):
+            into_A[i, j] = A[i, j]
+    for i in range(into_G.shape[0]):
+        for j in range(n):
+            into_G[i, j] = G[i, j]
 
 
 @dataclass

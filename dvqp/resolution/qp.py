@@ -196,12 +196,44 @@ class QPSolver:
         rows = None if attempt is None else attempt(self.strict)
         return None if rows is None else self._packed(strict, rows)
 
+    def relaxed_attempt(self) -> Any:
+        """The relaxed backend's packed ``compiled_attempt`` of its next solve (as
+        :meth:`fused_attempt`'s), for a caller that relaxes a step whose strict problem its
+        cold attempt refused in compiled code (:func:`dvqp.motion.follow.follow`), then hands
+        both attempts' values to :meth:`solve` (``attempted``, ``relaxed_values``) or counts the
+        step (:meth:`count_relaxed`); None when it cannot (as :meth:`fused_attempt`)."""
+        if self.levels is not None or self.watchers:
+            return None
+        relaxed = self.backends[1]
+        attempt = getattr(relaxed, "compiled_attempt", None)
+        rows = None if attempt is None else attempt(self.relaxed)
+        return None if rows is None else self._packed(relaxed, rows)
+
+    def followed(self) -> None:
+        """After a run's compiled loop made the strict backend's attempts (and its cold
+        restarts, :func:`dvqp.motion.follow.follow`): the backend takes the warm state the
+        loop left it in (``settle_mode``)."""
+        self.backends[0].settle_mode()  # type: ignore[attr-defined]
+
+    def count_relaxed(self, flags: NDArray[np.float64]) -> None:
+        """Count the strict refusals of steps relaxed in compiled code (the relaxed answers'
+        accuracy counted there): ``flags``, the refused cold attempts' exit flags, each
+        named by the strict backend (``refusal_of``) as its refused solution would be."""
+        strict = self.backends[0]
+        for flag, count in zip(*np.unique(flags, return_counts=True), strict=True):
+            self.refusals[strict.refusal_of(flag)] += int(count)  # type: ignore[attr-defined]
+
     def took(self, out: tuple[float, ...]) -> Taken:
         """The strict attempt made and taken in compiled code (its values ``out``), counted."""
         strict = self.backends[0]
         return self._took(strict, self._packs[id(strict)][0], out)
 
-    def solve(self, rest: bool = False, attempted: tuple[float, ...] | None = None) -> Answer:
+    def solve(
+        self,
+        rest: bool = False,
+        attempted: tuple[float, ...] | None = None,
+        relaxed_values: tuple[float, ...] | None = None,
+    ) -> Answer:
         """Strict, else relaxed, else braking (``x`` a view, valid until the next solve).
 
         ``rest``: a step of a stop, whose cost has no linear part and whose tasks ask for no
@@ -211,6 +243,9 @@ class QPSolver:
 
         ``attempted``: the values of the strict problem's first attempt, made in compiled code
         with :meth:`fused_attempt`'s struct and not taken there; the solve goes on from them.
+        ``relaxed_values``: with them, the values of the relaxed problem's first attempt, made in
+        compiled code too (:meth:`relaxed_attempt`) after that strict attempt, a cold one,
+        was refused and the relaxed problem loaded.
         """
         qp = self.qp
         if rest and not (np.any(qp.lb > 0.0) or np.any(qp.ub < 0.0) or np.any(qp.h < 0.0)):
@@ -236,7 +271,7 @@ class QPSolver:
             spent, status = spent + solution.solver_time, "slowed"
         if not solution.found:
             load_relaxed(qp, self.relaxed)
-            solution = self._call("relaxed", relaxed, self.relaxed)
+            solution = self._call("relaxed", relaxed, self.relaxed, relaxed_values)
             spent, status = spent + solution.solver_time, "relaxed"
         if solution.found and solution.x is not None:
             x = solution.x[: qp.cost.shape[0]]

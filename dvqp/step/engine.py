@@ -79,11 +79,17 @@ class Made(NamedTuple):
     """A step's compiled call made by a run's compiled loop and handed back to Python to
     finish (:meth:`Stepper.resolve_and_move`): the configuration it started from (rad, (n,)),
     when its resolution started (``time.perf_counter``'s s) and the call's values
-    (:func:`~dvqp.step.stages.resolve_move`'s, or the baseline's)."""
+    (:func:`~dvqp.step.stages.resolve_move`'s, or the baseline's). After the strict
+    problem's cold attempt was refused there, the loop may have made the relaxed problem's
+    attempt too (``relaxed``: its values, :meth:`~dvqp.resolution.qp.QPSolver.
+    relaxed_attempt`) and, that answer taken, evaluated the state it reaches (``moved``:
+    ``(singular, seconds)`` as :func:`~dvqp.step.stages.resolve_move`'s)."""
 
     start: Array
     started: float
     values: tuple[float, ...]
+    relaxed: tuple[float, ...] | None = None
+    moved: tuple[float, float] | None = None
 
 
 class Resolution(NamedTuple):
@@ -296,6 +302,8 @@ class Stepper(Verification):
         if made is not None:
             if solver is None:
                 return self._baseline_moved(made.values, made.started)
+            if made.relaxed is not None or made.moved is not None:
+                return self._finished(solver, made)
             return self._fused(solver, made.values, made.started)
         if self.hooks.active or self.stopping:
             return self.resolve(command, dt), None
@@ -311,19 +319,18 @@ class Stepper(Verification):
         self._command(command, dt)
         return self._fused(solver, stages.resolve_move(self.struct, packed), started)
 
-    def fused(self) -> tuple[Any, bool] | None:
+    def fused(self) -> Any:
         """What a run's compiled loop resolves its common steps with, when it may
-        (:func:`dvqp.motion.follow.follow`): ``(packed, True)``, the strict backend's packed
-        attempt (:meth:`~dvqp.resolution.qp.QPSolver.fused_attempt`), or ``(clock, False)``
-        for the baseline (:func:`solvers.clock.address`); None when the steps resolve in
-        Python (parts of your own, a stop's steps, levels, watched backend calls, a limit
-        that observes the velocity only in Python)."""
+        (:func:`dvqp.motion.follow.follow`): the strict backend's packed attempt
+        (:meth:`~dvqp.resolution.qp.QPSolver.fused_attempt`), or for the baseline the clock's
+        address (:func:`solvers.clock.address`); None when the steps resolve in Python (parts
+        of your own, a stop's steps, levels, watched backend calls, a limit that observes the
+        velocity only in Python)."""
         if self.hooks.active or self.stopping or self.observed is None:
             return None
         if self.solver is None:
-            return clock.address(), False
-        packed = self.solver.fused_attempt()
-        return None if packed is None else (packed, True)
+            return clock.address()
+        return self.solver.fused_attempt()
 
     def _fused(
         self, solver: QPSolver, out: tuple[float, ...], started: float
@@ -341,6 +348,16 @@ class Stepper(Verification):
         if status != stages.ATTEMPTED:
             return self._crossed(status, started), None
         return self._resolved(solver.solve(attempted=out[3:]), started), None
+
+    def _finished(self, solver: QPSolver, made: Made) -> tuple[Resolution, bool | None]:
+        """The step whose strict attempt, and maybe its relaxed attempt and move, the loop
+        made (``made``): the resolution goes on from their values."""
+        answer = solver.solve(attempted=made.values[3:], relaxed_values=made.relaxed)
+        if made.moved is None:
+            return self._resolved(answer, made.started), None
+        singular, moving = made.moved
+        found = self._resolved(answer, made.started + moving)  # less the evaluation's time
+        return found, singular == -1
 
     def _baseline_moved(
         self, values: tuple[float, ...], started: float

@@ -48,18 +48,18 @@ def planned(name: str, backend: str, loop: bool, **options: Any) -> tuple[Any, l
     taken = 0
     kernels = follow.follow, follow.follow_baseline
 
-    def counted(kernel: Any) -> Any:
-        def call(s: Any, handle: Any, f: Any, k: int, *rest: Any) -> Any:
+    def counted(kernel: Any, at: int) -> Any:
+        def call(*args: Any) -> Any:
             nonlocal taken
-            out = kernel(s, handle, f, k, *rest)
-            taken += int(out[1]) - k
+            out = kernel(*args)
+            taken += int(out[1]) - args[at]
             return out
 
         return call
 
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(follow, "follow", counted(kernels[0]))
-        patch.setattr(follow, "follow_baseline", counted(kernels[1]))
+        patch.setattr(follow, "follow", counted(kernels[0], 4))
+        patch.setattr(follow, "follow_baseline", counted(kernels[1], 3))
         if not loop:
             patch.setattr(Stepper, "fused", lambda self: None)
         traj = dvqp.plan(scene, backend, progress=lambda k, n: calls.append((k, n)), **options)
@@ -92,14 +92,23 @@ def test_a_run_with_its_compiled_loop_is_the_run_step_by_step(name: str, backend
     assert len(fast_calls) >= fast.n_steps - 100  # a stop's steps are not counted
 
 
-def test_a_handed_step_is_finished_by_python_as_it_would_have_been() -> None:
-    """probe-into-clamp relaxes hundreds of steps: each is made by the loop, handed over
-    after its refused attempt and finished (retried cold, relaxed) in Python."""
+def test_a_relaxed_streak_runs_in_the_loop_and_each_handed_step_is_finished_by_python() -> None:
+    """probe-into-clamp relaxes hundreds of steps in one streak: its first (the warm strict
+    attempt refused, retried cold) is Python's, the others the loop's (the strict problem's
+    cold attempt refused, the relaxed one accepted). With a stride of 0 the loop hands every
+    step over after its move (a relaxed one with both attempts made): Python finishes each
+    as it would have made it."""
     fast, _, taken = planned("probe-into-clamp", "daqp", loop=True)
     slow, _, _ = planned("probe-into-clamp", "daqp", loop=False)
     relaxed = int(np.sum(fast.status == "relaxed"))
-    assert relaxed > 50 and taken < fast.n_steps - relaxed
+    assert relaxed > 300 and taken >= fast.n_steps - 10
+    assert fast.refusals == {"infeasible": relaxed}
     assert_same_run(fast, slow)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(follow, "JOINT_STRIDE", 0.0)
+        handed, _, none = planned("probe-into-clamp", "daqp", loop=True)
+    assert none == 0
+    assert_same_run(handed, slow)
 
 
 def test_a_recorder_outgrown_inside_the_loop_is_grown_and_the_loop_goes_on() -> None:
@@ -141,9 +150,9 @@ def test_a_limit_that_observes_in_python_turns_the_loop_off_and_sees_every_step(
     taken = 0
     kernel = follow.follow
 
-    def counted(s: Any, w: Any, f: Any, k: int, *rest: Any) -> Any:
+    def counted(s: Any, w: Any, r: Any, f: Any, k: int, *rest: Any) -> Any:
         nonlocal taken
-        out = kernel(s, w, f, k, *rest)
+        out = kernel(s, w, r, f, k, *rest)
         taken += int(out[1]) - k
         return out
 
