@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 from dvqp.motion.recorder import TrajectoryRecorder
 from dvqp.motion.schedule import Schedule, ScheduleArrays, command_into
 from dvqp.resolution.levels import load_columns
+from dvqp.resolution.qp import load_scaled
 from dvqp.step import JOINT_STRIDE, Stepper
 from dvqp.step.engine import Made
 from dvqp.step.stages import (
@@ -59,8 +60,10 @@ ATTEMPT = 12
 STOPPED, HANDED = 0.0, 1.0
 """How :func:`follow` returns: it stopped before a step (the schedule's end, ``until``), or
 it hands a step it made but cannot take as it is to Python."""
-OPTIMAL, RELAXED = 0, 1
+OPTIMAL, RELAXED, SLOWED = 0, 1, 2
 """The kinds of step the loop takes (``FollowArrays.kinds``)."""
+KINDS = ("optimal", "relaxed", "slowed")
+"""Their statuses."""
 
 
 @dataclass(frozen=True)
@@ -71,15 +74,19 @@ class FollowArrays:
     levels: ``solve_time``, ``solver_time``, ``step_time``, ``task_error`` (N,) s and task
     units per s, ``level_error`` (N, L), ``iterations`` (N,), ``substeps`` (N,), ``success``
     (N,), ``qdot`` (N, n) rad/s); each step's ``kinds`` (N,: :data:`OPTIMAL`,
-    :data:`RELAXED`) and a relaxed step's strict refusal, its exit ``flags`` (N,);
+    :data:`RELAXED`, :data:`SLOWED`) and such a step's strict refusal, its exit ``flags``
+    (N,);
     ``progress`` (B + 1,): the schedule's progress ``u`` at each sample; the strict
     problem's ``feedforward`` (m,; size 0 for the baseline) and the rows and command
     components it paces (:meth:`dvqp.step.Stepper.pace`); the relaxed problem's arrays
-    (``relaxed_P`` .. ``relaxed_ub``; size 0 for the baseline); where the velocity is
+    (``relaxed_P`` .. ``relaxed_ub``; size 0 for the baseline), the time-scaled problem's
+    (``scaled_P`` .. ``scaled_ub``; size 0 before a step was first slowed), the tasks'
+    weight ``ρ`` and room to keep ``b`` (m,) while a slowed step is tried; where the velocity is
     observed (``observed`` (n,), size 0: nowhere); the accuracy tally's ``log_sums`` (3,)
     and ``solves`` (1,) counted here; ``start`` (n,) the configuration the last step started
     from, ``made`` (15,) its compiled call's values, ``relaxed_made`` (12,) its relaxed
-    attempt's (NaN: none) and ``moved`` (2,) its move's; ``nominal`` (4,) scratch;
+    attempt's and ``scaled_made`` (12,) its time-scaled one's (NaN: none), ``moved`` (2,)
+    its move's; ``nominal`` (4,) scratch;
     ``verify`` (check every limit) and ``stride`` (rad, the largest joint motion of a step
     checked at its end only)."""
 
@@ -105,16 +112,31 @@ class FollowArrays:
     relaxed_G: Array
     relaxed_lb: Array
     relaxed_ub: Array
+    scaled_P: Array
+    scaled_q: Array
+    scaled_A: Array
+    scaled_b: Array
+    scaled_G: Array
+    scaled_lb: Array
+    scaled_ub: Array
+    task_weight: float
+    saved_b: Array
     observed: Array
     log_sums: Array
     solves: Index
     start: Array
     made: Array
     relaxed_made: Array
+    scaled_made: Array
     moved: Array
     nominal: Array
     verify: bool
     stride: float
+
+
+def _values(attempt: Array) -> tuple[float, ...] | None:
+    """An attempt's values as the loop left them (None: not made)."""
+    return None if math.isnan(attempt[0]) else tuple(attempt.tolist())
 
 
 class Followed(NamedTuple):
@@ -126,6 +148,21 @@ class Followed(NamedTuple):
     u: float
     started: float
     made: Made | None
+
+
+def _problem(problem: Any, with_b: bool) -> tuple[Array, ...]:
+    """A relaxed or time-scaled problem's arrays the loop writes: ``P``, ``q``, ``A``,
+    (``b``), ``G`` ((0, columns) without constraints), ``lb``, ``ub``; of size 0 without the
+    problem."""
+    if problem is None:
+        return (
+            (np.zeros((0, 0)), np.zeros(0), np.zeros((0, 0)))
+            + ((np.zeros(0),) if with_b else ())
+            + (np.zeros((0, 0)), np.zeros(0), np.zeros(0))
+        )
+    G = problem.G if problem.G is not None else np.zeros((0, problem.P.shape[0]))
+    b = (problem.b,) if with_b else ()
+    return (problem.P, problem.q, problem.A, *b, G, problem.lb, problem.ub)
 
 
 class Follower:
@@ -149,20 +186,21 @@ class Follower:
         self._packed: tuple[FollowArrays, Any] | None = None  # the arrays and their struct
 
     def _struct(self) -> tuple[FollowArrays, Any]:
-        """The loop's arrays and their struct (packed again when the recorder has grown)."""
-        a = self.record.arrays
-        if self._packed is not None and self._packed[0].qdot is a["qdot"]:
-            return self._packed
-        stepper = self.stepper
-        solver = stepper.solver
-        rows, components = stepper.paced
+        """The loop's arrays and their struct (packed again when the recorder has grown or
+        the time-scaled problem has been made)."""
+        a, solver = self.record.arrays, self.stepper.solver
+        scaled = None if solver is None else solver.scaled
+        kept = self._packed
+        if (
+            kept is not None
+            and kept[0].qdot is a["qdot"]
+            and kept[0].scaled_q.size == (0 if scaled is None else scaled.q.size)
+        ):
+            return kept
+        rows, components = self.stepper.paced
         if solver is None:  # the baseline is neither paced (Stepper.pace) nor relaxed
             rows, components = rows[:0], components[:0]
-            relaxed = (np.zeros((0, 0)), np.zeros(0), np.zeros((0, 0)), None, np.zeros(0))
-        else:
-            p = solver.relaxed
-            relaxed = (p.P, p.q, p.A, p.G, p.lb)
-        observed, steps = stepper.observed, a["qdot"].shape[0]
+        steps = a["qdot"].shape[0]
         arrays = FollowArrays(
             self.schedule.arrays,
             *(a[name] for name in ("solve_time", "solver_time", "step_time", "task_error")),
@@ -177,17 +215,16 @@ class Follower:
             np.zeros(0) if solver is None else solver.feedforward,
             rows.astype(np.int64),
             components.astype(np.int64),
-            relaxed[0],
-            relaxed[1],
-            relaxed[2],
-            np.zeros((0, relaxed[0].shape[1])) if relaxed[3] is None else relaxed[3],
-            relaxed[4],
-            np.zeros(0) if solver is None else solver.relaxed.ub,
-            np.zeros(0) if observed is None else observed,
+            *_problem(None if solver is None else solver.relaxed, with_b=False),
+            *_problem(scaled, with_b=True),
+            0.0 if solver is None else float(solver.task_weight),
+            np.zeros(0) if solver is None else np.zeros_like(solver.feedforward),
+            np.zeros(0) if self.stepper.observed is None else self.stepper.observed,
             np.zeros(3),
             np.zeros(1, np.int64),
-            np.zeros(stepper.robot.n),
+            np.zeros(self.stepper.robot.n),
             np.zeros(MADE),
+            np.zeros(ATTEMPT),
             np.zeros(ATTEMPT),
             np.zeros(2),
             np.zeros(4),
@@ -219,9 +256,20 @@ class Follower:
         else:
             arrays.log_sums[:] = solver.accuracy.log_sums
             arrays.solves[0] = 0
-            relaxed = solver.relaxed_attempt()
-            r = handle if relaxed is None else relaxed
-            out = follow(stepper.struct, handle, r, f, k, u, started, stop, relaxed is not None)
+            relaxed, pacing = solver.relaxed_attempt(), solver.pacing_attempt()
+            out = follow(
+                stepper.struct,
+                handle,
+                handle if relaxed is None else relaxed,
+                handle if pacing is None else pacing,
+                f,
+                k,
+                u,
+                started,
+                stop,
+                relaxed is not None,
+                pacing is not None,
+            )
             solver.followed()
             solver.accuracy.log_sums = [float(v) for v in arrays.log_sums]
             solver.accuracy.solves += int(arrays.solves[0])
@@ -230,13 +278,14 @@ class Follower:
             self._taken(k, reached)
         if out[0] != HANDED:
             return Followed(reached, float(out[2]), float(out[3]), None)
-        relaxed_made, (singular, moving) = arrays.relaxed_made, arrays.moved.tolist()
+        singular, moving = arrays.moved.tolist()
         made = Made(
             arrays.start.copy(),
             float(out[4]),
             tuple(arrays.made.tolist()),
-            None if math.isnan(relaxed_made[0]) else tuple(relaxed_made.tolist()),
+            _values(arrays.relaxed_made),
             None if math.isnan(singular) else (singular, moving),
+            _values(arrays.scaled_made),
         )
         return Followed(reached, float(out[2]), float(out[3]), made)
 
@@ -244,13 +293,15 @@ class Follower:
         """Steps ``first`` to ``end`` (excluded), taken by the loop: their statuses, and the
         refusals of the relaxed ones' strict problems."""
         record, (arrays, _) = self.record, self._struct()
-        record.status[first:end] = "optimal"
+        record.status[first:end] = KINDS[OPTIMAL]
         record.steps = end
-        relaxed = arrays.kinds[first:end] == RELAXED
-        if relaxed.any():
-            record.status[first:end][relaxed] = "relaxed"
+        kinds = arrays.kinds[first:end]
+        refused = kinds != OPTIMAL
+        if refused.any():
+            for kind in (RELAXED, SLOWED):
+                record.status[first:end][kinds == kind] = KINDS[kind]
             assert self.stepper.solver is not None
-            self.stepper.solver.count_relaxed(arrays.flags[first:end][relaxed])
+            self.stepper.solver.count_refused(arrays.flags[first:end][refused])
 
 
 @njit(inline="always")
@@ -308,7 +359,7 @@ def _handed(f, out, k, u, started, begun):  # type: ignore[no-untyped-def]
     made)."""
     for i in range(MADE):
         f.made[i] = out[i]
-    f.relaxed_made[0] = f.moved[0] = math.nan
+    f.relaxed_made[0] = f.scaled_made[0] = f.moved[0] = math.nan
     return (HANDED, float(k), u, started, begun)
 
 
@@ -341,20 +392,77 @@ def _move(s, f, x, clock):  # type: ignore[no-untyped-def]
     return singular == -1 and _kept(s, f)
 
 
+@njit(inline="always")
+def _relax(s, f, r):  # type: ignore[no-untyped-def]
+    """The relaxed problem loaded (as :func:`~dvqp.resolution.levels.load_relaxed`) and its
+    first attempt made (``r``); its values, also in ``f.relaxed_made``."""
+    qp = s.qp
+    load_columns(
+        qp.P,
+        qp.cost,
+        qp.A,
+        qp.G,
+        qp.lb,
+        qp.ub,
+        f.relaxed_P,
+        f.relaxed_q,
+        f.relaxed_A,
+        f.relaxed_G,
+        f.relaxed_lb,
+        f.relaxed_ub,
+    )
+    again = solve_dropped(r)
+    for i in range(ATTEMPT):
+        f.relaxed_made[i] = again[i]
+    return again
+
+
+@njit(inline="always")
+def _slow(s, f, p):  # type: ignore[no-untyped-def]
+    """The time-scaled problem loaded (:func:`~dvqp.resolution.qp.load_scaled`) and its
+    first attempt made (``p``); its values, also in ``f.scaled_made``."""
+    qp = s.qp
+    load_scaled(
+        qp.P,
+        qp.cost,
+        qp.A,
+        qp.b,
+        qp.G,
+        qp.lb,
+        qp.ub,
+        f.feedforward,
+        f.task_weight,
+        f.scaled_P,
+        f.scaled_q,
+        f.scaled_A,
+        f.scaled_b,
+        f.scaled_G,
+        f.scaled_lb,
+        f.scaled_ub,
+    )
+    again = solve_dropped(p)
+    for i in range(ATTEMPT):
+        f.scaled_made[i] = again[i]
+    return again
+
+
 @njit
-def follow(s, w, r, f, k, u, started, until, relaxing):  # type: ignore[no-untyped-def]
+def follow(s, w, r, p, f, k, u, started, until, relaxing, pacing):  # type: ignore[no-untyped-def]
     """A QP run's common steps from step ``k`` at progress ``u`` (the step starting at
     ``started``, s of ``time.perf_counter``'s clock), on the step's struct ``s``, the strict
     backend's packed attempt ``w`` (:meth:`~dvqp.resolution.qp.QPSolver.fused_attempt`), the
     relaxed backend's ``r`` (:meth:`~dvqp.resolution.qp.QPSolver.relaxed_attempt`; used if
-    ``relaxing``) and the loop's arrays ``f`` (:class:`FollowArrays`), up to step ``until``
-    (excluded).
+    ``relaxing``), the time-scaled problem's ``p`` (:meth:`~dvqp.resolution.qp.QPSolver.
+    pacing_attempt`; used if ``pacing``) and the loop's arrays ``f`` (:class:`FollowArrays`),
+    up to step ``until`` (excluded).
 
     Each step's strict problem is solved as :meth:`~dvqp.resolution.qp.QPSolver.solve` and
     its backend solve it: the warm attempt, and if it is refused the cold restart (the
     backend's ``after_warm``); after a refusal the next step's first attempt is the cold
-    one. Refused, at fixed timing, the step is relaxed: the relaxed problem loaded and its
-    warm attempt made. A step is taken here when its answer was accepted (strict, or the
+    one. Refused, a paced step (time scaling) is slowed: the time-scaled problem loaded
+    (:func:`~dvqp.resolution.qp.load_scaled`), its warm attempt made, ``b`` left at the
+    progress it makes; at fixed timing the step is relaxed: the relaxed problem loaded and
+    its warm attempt made. A step is taken here when its answer was accepted (strict, or the
     relaxed one's warm attempt) and the state it reaches is regular and kept; else it is
     handed to Python with what was made of it, the strict backend's ``mode`` as it was
     before the step (Python makes its cold restart again: a restart re-forms DAQP's problem
@@ -400,27 +508,33 @@ def follow(s, w, r, f, k, u, started, until, relaxing):  # type: ignore[no-untyp
                     return (HANDED, float(k), u, started, begun)
                 kind, iterations, moving = OPTIMAL, int(answer[2]), f.moved[1]
                 add_kernel_metrics(f.log_sums, answer[4:12])
-            else:  # refused: relaxed, at fixed timing
-                if not relaxing or _paced(f):
+            elif _paced(f):  # refused, paced: slowed along the path
+                if not pacing:
                     mode[0] = first
                     return (HANDED, float(k), u, started, begun)
-                load_columns(
-                    qp.P,
-                    qp.cost,
-                    qp.A,
-                    qp.G,
-                    qp.lb,
-                    qp.ub,
-                    f.relaxed_P,
-                    f.relaxed_q,
-                    f.relaxed_A,
-                    f.relaxed_G,
-                    f.relaxed_lb,
-                    f.relaxed_ub,
-                )
-                again = solve_dropped(r)
-                for i in range(ATTEMPT):
-                    f.relaxed_made[i] = again[i]
+                again = _slow(s, f, p)
+                if again[0] != ACCEPTED or p.call.mode[0] != WARM:
+                    mode[0] = first
+                    return (HANDED, float(k), u, started, begun)
+                rate = min(max(p.call.x[s.x.shape[0]], 0.0), 1.0)
+                for i in range(qp.b.shape[0]):  # b at the progress the step makes
+                    f.saved_b[i] = qp.b[i]
+                    qp.b[i] = qp.b[i] - (1.0 - rate) * f.feedforward[i]
+                if not _move(s, f, p.call.x, clock):
+                    for i in range(qp.b.shape[0]):
+                        qp.b[i] = f.saved_b[i]
+                    mode[0] = first
+                    return (HANDED, float(k), u, started, begun)
+                kind, iterations, moving = SLOWED, int(again[2]), f.moved[1]
+                solver_time += again[3]
+                span *= rate
+                f.flags[k] = answer[1]
+                add_kernel_metrics(f.log_sums, again[4:12])
+            else:  # refused: relaxed, at fixed timing
+                if not relaxing:
+                    mode[0] = first
+                    return (HANDED, float(k), u, started, begun)
+                again = _relax(s, f, r)
                 if again[0] != ACCEPTED or r.call.mode[0] != WARM:
                     mode[0] = first
                     return (HANDED, float(k), u, started, begun)

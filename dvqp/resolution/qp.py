@@ -39,12 +39,19 @@ from numpy.typing import NDArray
 
 import solvers
 from dvqp.errors import BackendError
-from dvqp.resolution.levels import Levels, load_relaxed, relaxed_problem, strict_problem
+from dvqp.resolution.levels import (
+    Levels,
+    load_columns,
+    load_relaxed,
+    relaxed_problem,
+    strict_problem,
+)
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 from dvqp.workspace import QPBuffers, as_struct
 from solvers.accuracy import AccuracyTally, kernel_metrics
 from solvers.daqp_c import ACCEPTED, WARM, solve_dropped
+from solvers.jit import njit
 
 #: A watcher of the backend calls: ``(kind, problem, solution)``, kind ``"strict"``,
 #: ``"scaled"`` or ``"relaxed"``.
@@ -201,7 +208,7 @@ class QPSolver:
         :meth:`fused_attempt`'s), for a caller that relaxes a step whose strict problem its
         cold attempt refused in compiled code (:func:`dvqp.motion.follow.follow`), then hands
         both attempts' values to :meth:`solve` (``attempted``, ``relaxed_values``) or counts the
-        step (:meth:`count_relaxed`); None when it cannot (as :meth:`fused_attempt`)."""
+        step (:meth:`count_refused`); None when it cannot (as :meth:`fused_attempt`)."""
         if self.levels is not None or self.watchers:
             return None
         relaxed = self.backends[1]
@@ -215,10 +222,11 @@ class QPSolver:
         loop left it in (``settle_mode``)."""
         self.backends[0].settle_mode()  # type: ignore[attr-defined]
 
-    def count_relaxed(self, flags: NDArray[np.float64]) -> None:
-        """Count the strict refusals of steps relaxed in compiled code (the relaxed answers'
-        accuracy counted there): ``flags``, the refused cold attempts' exit flags, each
-        named by the strict backend (``refusal_of``) as its refused solution would be."""
+    def count_refused(self, flags: NDArray[np.float64]) -> None:
+        """Count the strict refusals of steps relaxed or slowed in compiled code (their
+        answers' accuracy counted there): ``flags``, the refused cold attempts' exit flags,
+        each named by the strict backend (``refusal_of``) as its refused solution would
+        be."""
         strict = self.backends[0]
         for flag, count in zip(*np.unique(flags, return_counts=True), strict=True):
             self.refusals[strict.refusal_of(flag)] += int(count)  # type: ignore[attr-defined]
@@ -233,6 +241,7 @@ class QPSolver:
         rest: bool = False,
         attempted: tuple[float, ...] | None = None,
         relaxed_values: tuple[float, ...] | None = None,
+        scaled_values: tuple[float, ...] | None = None,
     ) -> Answer:
         """Strict, else relaxed, else braking (``x`` a view, valid until the next solve).
 
@@ -245,7 +254,8 @@ class QPSolver:
         with :meth:`fused_attempt`'s struct and not taken there; the solve goes on from them.
         ``relaxed_values``: with them, the values of the relaxed problem's first attempt, made in
         compiled code too (:meth:`relaxed_attempt`) after that strict attempt, a cold one,
-        was refused and the relaxed problem loaded.
+        was refused and the relaxed problem loaded; ``scaled_values`` so, the time-scaled
+        problem's (:meth:`pacing_attempt`).
         """
         qp = self.qp
         if rest and not (np.any(qp.lb > 0.0) or np.any(qp.ub < 0.0) or np.any(qp.h < 0.0)):
@@ -267,7 +277,7 @@ class QPSolver:
         solution = self._call("strict", strict, self.strict, attempted)
         spent, status, rate = solution.solver_time, "optimal", 1.0
         if not solution.found and not rest and self.feedforward.any():
-            solution, rate = self._slow_down()
+            solution, rate = self._slow_down(scaled_values)
             spent, status = spent + solution.solver_time, "slowed"
         if not solution.found:
             load_relaxed(qp, self.relaxed)
@@ -333,30 +343,56 @@ class QPSolver:
             return Answer(None, f"failed: {message}", iterations, spent, 0.0)
         return Answer(np.clip(0.0, qp.lb, qp.ub), "braking", iterations, spent, rate)
 
-    def _slow_down(self) -> tuple[Any, float]:
-        """Solve the time-scaled problem; leave in ``b`` the task the answer meets (or, if it
-        has none, the task of stopping on the path, ``b − v``, for the relaxed problem).
-        Returns the solution and ``σ`` (0 if it has no accepted answer)."""
+    def _slow_down(self, attempted: tuple[float, ...] | None = None) -> tuple[Any, float]:
+        """Solve the time-scaled problem (:func:`load_scaled`; from its first attempt's
+        values ``attempted`` if compiled code made it, :meth:`pacing_attempt`); leave in
+        ``b`` the task the answer meets (or, if it has none, the task of stopping on the
+        path, ``b − v``, for the relaxed problem). Returns the solution and ``σ`` (0 if it
+        has no accepted answer)."""
         qp, v = self.qp, self.feedforward
         n = qp.cost.shape[0]
         if self.scaled is None:
             self.scaled = self._scaled_problem()
             self._pacer = self.factory()
         p = self.scaled
-        weight = self.task_weight * float(v @ v)
-        p.P[:n, :n], p.q[:n], p.A[:, :n], p.A[:, n] = qp.P, qp.cost, qp.A, -v
-        p.P[n, n], p.q[n] = weight, -weight
-        np.subtract(qp.b, v, out=p.b)
-        p.lb[:n], p.ub[:n] = qp.lb, qp.ub
-        if p.G is not None:
-            p.G[:, :n] = qp.G
-        solution = self._call("scaled", self._pacer, p)  # type: ignore[arg-type]
+        G = p.G if p.G is not None else np.zeros((0, n + 1))
+        weight = float(self.task_weight)
+        load_scaled(
+            qp.P,
+            qp.cost,
+            qp.A,
+            qp.b,
+            qp.G,
+            qp.lb,
+            qp.ub,
+            v,
+            weight,
+            p.P,
+            p.q,
+            p.A,
+            p.b,
+            G,
+            p.lb,
+            p.ub,
+        )
+        solution = self._call("scaled", self._pacer, p, attempted)  # type: ignore[arg-type]
         if not (solution.found and solution.x is not None):
             qp.b[:] -= v
             return solution, 0.0
         rate = min(max(float(solution.x[n]), 0.0), 1.0)
         qp.b[:] -= (1.0 - rate) * v
         return solution, rate
+
+    def pacing_attempt(self) -> Any:
+        """The time-scaled problem's backend's packed ``compiled_attempt`` of its next solve
+        (as :meth:`relaxed_attempt`'s), for a caller that slows a step whose strict problem
+        was refused in compiled code; None before a step was first slowed, or when it cannot
+        (as :meth:`fused_attempt`)."""
+        if self.levels is not None or self.watchers or self._pacer is None or self.scaled is None:
+            return None
+        attempt = getattr(self._pacer, "compiled_attempt", None)
+        rows = None if attempt is None else attempt(self.scaled)
+        return None if rows is None else self._packed(self._pacer, rows)
 
     def _scaled_problem(self) -> solvers.Problem:
         """The time-scaled problem's arrays, ``x = [Q̇; σ]`` (filled by :meth:`_slow_down`)."""
@@ -393,3 +429,40 @@ class QPSolver:
                 backend.reset()
         if self.levels is not None:
             self.levels.reset()
+
+
+@njit(separate=True, python=True)  # a run's compiled loop calls it, and QPSolver._slow_down
+def load_scaled(  # type: ignore[no-untyped-def]
+    P,
+    cost,
+    A,
+    b,
+    G,
+    lb,
+    ub,
+    v,
+    task_weight,
+    into_P,
+    into_q,
+    into_A,
+    into_b,
+    into_G,
+    into_lb,
+    into_ub,
+):
+    """The time-scaled problem of a step over ``x = [Q̇; σ]`` (:meth:`QPSolver._slow_down`):
+    the step's arrays in its ``Q̇`` columns (:func:`~dvqp.resolution.levels.load_columns`),
+    the tool rows' nominal motion ``v`` (m,) as ``σ``'s column ``−v``, the right side
+    ``b − v``, and ``σ``'s cost ``½ρ‖v‖²(1 − σ)²`` (``ρ`` the ``task_weight``): its weight
+    ``ρ‖v‖²`` on the diagonal and ``−ρ‖v‖²`` in the linear part."""
+    load_columns(P, cost, A, G, lb, ub, into_P, into_q, into_A, into_G, into_lb, into_ub)
+    n = cost.shape[0]
+    norm = 0.0
+    for i in range(v.shape[0]):
+        norm += v[i] * v[i]
+    weight = task_weight * norm
+    for i in range(into_A.shape[0]):
+        into_A[i, n] = -v[i]
+        into_b[i] = b[i] - v[i]
+    into_P[n, n] = weight
+    into_q[n] = -weight

@@ -90,6 +90,7 @@ class Made(NamedTuple):
     values: tuple[float, ...]
     relaxed: tuple[float, ...] | None = None
     moved: tuple[float, float] | None = None
+    scaled: tuple[float, ...] | None = None
 
 
 class Resolution(NamedTuple):
@@ -302,7 +303,7 @@ class Stepper(Verification):
         if made is not None:
             if solver is None:
                 return self._baseline_moved(made.values, made.started)
-            if made.relaxed is not None or made.moved is not None:
+            if made.relaxed is not None or made.scaled is not None or made.moved is not None:
                 return self._finished(solver, made)
             return self._fused(solver, made.values, made.started)
         if self.hooks.active or self.stopping:
@@ -352,7 +353,9 @@ class Stepper(Verification):
     def _finished(self, solver: QPSolver, made: Made) -> tuple[Resolution, bool | None]:
         """The step whose strict attempt, and maybe its relaxed attempt and move, the loop
         made (``made``): the resolution goes on from their values."""
-        answer = solver.solve(attempted=made.values[3:], relaxed_values=made.relaxed)
+        answer = solver.solve(
+            attempted=made.values[3:], relaxed_values=made.relaxed, scaled_values=made.scaled
+        )
         if made.moved is None:
             return self._resolved(answer, made.started), None
         singular, moving = made.moved

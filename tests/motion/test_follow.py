@@ -58,7 +58,7 @@ def planned(name: str, backend: str, loop: bool, **options: Any) -> tuple[Any, l
         return call
 
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(follow, "follow", counted(kernels[0], 4))
+        patch.setattr(follow, "follow", counted(kernels[0], 5))
         patch.setattr(follow, "follow_baseline", counted(kernels[1], 3))
         if not loop:
             patch.setattr(Stepper, "fused", lambda self: None)
@@ -92,21 +92,29 @@ def test_a_run_with_its_compiled_loop_is_the_run_step_by_step(name: str, backend
     assert len(fast_calls) >= fast.n_steps - 100  # a stop's steps are not counted
 
 
-def test_a_relaxed_streak_runs_in_the_loop_and_each_handed_step_is_finished_by_python() -> None:
-    """probe-into-clamp relaxes hundreds of steps in one streak: its first (the warm strict
-    attempt refused, retried cold) is Python's, the others the loop's (the strict problem's
-    cold attempt refused, the relaxed one accepted). With a stride of 0 the loop hands every
-    step over after its move (a relaxed one with both attempts made): Python finishes each
-    as it would have made it."""
-    fast, _, taken = planned("probe-into-clamp", "daqp", loop=True)
-    slow, _, _ = planned("probe-into-clamp", "daqp", loop=False)
-    relaxed = int(np.sum(fast.status == "relaxed"))
-    assert relaxed > 300 and taken >= fast.n_steps - 10
-    assert fast.refusals == {"infeasible": relaxed}
+@pytest.mark.parametrize(
+    ("name", "kind"), [("probe-into-clamp", "relaxed"), ("weld-rush", "slowed")]
+)
+def test_a_refused_streak_runs_in_the_loop_and_each_handed_step_is_finished_by_python(
+    name: str, kind: str
+) -> None:
+    """probe-into-clamp relaxes hundreds of steps in one streak, weld-rush slows 171 in
+    three: a streak's first step (the warm strict attempt refused, restarted cold) and the
+    others (the cold attempt refused) are the loop's, relaxed or slowed there, all but the
+    first such step of a run (its relaxed or time-scaled backend not yet set up). With a
+    stride of 0 the loop hands every step over after its move (with every attempt made, and
+    a slowed step's ``b`` put back): Python finishes each as it would have made it."""
+    fast, _, taken = planned(name, "daqp", loop=True)
+    slow, _, _ = planned(name, "daqp", loop=False)
+    refused = int(np.sum(fast.status == kind))
+    # Python's: the first step (the backends' set-up), the first refused step (the relaxed
+    # or time-scaled backend's set-up) and a stop's steps
+    assert refused > 100 and taken == fast.brake_start - 2
+    assert fast.refusals == {"infeasible": refused}
     assert_same_run(fast, slow)
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(follow, "JOINT_STRIDE", 0.0)
-        handed, _, none = planned("probe-into-clamp", "daqp", loop=True)
+        handed, _, none = planned(name, "daqp", loop=True)
     assert none == 0
     assert_same_run(handed, slow)
 
@@ -150,9 +158,9 @@ def test_a_limit_that_observes_in_python_turns_the_loop_off_and_sees_every_step(
     taken = 0
     kernel = follow.follow
 
-    def counted(s: Any, w: Any, r: Any, f: Any, k: int, *rest: Any) -> Any:
+    def counted(s: Any, w: Any, r: Any, p: Any, f: Any, k: int, *rest: Any) -> Any:
         nonlocal taken
-        out = kernel(s, w, r, f, k, *rest)
+        out = kernel(s, w, r, p, f, k, *rest)
         taken += int(out[1]) - k
         return out
 

@@ -51,9 +51,9 @@ def run(scene: dvqp.Scene, monkeypatch: pytest.MonkeyPatch, mode: str) -> tuple[
         return call
 
     def looped(kernel: Any) -> Any:
-        def call(s: Any, w: Any, r: Any, f: Any, k: int, *rest: Any) -> Any:
+        def call(s: Any, w: Any, r: Any, p: Any, f: Any, k: int, *rest: Any) -> Any:
             nonlocal made
-            out = kernel(s, w, r, f, k, *rest)
+            out = kernel(s, w, r, p, f, k, *rest)
             made += int(out[1]) - k + int(out[0] == follow.HANDED)
             return out
 
