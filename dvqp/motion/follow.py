@@ -275,7 +275,7 @@ class Follower:
             solver.accuracy.solves += int(arrays.solves[0])
         reached = int(out[1])
         if reached > k:
-            self._taken(k, reached)
+            self._taken(arrays, k, reached)
         if out[0] != HANDED:
             return Followed(reached, float(out[2]), float(out[3]), None)
         singular, moving = arrays.moved.tolist()
@@ -289,10 +289,10 @@ class Follower:
         )
         return Followed(reached, float(out[2]), float(out[3]), made)
 
-    def _taken(self, first: int, end: int) -> None:
-        """Steps ``first`` to ``end`` (excluded), taken by the loop: their statuses, and the
-        refusals of the relaxed ones' strict problems."""
-        record, (arrays, _) = self.record, self._struct()
+    def _taken(self, arrays: FollowArrays, first: int, end: int) -> None:
+        """Steps ``first`` to ``end`` (excluded), taken by the loop (``arrays``): their
+        statuses, and the refusals of the relaxed or slowed ones' strict problems."""
+        record = self.record
         record.status[first:end] = KINDS[OPTIMAL]
         record.steps = end
         kinds = arrays.kinds[first:end]
@@ -478,7 +478,7 @@ def follow(s, w, r, p, f, k, u, started, until, relaxing, pacing):  # type: igno
         not made), and the move's ``(singular, seconds)`` in ``f.moved`` (NaN: not moved).
     """
     clock = w.call.handles[H_CLOCK]
-    a, qp, mode = f.schedule, s.qp, w.call.mode
+    a, mode = f.schedule, w.call.mode
     while k < until and not u >= a.n - 1e-9:
         begun = now(clock)
         span = _begin(s, f, k, u)
@@ -487,72 +487,73 @@ def follow(s, w, r, p, f, k, u, started, until, relaxing, pacing):  # type: igno
         if out[0] == MOVED:  # the warm answer accepted, its state evaluated
             if out[1] != -1.0 or not _kept(s, f):
                 return _handed(f, out, k, u, started, begun)
-            kind, iterations, solver_time, moving = OPTIMAL, int(out[5]), out[6], out[2]
+            kind, iterations, solver_time, rate = OPTIMAL, int(out[5]), out[6], 1.0
+            moving = out[2]
             add_kernel_metrics(f.log_sums, out[7:15])
         else:
             if out[0] != ATTEMPTED or not _checked(out[3:15]):
                 return _handed(f, out, k, u, started, begun)
-            answer, warm = out[3:15], 0.0
-            if first == WARM:  # refused warm: the cold restart, its time the warm one's too
-                mode[0] = RESTART
-                answer, warm = attempt(w.call), out[6]
-                if not _checked(answer):
-                    mode[0] = first
-                    return _handed(f, out, k, u, started, begun)
             _handed(f, out, k, u, started, begun)  # what Python finishes if it must
-            solver_time = answer[3] + warm
-            if answer[0] == ACCEPTED:  # the strict answer, cold
-                mode[0] = WARM
-                if not _move(s, f, w.call.x, clock):
-                    mode[0] = first
-                    return (HANDED, float(k), u, started, begun)
-                kind, iterations, moving = OPTIMAL, int(answer[2]), f.moved[1]
-                add_kernel_metrics(f.log_sums, answer[4:12])
-            elif _paced(f):  # refused, paced: slowed along the path
-                if not pacing:
-                    mode[0] = first
-                    return (HANDED, float(k), u, started, begun)
-                again = _slow(s, f, p)
-                if again[0] != ACCEPTED or p.call.mode[0] != WARM:
-                    mode[0] = first
-                    return (HANDED, float(k), u, started, begun)
-                rate = min(max(p.call.x[s.x.shape[0]], 0.0), 1.0)
-                for i in range(qp.b.shape[0]):  # b at the progress the step makes
-                    f.saved_b[i] = qp.b[i]
-                    qp.b[i] = qp.b[i] - (1.0 - rate) * f.feedforward[i]
-                if not _move(s, f, p.call.x, clock):
-                    for i in range(qp.b.shape[0]):
-                        qp.b[i] = f.saved_b[i]
-                    mode[0] = first
-                    return (HANDED, float(k), u, started, begun)
-                kind, iterations, moving = SLOWED, int(again[2]), f.moved[1]
-                solver_time += again[3]
-                span *= rate
-                f.flags[k] = answer[1]
-                add_kernel_metrics(f.log_sums, again[4:12])
-            else:  # refused: relaxed, at fixed timing
-                if not relaxing:
-                    mode[0] = first
-                    return (HANDED, float(k), u, started, begun)
-                again = _relax(s, f, r)
-                if again[0] != ACCEPTED or r.call.mode[0] != WARM:
-                    mode[0] = first
-                    return (HANDED, float(k), u, started, begun)
-                if not _move(s, f, r.call.x, clock):
-                    mode[0] = first
-                    return (HANDED, float(k), u, started, begun)
-                kind, iterations, moving = RELAXED, int(again[2]), f.moved[1]
-                solver_time += again[3]
-                f.flags[k] = answer[1]
-                add_kernel_metrics(f.log_sums, again[4:12])
+            kind, iterations, solver_time, rate = _refused(s, w, r, p, f, k, out, relaxing, pacing)
+            if kind < 0:
+                mode[0] = first
+                return (HANDED, float(k), u, started, begun)
+            moving = f.moved[1]
         f.solves[0] += 1
         ended = now(clock)
         _record(s, f, k, ended - begun - moving, iterations, solver_time, ended - started, kind)
         started = ended
-        u += span
+        u += rate * span
         k += 1
         f.progress[k] = u
     return (STOPPED, float(k), u, started, 0.0)
+
+
+@njit(inline="always")
+def _refused(s, w, r, p, f, k, out, relaxing, pacing):  # type: ignore[no-untyped-def]
+    """Step ``k`` whose strict attempt (``out``, :func:`~dvqp.step.stages.resolve_move`'s) was
+    refused or a cold one: restarted cold if it was warm (the backend's ``after_warm``),
+    then, still refused, slowed if paced, else relaxed, and moved. Returns ``(kind,
+    iterations, solver_time, rate)`` of the step taken, its kind −1 (with ``b`` as it was)
+    when it cannot be taken here."""
+    clock, mode, qp = w.call.handles[H_CLOCK], w.call.mode, s.qp
+    answer, warm = out[3:15], 0.0
+    if mode[0] == WARM:  # the cold restart; its time counts the warm attempt's too
+        mode[0] = RESTART
+        answer, warm = attempt(w.call), out[6]
+        if not _checked(answer):
+            return (-1, 0, 0.0, 0.0)
+    solver_time = answer[3] + warm
+    if answer[0] == ACCEPTED:  # the strict answer, cold
+        mode[0] = WARM
+        if not _move(s, f, w.call.x, clock):
+            return (-1, 0, 0.0, 0.0)
+        add_kernel_metrics(f.log_sums, answer[4:12])
+        return (OPTIMAL, int(answer[2]), solver_time, 1.0)
+    f.flags[k] = answer[1]
+    if _paced(f):  # slowed along the path
+        if not pacing:
+            return (-1, 0, 0.0, 0.0)
+        again = _slow(s, f, p)
+        if again[0] != ACCEPTED or p.call.mode[0] != WARM:
+            return (-1, 0, 0.0, 0.0)
+        rate = min(max(p.call.x[s.x.shape[0]], 0.0), 1.0)
+        for i in range(qp.b.shape[0]):  # b at the progress the step makes
+            f.saved_b[i] = qp.b[i]
+            qp.b[i] = qp.b[i] - (1.0 - rate) * f.feedforward[i]
+        if not _move(s, f, p.call.x, clock):
+            for i in range(qp.b.shape[0]):
+                qp.b[i] = f.saved_b[i]
+            return (-1, 0, 0.0, 0.0)
+        add_kernel_metrics(f.log_sums, again[4:12])
+        return (SLOWED, int(again[2]), solver_time + again[3], rate)
+    if not relaxing:  # relaxed, at fixed timing
+        return (-1, 0, 0.0, 0.0)
+    again = _relax(s, f, r)
+    if again[0] != ACCEPTED or r.call.mode[0] != WARM or not _move(s, f, r.call.x, clock):
+        return (-1, 0, 0.0, 0.0)
+    add_kernel_metrics(f.log_sums, again[4:12])
+    return (RELAXED, int(again[2]), solver_time + again[3], 1.0)
 
 
 @njit

@@ -194,9 +194,10 @@ class QPSolver:
         """The strict backend's packed ``compiled_attempt`` of its next solve, for a caller
         that makes the attempt in a compiled call of its own (:func:`dvqp.step.stages.
         resolve_move`), then hands its values to :meth:`took` (taken) or :meth:`solve`
-        (``attempted``); None when the step is not one strict problem made that way (levels,
-        watchers, a backend without compiled attempts)."""
-        if self.levels is not None or self.watchers:
+        (``attempted``); None when the step's first problem is not the strict one made that
+        way (levels that cannot all be met together, watchers, a backend without compiled
+        attempts)."""
+        if (self.levels is not None and not self.levels.together) or self.watchers:
             return None
         strict = self.backends[0]
         attempt = getattr(strict, "compiled_attempt", None)
@@ -263,8 +264,7 @@ class QPSolver:
         strict, relaxed = self.backends
         levels, refused = self.levels, None
         if levels is not None and levels.together:  # all the task rows, strict: as one level
-            solution = refused = strict.solve(self.strict)
-            self._count("strict", self.strict, solution)
+            solution = refused = self._call("strict", strict, self.strict, attempted)
             if solution.found and solution.x is not None:
                 x = solution.x[: qp.cost.shape[0]]
                 return Answer(x, "optimal", solution.iterations, solution.solver_time)

@@ -81,6 +81,7 @@ def assert_same_run(a: Any, b: Any) -> None:
         ("weld-rush", "daqp"),  # time-scaled, slowed steps handed over, the recorder grows
         ("weld-rush", "pinv"),
         ("fold", "daqp"),
+        ("reach-priorities", "daqp"),  # two levels, met together in most steps
     ],
 )
 def test_a_run_with_its_compiled_loop_is_the_run_step_by_step(name: str, backend: str) -> None:

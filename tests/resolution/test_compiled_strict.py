@@ -29,7 +29,7 @@ needs_mirror = pytest.mark.skipif(
     not daqp_abi.available(), reason="the installed daqp's layout is not mirrored"
 )
 
-SCENES = ("paper-two-inlets", "probe-into-clamp", "weld-rush", "joint-limit")
+SCENES = ("paper-two-inlets", "probe-into-clamp", "weld-rush", "joint-limit", "reach-priorities")
 
 
 def run(scene: dvqp.Scene, monkeypatch: pytest.MonkeyPatch, mode: str) -> tuple[Any, int]:
