@@ -60,6 +60,9 @@ ATTEMPT = 12
 STOPPED, HANDED = 0.0, 1.0
 """How :func:`follow` returns: it stopped before a step (the schedule's end, ``until``), or
 it hands a step it made but cannot take as it is to Python."""
+BATCH = 1000
+"""Most steps one call of the loop takes (some ms): Python then handles a pending signal
+(Ctrl-C) and shows the progress before the next."""
 OPTIMAL, RELAXED, SLOWED = 0, 1, 2
 """The kinds of step the loop takes (``FollowArrays.kinds``)."""
 KINDS = ("optimal", "relaxed", "slowed")
@@ -240,14 +243,14 @@ class Follower:
 
     def run(self, k: int, u: float, started: float, until: int | None = None) -> Followed:
         """The common steps from step ``k`` at progress ``u`` (the step starting at
-        ``started``), until the schedule's end, its budget, the recorder's room or ``until``
-        steps; each recorded and counted. The step after them, made, is handed over when it
-        is not common."""
+        ``started``), until the schedule's end, its budget, the recorder's room, :data:`BATCH`
+        steps or step ``until``; each recorded and counted. The step after them, made, is
+        handed over when it is not common."""
         stepper, record, schedule = self.stepper, self.record, self.schedule
         handle = stepper.fused()
         if handle is None:
             return Followed(k, u, started, None)
-        room = min(schedule.budget, record.arrays["qdot"].shape[0])
+        room = min(schedule.budget, record.arrays["qdot"].shape[0], k + BATCH)
         stop = room if until is None else min(until, room)
         arrays, f = self._struct()
         solver = stepper.solver

@@ -24,7 +24,7 @@ from dvqp.geometry.shapes import Shape
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DamperArrays
-from dvqp.resolution.pinv import PseudoinverseResolver
+from dvqp.resolution.pinv import PseudoinverseResolver, work_size
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 from dvqp.step.arrays import (
@@ -248,7 +248,15 @@ def lay_out(
         layout.params,
         plan.dampers,
         plan.qp,
-        PinvArrays(baseline, weights, layout.hooks.soft, damping, np.zeros(3), x),
+        PinvArrays(
+            baseline,
+            weights,
+            layout.hooks.soft,
+            damping,
+            np.zeros(3),
+            x,
+            np.zeros(work_size(n, plan.qp.A.shape[0]) if baseline else 0),
+        ),
         plan.checks,
         layout.joint_values,
         layout.damper_values,
