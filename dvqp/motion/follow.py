@@ -512,7 +512,7 @@ def follow(s, w, r, p, f, k, u, started, until, relaxing, pacing):  # type: igno
     return (STOPPED, float(k), u, started, 0.0)
 
 
-@njit(inline="always")
+@njit(separate=True)  # compiled once, called by symbol: the loop stays small to compile
 def _refused(s, w, r, p, f, k, out, relaxing, pacing):  # type: ignore[no-untyped-def]
     """Step ``k`` whose strict attempt (``out``, :func:`~dvqp.step.stages.resolve_move`'s) was
     refused or a cold one: restarted cold if it was warm (the backend's ``after_warm``),

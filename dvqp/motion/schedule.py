@@ -141,7 +141,9 @@ class Schedule:
 @njit(inline="always")
 def _position(a, u, c):  # type: ignore[no-untyped-def]
     """Component ``c`` of ``x_d(u)``: the path's nodes interpolated linearly."""
-    i = min(int(u), a.n - 1)
+    i = int(u)
+    if i > a.n - 1:
+        i = a.n - 1
     return a.nodes[i, c] + (u - i) * (a.nodes[i + 1, c] - a.nodes[i, c])
 
 
@@ -155,7 +157,7 @@ def _wrapped(a, e, c):  # type: ignore[no-untyped-def]
     return e
 
 
-@njit
+@njit(separate=True, python=True)  # a run's compiled loop calls it, and Schedule.command
 def command_into(a, u, tool, xdot, feedforward):  # type: ignore[no-untyped-def]
     """The tool command of the schedule ``a`` (:class:`ScheduleArrays`) at progress ``u`` with
     the tool at ``tool`` (4,), written into ``xdot`` (4,), and at a time-scaled run its
@@ -173,7 +175,7 @@ def command_into(a, u, tool, xdot, feedforward):  # type: ignore[no-untyped-def]
             if a.feedback:
                 xdot[c] = xdot[c] + a.gain * _wrapped(a, a.reference[k, c] - tool[c], c)
         return 1.0
-    span = min(1.0, a.n - u)
+    span = a.n - u if a.n - u < 1.0 else 1.0  # min(1, n − u)
     for c in range(4):
         here = _position(a, u, c)
         feedforward[c] = (_position(a, u + span, c) - here) / a.dt
