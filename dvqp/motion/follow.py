@@ -382,7 +382,7 @@ def _paced(f) -> bool:  # type: ignore[no-untyped-def]
     return paced
 
 
-@njit(inline="always")
+@njit(separate=True)
 def _move(s, f, x, clock):  # type: ignore[no-untyped-def]
     """The step ``x`` taken and the state it reaches evaluated (as :meth:`dvqp.step.
     Stepper.move`), kept in ``f.moved`` as ``(singular, seconds)``; whether it is taken as

@@ -204,8 +204,8 @@ def test_the_schedule_command_is_the_feedforward_plus_the_wrapped_feedback(
     x = np.array(tool)
     schedule = Schedule(commands, reference[:-1], gain, dt, radius, scaled=scaled)
     xdot, feedforward, span = schedule.command(u, x)
-    if scaled:
-        nodes = reference
+    if scaled:  # the path's nodes: the reference, then its last plus the last command's motion
+        nodes = np.vstack([reference[:-1], reference[-2] + dt * commands[-1]])
         span_expected = min(1.0, 5 - u)
 
         def at(v: float) -> np.ndarray:
