@@ -23,7 +23,7 @@ AFTER = 0.1
 nothing; a cold one starts compiling about 2 s after the command starts, most of it
 importing)."""
 
-ESTIMATES = {"plan": 21, "compare": 28, "export-qps": 22, "bench": 30}
+ESTIMATES = {"plan": 24, "compare": 32, "export-qps": 26, "bench": 33}
 """s a first run of each command compiles for on the paper scene (a 2-core machine, quiet:
 ``benchmarks/startup.py``); other commands compile less."""
 

@@ -431,7 +431,7 @@ class QPSolver:
             self.levels.reset()
 
 
-@njit(separate=True, python=True)  # a run's compiled loop calls it, and QPSolver._slow_down
+@njit(separate=True)  # a run's compiled loop calls it; QPSolver._slow_down when a run slows
 def load_scaled(  # type: ignore[no-untyped-def]
     P,
     cost,
