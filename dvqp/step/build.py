@@ -194,6 +194,25 @@ def _verified(layout: Layout, step: StepWiring, joints: tuple[str, ...]) -> None
         layout.blocks.append(Block(block.limit, first, first + count, named[:count]))
 
 
+def _pinv_arrays(
+    resolver: Resolver, weights: np.ndarray, soft: bool, x: np.ndarray, rows: int
+) -> PinvArrays:
+    """The baseline's arrays (for a QP resolver: unused, its scratch empty), ``x`` (n,) its
+    step, ``rows`` the task rows.
+
+    Raises
+    ------
+    ParameterError
+        A damped inverse with soft tasks (``soft``).
+    """
+    baseline = isinstance(resolver, PseudoinverseResolver)
+    damping = resolver.damping if isinstance(resolver, PseudoinverseResolver) else 0.0
+    if damping > 0.0 and soft:
+        raise ParameterError("damping", "the damped inverse takes no soft tasks")
+    work = np.zeros(work_size(x.shape[0], rows) if baseline else 0)
+    return PinvArrays(baseline, weights, soft, damping, np.zeros(3), x, work)
+
+
 def lay_out(
     robot: Robot,
     radius: float,
@@ -213,10 +232,8 @@ def lay_out(
     assert plan.qp is not None and plan.dampers is not None and plan.checks is not None
     weights = spec.diagonal(n)
     plan.qp.P[:] = np.diag(weights)
-    baseline = isinstance(resolver, PseudoinverseResolver)
-    damping = resolver.damping if isinstance(resolver, PseudoinverseResolver) else 0.0
-    if damping > 0.0 and layout.hooks.soft:
-        raise ParameterError("damping", "the damped inverse takes no soft tasks")
+    x = np.zeros(n)  # the step: the baseline's is written there directly
+    pinv = _pinv_arrays(resolver, weights, layout.hooks.soft, x, plan.qp.A.shape[0])
     shapes = ShapeArrays.of(layout.shapes, plan.period)
     shapes.refine[:] = layout.refine  # links measured to the last precision below a margin
     if not layout.hooks.active:  # parts of your own may read any row: every row exact
@@ -229,7 +246,6 @@ def lay_out(
         if samples is None
         else RecordArrays(np.full(1, -1, np.int64), *(samples[f] for f in fields))
     )
-    x = np.zeros(n)  # the step: the baseline's is written there directly
     return layout, Pipeline(
         float(radius),
         plan.dt,
@@ -248,15 +264,7 @@ def lay_out(
         layout.params,
         plan.dampers,
         plan.qp,
-        PinvArrays(
-            baseline,
-            weights,
-            layout.hooks.soft,
-            damping,
-            np.zeros(3),
-            x,
-            np.zeros(work_size(n, plan.qp.A.shape[0]) if baseline else 0),
-        ),
+        pinv,
         plan.checks,
         layout.joint_values,
         layout.damper_values,
