@@ -131,12 +131,35 @@ def _inverse(P: Array, dense: bool, weights: Array, info: Array, Q: Array) -> bo
 
 
 @njit(inline="always")
-def _level(A, b, first, m, Q, inverse, x, damping, info, lower, diagonal, work) -> bool:  # type: ignore[no-untyped-def]
+def _project(Q, qa, gram, cost, x, column, out):  # type: ignore[no-untyped-def]
+    """``out = x − (Q − Q Aᵀ S⁻¹ (Q Aᵀ)ᵀ) cost`` without forming the projected ``Q``
+    (``qa = Q Aᵀ`` (n, m), ``gram`` the factor of ``S``, ``column`` (m,) scratch): ``x −
+    Q cost + qa S⁻¹ (qaᵀ cost)``."""
+    n, m = qa.shape
+    for r in range(m):
+        v = 0.0
+        for c in range(n):
+            v += qa[c, r] * cost[c]
+        column[r] = v
+    _solve(gram, column)
+    for c in range(n):
+        v = x[c]
+        for j in range(n):
+            v -= Q[c, j] * cost[j]
+        for r in range(m):
+            v += qa[c, r] * column[r]
+        out[c] = v
+
+
+@njit(inline="always")
+def _level(A, b, first, m, Q, inverse, x, damping, info, lower, diagonal, work, cost, out) -> bool:  # type: ignore[no-untyped-def]
     """Level ``A[first : first + m]``: ``x += Q Aᵀ S⁻¹ (b − A x)`` and ``Q −= Q Aᵀ S⁻¹ A Q``;
     False if ``S`` is not safely positive definite (``lower``: below the first level, also
     against the level's own size through ``inverse`` = M⁻¹; ``diagonal``: ``Q`` is, the
     first level's ``M⁻¹`` of a diagonal metric; ``work``: scratch, ``(n + m + 2) m``
-    floats)."""
+    floats). The last level (``out`` of size n, else of size 0) writes the step instead,
+    ``out = x − Q cost`` with the ``Q`` it would leave (:func:`_project`), and leaves ``Q``
+    as it was."""
     n = A.shape[1]
     qa, gram = work[: n * m].reshape((n, m)), work[n * m : (n + m) * m].reshape((m, m))
     rhs, column = work[(n + m) * m : (n + m + 1) * m], work[(n + m + 1) * m : (n + m + 2) * m]
@@ -176,6 +199,9 @@ def _level(A, b, first, m, Q, inverse, x, damping, info, lower, diagonal, work) 
         for r in range(m):
             v += qa[c, r] * rhs[r]
         x[c] += v
+    if out.shape[0]:  # the last level: Q is read once more, as out = x − Q_new c
+        _project(Q, qa, gram, cost, x, column, out)
+        return True
     for c in range(n):  # Q −= Q A_kᵀ S_k⁻¹ (Q A_kᵀ)ᵀ, column by column
         for r in range(m):
             column[r] = qa[c, r]
@@ -219,17 +245,23 @@ def pinv_step(A, b, levels, cost, weights, P, dense, damping, info, out, work) -
     x, scratch = work[2 * n * n : 2 * n * n + n], work[2 * n * n + n :]
     for i in range(n):
         x[i] = 0.0
+    last = -1  # the last level with rows: it writes the step
+    for level in range(levels.shape[0] - 1):
+        if levels[level + 1] > levels[level]:
+            last = level
     for level in range(levels.shape[0] - 1):
         first, m = levels[level], levels[level + 1] - levels[level]
         diagonal = not dense and level == 0
+        step = out if level == last else out[:0]
         if m > 0 and not _level(
-            A, b, first, m, Q, inverse, x, damping, info, level > 0, diagonal, scratch
+            A, b, first, m, Q, inverse, x, damping, info, level > 0, diagonal, scratch, cost, step
         ):
             info[2] = level
             return SINGULAR
-    for c in range(n):
-        v = x[c]
-        for j in range(n):
-            v -= Q[c, j] * cost[j]
-        out[c] = v
+    if last == -1:  # no task row: the objective's step alone
+        for c in range(n):
+            v = x[c]
+            for j in range(n):
+                v -= Q[c, j] * cost[j]
+            out[c] = v
     return -1
