@@ -180,6 +180,7 @@ def inlet_point(pl, pz, r, big, sl, sz):  # type: ignore[no-untyped-def]
     points along the inward normal (the region is convex)."""
     n, h = sl.shape[0], 2.0 * math.pi / sl.shape[0]
     best, phi = math.inf, 0.0
+    dl, dz, l1, z1 = math.nan, math.nan, math.nan, math.nan  # the outline at the nearest φ
     before = (sl[n - 1] - pl) ** 2 + (sz[n - 1] - pz) ** 2
     here = (sl[0] - pl) ** 2 + (sz[0] - pz) ** 2
     for k in range(n):
@@ -191,12 +192,13 @@ def inlet_point(pl, pz, r, big, sl, sz):  # type: ignore[no-untyped-def]
             x = _nearest(pl, pz, r, big, guess, (k - 1) * h, (k + 1) * h)
             if x != x:  # nan: no clean Newton's step
                 x = _golden(pl, pz, r, big, (k - 1) * h, (k + 1) * h)
-            dl, dz = _curve(x, r, big)[:2]
-            d2 = (dl - pl) ** 2 + (dz - pz) ** 2
+            cl, cz, cl1, cz1, _, _ = _curve(x, r, big)
+            d2 = (cl - pl) ** 2 + (cz - pz) ** 2
             if d2 < best:
-                best, phi = d2, x
+                best, phi, dl, dz, l1, z1 = d2, x, cl, cz, cl1, cz1
         before, here = here, after
-    dl, dz, l1, z1, _, _ = _curve(phi, r, big)
+    if phi != phi or best == math.inf:  # no sample bracketed one (not finite): as before
+        dl, dz, l1, z1, _, _ = _curve(phi, r, big)
     d = math.sqrt(best)
     sign = -1.0 if (pl - dl) * z1 - (pz - dz) * l1 < 0.0 else 1.0  # p − c along the normal?
     if d > _ON:
