@@ -152,17 +152,16 @@ def _project(Q, qa, gram, cost, x, column, out):  # type: ignore[no-untyped-def]
 
 
 @njit(inline="always")
-def _level(A, b, first, m, Q, inverse, x, damping, info, lower, diagonal, work, cost, out) -> bool:  # type: ignore[no-untyped-def]
+def _level(A, b, first, m, Q, inverse, x, damping, info, lower, diagonal, last, cost, out) -> bool:  # type: ignore[no-untyped-def]
     """Level ``A[first : first + m]``: ``x += Q Aᵀ S⁻¹ (b − A x)`` and ``Q −= Q Aᵀ S⁻¹ A Q``;
     False if ``S`` is not safely positive definite (``lower``: below the first level, also
     against the level's own size through ``inverse`` = M⁻¹; ``diagonal``: ``Q`` is, the
-    first level's ``M⁻¹`` of a diagonal metric; ``work``: scratch, ``(n + m + 2) m``
-    floats). The last level (``out`` of size n, else of size 0) writes the step instead,
+    first level's ``M⁻¹`` of a diagonal metric). The ``last`` level writes the step instead,
     ``out = x − Q cost`` with the ``Q`` it would leave (:func:`_project`), and leaves ``Q``
     as it was."""
     n = A.shape[1]
-    qa, gram = work[: n * m].reshape((n, m)), work[n * m : (n + m) * m].reshape((m, m))
-    rhs, column = work[(n + m) * m : (n + m + 1) * m], work[(n + m + 1) * m : (n + m + 2) * m]
+    qa, gram, rhs = np.empty((n, m)), np.empty((m, m)), np.empty(m)  # Q A_kᵀ, S_k
+    column = np.empty(m)
     for c in range(n):
         for r in range(m):
             if diagonal:  # the sum below of a diagonal Q, bit for bit (its zeros add +0)
@@ -199,7 +198,7 @@ def _level(A, b, first, m, Q, inverse, x, damping, info, lower, diagonal, work, 
         for r in range(m):
             v += qa[c, r] * rhs[r]
         x[c] += v
-    if out.shape[0]:  # the last level: Q is read once more, as out = x − Q_new c
+    if last:  # the last level: Q is read once more, as out = x − Q_new c
         _project(Q, qa, gram, cost, x, column, out)
         return True
     for c in range(n):  # Q −= Q A_kᵀ S_k⁻¹ (Q A_kᵀ)ᵀ, column by column
@@ -214,37 +213,21 @@ def _level(A, b, first, m, Q, inverse, x, damping, info, lower, diagonal, work, 
     return True
 
 
-def work_size(n: int, m: int) -> int:
-    """Floats of :func:`pinv_step`'s scratch for ``n`` joints and ``m`` task rows."""
-    return 2 * n * n + n + (n + m + 2) * m
-
-
 @njit(separate=True)
-def pinv_step(A, b, levels, cost, weights, P, dense, damping, info, out, work) -> int:  # type: ignore[no-untyped-def]
+def pinv_step(A, b, levels, cost, weights, P, dense, damping, info, out) -> int:  # type: ignore[no-untyped-def]
     """``out``: the nested step of the module docstring over the levels ``A[levels[k] :
     levels[k+1]]`` (``levels`` (L + 1,)), with ``g = −cost`` and ``M = diag(weights)``, or the
     dense ``P`` if ``dense``. Returns −1, :data:`SINGULAR` (a level's Gram matrix ``S_k`` not
     safely positive definite: undamped, its smallest pivot below :data:`SINGULAR_RCOND` of its
     largest or, below the first level, of the level's own ``max_r A_r M⁻¹ A_rᵀ``, which the
     levels above may have hidden; ``info`` the pivots' extreme squares and the level k) or
-    :data:`NOT_DEFINITE` (the metric). ``work``: scratch of :func:`work_size` floats (no
-    array is allocated but a dense metric's factor)."""
+    :data:`NOT_DEFINITE` (the metric)."""
     n = A.shape[1]
-    Q = work[: n * n].reshape((n, n))  # M⁻¹, then what the levels leave free
-    for i in range(n):
-        for j in range(n):
-            Q[i, j] = 0.0
+    Q = np.zeros((n, n))  # M⁻¹, then what the levels leave free
     if not _inverse(P, dense, weights, info, Q):
         return NOT_DEFINITE
-    inverse = Q  # M⁻¹, kept for the lower levels' scale
-    if levels.shape[0] > 2:
-        inverse = work[n * n : 2 * n * n].reshape((n, n))
-        for i in range(n):
-            for j in range(n):
-                inverse[i, j] = Q[i, j]
-    x, scratch = work[2 * n * n : 2 * n * n + n], work[2 * n * n + n :]
-    for i in range(n):
-        x[i] = 0.0
+    inverse = Q.copy() if levels.shape[0] > 2 else Q  # M⁻¹, kept for the lower levels' scale
+    x = np.zeros(n)
     last = -1  # the last level with rows: it writes the step
     for level in range(levels.shape[0] - 1):
         if levels[level + 1] > levels[level]:
@@ -252,9 +235,21 @@ def pinv_step(A, b, levels, cost, weights, P, dense, damping, info, out, work) -
     for level in range(levels.shape[0] - 1):
         first, m = levels[level], levels[level + 1] - levels[level]
         diagonal = not dense and level == 0
-        step = out if level == last else out[:0]
         if m > 0 and not _level(
-            A, b, first, m, Q, inverse, x, damping, info, level > 0, diagonal, scratch, cost, step
+            A,
+            b,
+            first,
+            m,
+            Q,
+            inverse,
+            x,
+            damping,
+            info,
+            level > 0,
+            diagonal,
+            level == last,
+            cost,
+            out,
         ):
             info[2] = level
             return SINGULAR

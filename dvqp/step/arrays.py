@@ -103,8 +103,7 @@ class MeasureArrays:
 class PinvArrays:
     """The baseline's step (eq. 18), when ``baseline``: ``weights`` (n,) of ``W``, ``dense``
     (soft tasks make the metric ``P``), ``damping`` μ, ``info`` (3,) the Cholesky pivots'
-    extremes, ``x`` (n,) the step, ``work`` its scratch
-    (:func:`~dvqp.resolution.pinv.work_size`)."""
+    extremes, ``x`` (n,) the step."""
 
     baseline: bool
     weights: Array
@@ -112,7 +111,6 @@ class PinvArrays:
     damping: float
     info: Array
     x: Array
-    work: Array
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ from dvqp.geometry.shapes import Shape
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DamperArrays
-from dvqp.resolution.pinv import PseudoinverseResolver, work_size
+from dvqp.resolution.pinv import PseudoinverseResolver
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 from dvqp.step.arrays import (
@@ -194,11 +194,8 @@ def _verified(layout: Layout, step: StepWiring, joints: tuple[str, ...]) -> None
         layout.blocks.append(Block(block.limit, first, first + count, named[:count]))
 
 
-def _pinv_arrays(
-    resolver: Resolver, weights: np.ndarray, soft: bool, x: np.ndarray, rows: int
-) -> PinvArrays:
-    """The baseline's arrays (for a QP resolver: unused, its scratch empty), ``x`` (n,) its
-    step, ``rows`` the task rows.
+def _pinv_arrays(resolver: Resolver, weights: np.ndarray, soft: bool, x: np.ndarray) -> PinvArrays:
+    """The baseline's arrays (for a QP resolver: unused), ``x`` (n,) its step.
 
     Raises
     ------
@@ -209,8 +206,7 @@ def _pinv_arrays(
     damping = resolver.damping if isinstance(resolver, PseudoinverseResolver) else 0.0
     if damping > 0.0 and soft:
         raise ParameterError("damping", "the damped inverse takes no soft tasks")
-    work = np.zeros(work_size(x.shape[0], rows) if baseline else 0)
-    return PinvArrays(baseline, weights, soft, damping, np.zeros(3), x, work)
+    return PinvArrays(baseline, weights, soft, damping, np.zeros(3), x)
 
 
 def lay_out(
@@ -233,7 +229,7 @@ def lay_out(
     weights = spec.diagonal(n)
     plan.qp.P[:] = np.diag(weights)
     x = np.zeros(n)  # the step: the baseline's is written there directly
-    pinv = _pinv_arrays(resolver, weights, layout.hooks.soft, x, plan.qp.A.shape[0])
+    pinv = _pinv_arrays(resolver, weights, layout.hooks.soft, x)
     shapes = ShapeArrays.of(layout.shapes, plan.period)
     shapes.refine[:] = layout.refine  # links measured to the last precision below a margin
     if not layout.hooks.active:  # parts of your own may read any row: every row exact

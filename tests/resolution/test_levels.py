@@ -29,7 +29,7 @@ from dvqp import (
 )
 from dvqp.errors import SingularConfigurationError
 from dvqp.limits import JointPositionLimit, JointVelocityLimit, SurfaceHeight
-from dvqp.resolution.pinv import pinv_step, work_size
+from dvqp.resolution.pinv import pinv_step
 from dvqp.resolution.spec import DEFAULT_TASK_WEIGHT
 from dvqp.step import advance
 from tests.common import LINK_LENGTHS, PIPE_RADIUS, Q0, objective_with, random_configurations
@@ -265,13 +265,12 @@ def test_the_compiled_nested_step_is_the_null_space_oracle(
     A, b = np.vstack(rows), np.concatenate(v)
     breaks = np.cumsum([0, *sizes]).astype(np.int64)
     out, info = np.zeros(n), np.zeros(3)
-    work = np.full(work_size(n, A.shape[0]), np.nan)  # scratch: nothing read before written
-    status = pinv_step(A, b, breaks, -g, w, np.eye(n), False, 0.0, info, out, work)
+    status = pinv_step(A, b, breaks, -g, w, np.eye(n), False, 0.0, info, out)
     assert status == -1
     np.testing.assert_allclose(out, nested(list(zip(rows, v, strict=True)), g, w), atol=1e-9)
     np.testing.assert_allclose(A @ out, b, atol=1e-9)  # every level met
     dense = np.diag(w)  # the same metric, written out: the dense path
-    status = pinv_step(A, b, breaks, -g, w, dense, True, 0.0, info, out, work)
+    status = pinv_step(A, b, breaks, -g, w, dense, True, 0.0, info, out)
     np.testing.assert_allclose(out, nested(list(zip(rows, v, strict=True)), g, w), atol=1e-9)
 
 

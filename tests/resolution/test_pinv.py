@@ -22,7 +22,7 @@ from dvqp import (
     simulate,
 )
 from dvqp.errors import ParameterError, ShapeError, SingularConfigurationError
-from dvqp.resolution.pinv import SINGULAR, pinv_step, work_size
+from dvqp.resolution.pinv import SINGULAR, pinv_step
 from tests.common import PIPE_RADIUS, Q0, random_configurations, spec_with
 from tests.oracles.resolution import eq18, frames, kkt
 
@@ -54,7 +54,6 @@ def compiled(
         damping,
         info,
         out,
-        np.full(work_size(*jac.shape[::-1]), np.nan),  # scratch: nothing read before written
     )
     return int(status), out
 
