@@ -150,6 +150,12 @@ class Limit:
         """The joint velocity (rad/s) applied over the step just taken (a limit that remembers
         motion keeps it; the default forgets it)."""
 
+    @property
+    def observes(self) -> bool:
+        """Whether the limit keeps the velocity it is shown: its class has an :meth:`observe`
+        of its own (the run then shows it every step's)."""
+        return type(self).observe is not Limit.observe
+
     def observed_into(self) -> NDArray[np.float64] | None:
         """Where a run's compiled loop may write the joint velocity (rad/s, (n,)) applied
         over a step instead of calling :meth:`observe` (an array the limit reads), or None:

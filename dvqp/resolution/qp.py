@@ -199,10 +199,7 @@ class QPSolver:
         attempts)."""
         if (self.levels is not None and not self.levels.together) or self.watchers:
             return None
-        strict = self.backends[0]
-        attempt = getattr(strict, "compiled_attempt", None)
-        rows = None if attempt is None else attempt(self.strict)
-        return None if rows is None else self._packed(strict, rows)
+        return self._compiled_attempt(self.backends[0], self.strict)
 
     def relaxed_attempt(self) -> Any:
         """The relaxed backend's packed ``compiled_attempt`` of its next solve (as
@@ -212,10 +209,7 @@ class QPSolver:
         step (:meth:`count_refused`); None when it cannot (as :meth:`fused_attempt`)."""
         if self.levels is not None or self.watchers:
             return None
-        relaxed = self.backends[1]
-        attempt = getattr(relaxed, "compiled_attempt", None)
-        rows = None if attempt is None else attempt(self.relaxed)
-        return None if rows is None else self._packed(relaxed, rows)
+        return self._compiled_attempt(self.backends[1], self.relaxed)
 
     def followed(self) -> None:
         """After a run's compiled loop made the strict backend's attempts (and its cold
@@ -356,7 +350,7 @@ class QPSolver:
             self._pacer = self.factory()
         p = self.scaled
         G = p.G if p.G is not None else np.zeros((0, n + 1))
-        weight = float(self.task_weight)
+        rho = float(self.task_weight)
         load_scaled(
             qp.P,
             qp.cost,
@@ -366,7 +360,7 @@ class QPSolver:
             qp.lb,
             qp.ub,
             v,
-            weight,
+            rho,
             p.P,
             p.q,
             p.A,
@@ -390,9 +384,14 @@ class QPSolver:
         (as :meth:`fused_attempt`)."""
         if self.levels is not None or self.watchers or self._pacer is None or self.scaled is None:
             return None
-        attempt = getattr(self._pacer, "compiled_attempt", None)
-        rows = None if attempt is None else attempt(self.scaled)
-        return None if rows is None else self._packed(self._pacer, rows)
+        return self._compiled_attempt(self._pacer, self.scaled)
+
+    def _compiled_attempt(self, backend: solvers.Backend, problem: solvers.Problem) -> Any:
+        """``backend``'s ``compiled_attempt`` of its next solve of ``problem``, packed; None
+        if it has none (or says None)."""
+        attempt = getattr(backend, "compiled_attempt", None)
+        rows = None if attempt is None else attempt(problem)
+        return None if rows is None else self._packed(backend, rows)
 
     def _scaled_problem(self) -> solvers.Problem:
         """The time-scaled problem's arrays, ``x = [Q̇; σ]`` (filled by :meth:`_slow_down`)."""

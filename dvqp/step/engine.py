@@ -57,7 +57,7 @@ def paced_rows(tool: NDArray[np.int64]) -> tuple[NDArray[np.intp], NDArray[np.in
 
 def observing(limits: tuple[Limit, ...]) -> list[Limit]:
     """The ``limits`` that keep the velocity they are shown (:meth:`Limit.observe`)."""
-    return [limit for limit in limits if type(limit).observe is not Limit.observe]
+    return [limit for limit in limits if limit.observes]
 
 
 def observed_into(observers: list[Limit]) -> Array | None:
@@ -80,10 +80,13 @@ class Made(NamedTuple):
     finish (:meth:`Stepper.resolve_and_move`): the configuration it started from (rad, (n,)),
     when its resolution started (``time.perf_counter``'s s) and the call's values
     (:func:`~dvqp.step.stages.resolve_move`'s, or the baseline's). After the strict
-    problem's cold attempt was refused there, the loop may have made the relaxed problem's
-    attempt too (``relaxed``: its values, :meth:`~dvqp.resolution.qp.QPSolver.
-    relaxed_attempt`) and, that answer taken, evaluated the state it reaches (``moved``:
-    ``(singular, seconds)`` as :func:`~dvqp.step.stages.resolve_move`'s)."""
+    problem's warm attempt was refused there, the loop may have made the cold restart, then
+    the relaxed problem's attempt (``relaxed``: its values, :meth:`~dvqp.resolution.qp.
+    QPSolver.relaxed_attempt`) or the time-scaled one's (``scaled``), and, an answer
+    accepted, evaluated the state it reaches (``moved``: ``(singular, seconds)`` as
+    :func:`~dvqp.step.stages.resolve_move`'s); Python makes the backend's cold restart again
+    from the warm attempt's values (a restart re-forms DAQP's problem from its data alone: the
+    same answer)."""
 
     start: Array
     started: float
