@@ -7,7 +7,8 @@ Usage::
 Every measurement is a fresh Python process with empty caches: ``NUMBA_CACHE_DIR``, ``HOME`` and
 ``XDG_CACHE_HOME`` point at new empty temporary folders, as on a machine that has just
 installed dvqp (whatever a command needs compiles). The "then" rows share the cache of the
-rows before them (what was compiled is loaded). For each command it prints the wall time, the
+rows before them (what was compiled is loaded; the second run compiles the step loop,
+``dvqp.motion.follow.COMPILE``). For each command it prints the wall time, the
 CPU time of the process (user + sys), how many numba functions it compiled, how long its first
 line on stderr took to come (the compile announcement) and the estimate that line gave, and,
 where issue 33/37 set one, the target and whether it is met. Run it with nothing else busy: the
@@ -124,7 +125,12 @@ def main(argv: list[str] | None = None) -> int:
                 env,
             ),
             ("then: dvqp plot", ["plot", trajectory, "-o", str(tmp / "run.png")], env),
-            ("then: dvqp plan (cached)", ["plan", args.scene, "--backend", args.backend], env),
+            (
+                "then: dvqp plan (its step loop compiles)",
+                ["plan", args.scene, "--backend", args.backend],
+                env,
+            ),
+            ("then: dvqp plan (all cached)", ["plan", args.scene, "--backend", args.backend], env),
             ("then: dvqp compare (every backend)", ["compare", args.scene], env),
             (
                 "cold: dvqp compare (README's first command)",

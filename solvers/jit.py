@@ -51,6 +51,8 @@ _ENTRY_SUFFIXES = (".nbi", ".nbc")
 CACHES: list[SoftCache] = []
 """Every cache made by :func:`njit`, in order."""
 
+_COMPILED = [0]  # kernels compiled in this process (not loaded from the cache)
+
 
 _NOTED: set[str] = set()  # the notes given once a process
 
@@ -266,8 +268,13 @@ class KernelDispatcher(CPUDispatcher):  # type: ignore[misc]
                     if args in self._native_only:
                         self._unwrapped.append(self.overloads.pop(args))
                         self._native_only.discard(args)
-        with frame_chunks.kept():  # numba's deep recursion maps no frame chunk a call
-            return super().compile(sig)
+        misses = sum(self._cache_misses.values())
+        try:
+            with frame_chunks.kept():  # numba's deep recursion maps no frame chunk a call
+                return super().compile(sig)
+        finally:
+            if sum(self._cache_misses.values()) > misses:
+                _COMPILED[0] += 1
 
     def add_overload(self, cres: Any) -> None:
         args = tuple(cres.signature.args)
@@ -320,6 +327,32 @@ def njit(
         return dispatcher
 
     return decorate if function is None else decorate(function)
+
+
+def compiled_count() -> int:
+    """The kernels :func:`njit` compiled in this process so far (those loaded from the
+    cache are not counted)."""
+    return _COMPILED[0]
+
+
+def ready(dispatcher: Dispatcher, args: tuple[Any, ...]) -> bool:
+    """Whether a call ``dispatcher(*args)`` from Python runs without compiling: its overload
+    for these arguments' types is compiled in this process, or is loaded now from the cache
+    (as numba's ``Dispatcher.compile`` loads it). Never compiles."""
+    argtypes = tuple(dispatcher.typeof_pyval(a) for a in args)
+    with global_compiler_lock:
+        if argtypes in getattr(dispatcher, "_native_only", ()) or linking.is_native_only():
+            return False  # compiled callers' code only: a Python call compiles its wrapper
+        if argtypes in dispatcher.overloads:
+            return True
+        cres = dispatcher._cache.load_overload(argtypes, dispatcher.targetctx)
+        if cres is None:
+            return False
+        dispatcher._cache_hits[argtypes] += 1
+        if not cres.objectmode:
+            dispatcher.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+        dispatcher.add_overload(cres)
+        return True
 
 
 def entry_files(roots: list[Path]) -> dict[Path, list[Path]]:

@@ -23,9 +23,16 @@ AFTER = 0.1
 nothing; a cold one starts compiling about 2 s after the command starts, most of it
 importing)."""
 
-ESTIMATES = {"plan": 24, "compare": 32, "export-qps": 26, "bench": 33}
+ESTIMATES = {"plan": 23, "compare": 29, "export-qps": 23, "bench": 35}
 """s a first run of each command compiles for on the paper scene (a 2-core machine, quiet:
 ``benchmarks/startup.py``); other commands compile less."""
+
+
+LOOP_MODULE = "dvqp.motion.follow"
+"""The module of a run's step loop, which the run after the first compiles
+(:data:`dvqp.motion.follow.COMPILE`)."""
+LOOP = 3
+"""s the step loop compiles for (``benchmarks/startup.py``'s second runs)."""
 
 
 class _Watch(event.Listener):  # type: ignore[misc]
@@ -35,10 +42,15 @@ class _Watch(event.Listener):  # type: ignore[misc]
 
     def __init__(self) -> None:
         self.depth, self.count, self.busy, self._since = 0, 0, 0.0, 0.0
+        self.first = ""
+        """The module of the first kernel compiled (outermost)."""
 
     def on_start(self, ev: Any) -> None:
         if self.depth == 0:
             self._since = time.perf_counter()
+            if not self.count:
+                dispatcher = ev.data.get("dispatcher")
+                self.first = getattr(getattr(dispatcher, "py_func", None), "__module__", "")
         self.depth += 1
         self.count += 1
 
@@ -65,12 +77,12 @@ def announced(command: str, stream: TextIO | None = None) -> Iterator[None]:
     def announce() -> None:
         while not stop.wait(0.1):
             if watch.elapsed() >= AFTER:
-                print(
-                    f"dvqp: compiling the step's kernels: the first run after installing "
-                    f"only ({about}; cached for later runs)",
-                    file=out,
-                    flush=True,
+                what = (
+                    f"the run's step loop: once, the run after the first (about {LOOP} s"
+                    if watch.first == LOOP_MODULE
+                    else f"the step's kernels: the first run after installing only ({about}"
                 )
+                print(f"dvqp: compiling {what}; cached for later runs)", file=out, flush=True)
                 said.set()
                 return
 

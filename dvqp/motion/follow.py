@@ -48,7 +48,7 @@ from solvers._kkt import MISFIT
 from solvers.accuracy import add_kernel_metrics
 from solvers.clock import now
 from solvers.daqp_c import ACCEPTED, H_CLOCK, RESTART, SOLVED, WARM, attempt, solve_dropped
-from solvers.jit import njit
+from solvers.jit import njit, ready
 
 Array = NDArray[np.float64]
 Index = NDArray[np.int64]
@@ -67,6 +67,14 @@ OPTIMAL, RELAXED, SLOWED = 0, 1, 2
 """The kinds of step the loop takes (``FollowArrays.kinds``)."""
 KINDS = ("optimal", "relaxed", "slowed")
 """Their statuses."""
+COMPILE = "warm"
+"""When a run may compile its loop (:func:`follow`, or :func:`follow_baseline`: 2-3 s
+together with the calls only they make; cached on disk, later runs load it): ``"warm"``, when
+the run's first step compiled nothing (its kernels were loaded from the cache, or compiled by
+an earlier run of the process), so that the first run after installing compiles only what
+its steps need and the next one compiles the loop; ``"always"``; or ``"never"``. A run whose
+loop is neither in the cache nor compiled takes every step in Python: the same run, bit for
+bit, only slower by some microseconds a step."""
 
 
 @dataclass(frozen=True)
@@ -187,6 +195,10 @@ class Follower:
         """The schedule's progress ``u`` at each sample, (B + 1,) (written by the loop and,
         for the steps Python takes, by the run)."""
         self._packed: tuple[FollowArrays, Any] | None = None  # the arrays and their struct
+        self.compiles = COMPILE == "always"
+        """Whether :meth:`run` compiles the loop when the cache does not hold it (set by
+        :meth:`compile`)."""
+        self._runs_for: dict[tuple[Any, ...], bool] = {}  # arguments' types -> verdict
 
     def _struct(self) -> tuple[FollowArrays, Any]:
         """The loop's arrays and their struct (packed again when the recorder has grown or
@@ -237,9 +249,21 @@ class Follower:
         self._packed = (arrays, as_struct(arrays))
         return self._packed
 
-    def compile(self) -> None:
-        """Compile (or load) the loop this run takes, without taking a step."""
+    def compile(self, warm: bool) -> None:
+        """Load the loop this run takes from the cache, or compile it if :data:`COMPILE`
+        allows (``warm``: the run's first step compiled nothing), without taking a step."""
+        self.compiles = COMPILE == "always" or (COMPILE == "warm" and warm)
         self.run(0, 0.0, 0.0, until=0)
+
+    def _runs(self, kernel: Any, args: tuple[Any, ...]) -> bool:
+        """Whether ``kernel(*args)`` runs: loaded or compiled already, loaded from the cache
+        now, or compiled at the call (:attr:`compiles`). Decided once for the arguments'
+        types (a packed struct's numba type; it holds no array, so no run's memory is kept)."""
+        key = (kernel, *(getattr(a, "_numba_type_", None) or type(a) for a in args))
+        runs = self._runs_for.get(key)
+        if runs is None:
+            runs = self._runs_for[key] = self.compiles or ready(kernel, args)
+        return runs
 
     def run(self, k: int, u: float, started: float, until: int | None = None) -> Followed:
         """The common steps from step ``k`` at progress ``u`` (the step starting at
@@ -255,24 +279,33 @@ class Follower:
         arrays, f = self._struct()
         solver = stepper.solver
         if solver is None:
-            out = follow_baseline(stepper.struct, handle, f, k, u, started, stop)
+            kernel, args = follow_baseline, (stepper.struct, handle, f, k, u, started, stop)
+        else:
+            relaxed, pacing = solver.relaxed_attempt(), solver.pacing_attempt()
+            kernel, args = (
+                follow,
+                (
+                    stepper.struct,
+                    handle,
+                    handle if relaxed is None else relaxed,
+                    handle if pacing is None else pacing,
+                    f,
+                    k,
+                    u,
+                    started,
+                    stop,
+                    relaxed is not None,
+                    pacing is not None,
+                ),
+            )
+        if not self._runs(kernel, args):
+            return Followed(k, u, started, None)
+        if solver is None:
+            out = kernel(*args)
         else:
             arrays.log_sums[:] = solver.accuracy.log_sums
             arrays.solves[0] = 0
-            relaxed, pacing = solver.relaxed_attempt(), solver.pacing_attempt()
-            out = follow(
-                stepper.struct,
-                handle,
-                handle if relaxed is None else relaxed,
-                handle if pacing is None else pacing,
-                f,
-                k,
-                u,
-                started,
-                stop,
-                relaxed is not None,
-                pacing is not None,
-            )
+            out = kernel(*args)
             solver.followed()
             solver.accuracy.log_sums = [float(v) for v in arrays.log_sums]
             solver.accuracy.solves += int(arrays.solves[0])

@@ -30,6 +30,7 @@ from dvqp.motion.trajectory import Trajectory
 from dvqp.resolution.step import Resolver
 from dvqp.step import MAX_HALVINGS, Stepper, advance
 from solvers import Problem, Solution
+from solvers.jit import compiled_count
 
 Array = NDArray[np.float64]
 
@@ -162,8 +163,10 @@ def simulate(
     )
     schedule = Schedule(cmd, ref, gain, dt, radius, time_scaling)
     with _noticed(notice):
+        compiled = compiled_count()
         stepper = Stepper(robot, radius, resolver, q_start, dt, obstacles, record.arrays)
-        follower = _compiled(stepper, Follower(stepper, record, schedule, check), q_start)
+        follower = Follower(stepper, record, schedule, check)
+        _compiled(stepper, follower, q_start, compiled)
     if watch is not None and stepper.solver is not None:
         stepper.solver.watchers.append(lambda kind, p, s: watch(record.steps, kind, p, s))
     n, path_time = _follow(stepper, record, schedule, follower, check, max_halvings, progress)
@@ -187,17 +190,18 @@ def simulate(
     return dataclasses.replace(traj, path_time=np.concatenate([path_time, held]))
 
 
-def _compiled(stepper: Stepper, follower: Follower, q0: Array) -> Follower:
+def _compiled(stepper: Stepper, follower: Follower, q0: Array, compiled: int) -> None:
     """Compile (or load) every call of the run's step and loop (a step of its first command,
-    none of the loop), then start afresh from ``q0``."""
+    none of the loop; the loop as :data:`dvqp.motion.follow.COMPILE` says: ``compiled``, the
+    kernels compiled in the process before the run's step was made), then start afresh from
+    ``q0``."""
     stepper.start(q0)
     schedule = follower.schedule
     if schedule.n:
         stepper.resolve(schedule.commands[0], schedule.dt)
-        follower.compile()
+        follower.compile(warm=compiled_count() == compiled)
         stepper.record_at[0] = 0
         stepper.start(q0)
-    return follower
 
 
 def _follow(

@@ -92,9 +92,11 @@ def _cholesky(a: Array, info: Array) -> bool:
     return True
 
 
-@njit(inline="always")
+@njit
 def _solve(factor: Array, x: Array) -> None:
-    """``x = (L Lᵀ)⁻¹ x`` in place, ``factor`` from :func:`_cholesky`."""
+    """``x = (L Lᵀ)⁻¹ x`` in place, ``factor`` from :func:`_cholesky`. Called, not inlined:
+    inlined in its four places it cost :func:`pinv_step` about 0.8 s more to compile, for
+    the same step time."""
     m = factor.shape[0]
     for r in range(m):
         v = x[r]

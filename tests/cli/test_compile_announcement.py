@@ -46,3 +46,22 @@ def test_a_command_that_compiles_nothing_says_nothing(monkeypatch: pytest.Monkey
     with compiling.announced("plan", out):
         time.sleep(0.3)
     assert out.getvalue() == ""
+
+
+def test_the_step_loop_compiled_alone_is_announced_as_such(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The run after the first compiles the step loop alone (dvqp.motion.follow.COMPILE):
+    its line names the loop and its own estimate, not the first run's."""
+    import numpy as np
+
+    monkeypatch.setattr(compiling, "AFTER", 0.01)
+    monkeypatch.setattr(compiling, "LOOP_MODULE", __name__)  # this module's kernel as the loop
+    out = io.StringIO()
+    with compiling.announced("plan", out):
+        _fresh_kernel()(np.ones(3))
+        time.sleep(0.3)
+    lines = out.getvalue().splitlines()
+    assert len(lines) == 2, lines
+    assert lines[0].startswith("dvqp: compiling the run's step loop: once, the run after the")
+    assert f"about {compiling.LOOP} s" in lines[0]

@@ -10,6 +10,8 @@ function, is checked here against the formula written out in NumPy.
 from __future__ import annotations
 
 import dataclasses
+import importlib
+import itertools
 import math
 from typing import Any
 
@@ -39,6 +41,12 @@ SAMPLES = (
     "iterations",
     "substeps",
 )
+
+
+@pytest.fixture(autouse=True)
+def loop_compiles(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each run here compiles its loop (a cold process would leave a first run in Python)."""
+    monkeypatch.setattr(follow, "COMPILE", "always")
 
 
 def planned(name: str, backend: str, loop: bool, **options: Any) -> tuple[Any, list, int]:
@@ -139,6 +147,44 @@ def test_a_recorder_outgrown_inside_the_loop_is_grown_and_the_loop_goes_on() -> 
         slow, _, _ = planned("weld-rush", "daqp", loop=False, stop=False)
     assert taken > 0.5 * fast.n_steps
     assert_same_run(fast, slow)
+
+
+@pytest.mark.parametrize(
+    ("policy", "first_step_compiled", "cached", "looped"),
+    [
+        ("warm", True, False, False),  # the first run after installing: its steps in Python
+        ("warm", False, False, True),  # the next run compiles the loop
+        ("warm", True, True, True),  # a loop in the cache is loaded, whatever compiled
+        ("never", False, False, False),
+        ("never", True, True, True),
+        ("always", True, False, True),
+    ],
+)
+def test_a_run_compiles_its_loop_as_the_policy_says_and_is_the_same_run_either_way(
+    policy: str, first_step_compiled: bool, cached: bool, looped: bool
+) -> None:
+    """:data:`dvqp.motion.follow.COMPILE`: ``"warm"`` compiles the loop in a run whose first
+    step compiled nothing; a loop the cache holds is always taken (``ready``)."""
+    simulate = importlib.import_module("dvqp.motion.simulate")
+    counted = itertools.count(0, 1 if first_step_compiled else 0)
+    asked: list[Any] = []
+
+    def in_cache(kernel: Any, args: tuple[Any, ...]) -> bool:
+        asked.append(kernel)
+        return cached
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(follow, "COMPILE", policy)
+        patch.setattr(simulate, "compiled_count", lambda: next(counted))
+        patch.setattr(follow, "ready", in_cache)
+        run, calls, taken = planned("paper-two-inlets", "daqp", loop=True)
+    assert (taken > 0.5 * run.n_steps) if looped else taken == 0
+    may_compile = policy == "always" or (policy == "warm" and not first_step_compiled)
+    # asked when the loop's arguments change (the relaxed backend set up), not every call
+    assert not asked if may_compile else 1 <= len(asked) <= 3
+    slow, slow_calls, _ = planned("paper-two-inlets", "daqp", loop=False)
+    assert_same_run(run, slow)
+    assert calls == slow_calls
 
 
 class Counting(AccelerationLimit):

@@ -29,6 +29,13 @@ needs_mirror = pytest.mark.skipif(
     not daqp_abi.available(), reason="the installed daqp's layout is not mirrored"
 )
 
+
+@pytest.fixture(autouse=True)
+def loop_compiles(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each run here compiles its loop (a cold process would leave a first run in Python)."""
+    monkeypatch.setattr(follow, "COMPILE", "always")
+
+
 SCENES = ("paper-two-inlets", "probe-into-clamp", "weld-rush", "joint-limit", "reach-priorities")
 
 

@@ -229,13 +229,19 @@ def test_cache_clear_removes_dvqp_entries_only_and_says_how_many(
 
 @pytest.fixture(scope="module")
 def filled(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, str], list[str], str]:
-    """An empty NUMBA_CACHE_DIR filled by one ``dvqp plan`` (compiles for ~30 s of CPU): the
+    """An empty NUMBA_CACHE_DIR filled by ``dvqp plan`` (compiles for ~25 s of CPU), then by
+    the next run, which compiles the step loop alone (dvqp.motion.follow.COMPILE): the
     environment, the command and its output."""
     folder = tmp_path_factory.mktemp("compile-cache")
     env = dict(os.environ, NUMBA_CACHE_DIR=str(folder / "cache"))
     argv = [sys.executable, "-m", "dvqp", "plan", write_scene(folder), "--backend", "pinv"]
     done = subprocess.run(argv, capture_output=True, text=True, env=env, cwd=ROOT, check=False)
     assert done.returncode == 0, done.stderr
+    assert "compiling the step's kernels" in done.stderr
+    loop = subprocess.run(argv, capture_output=True, text=True, env=env, cwd=ROOT, check=False)
+    assert loop.returncode == 0 and stable(loop.stdout) == stable(done.stdout)
+    said = loop.stderr.splitlines()
+    assert len(said) == 2 and said[0].startswith("dvqp: compiling the run's step loop"), said
     return env, argv, done.stdout
 
 
@@ -316,3 +322,25 @@ def test_first_calls_from_many_threads_at_once_all_get_the_answer() -> None:
         kernel = compiled_on_first_call(types.float64(types.float64))(_shifted_double(offset))
         assert _first_calls(kernel, 6) == [2.0 + offset] * 6
         assert len(kernel.overloads) == 1
+
+
+def test_ready_loads_a_cached_kernel_and_never_compiles_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``solvers.jit.ready``: a kernel neither compiled nor cached is not ready (and is not
+    compiled); one compiled in the process is; a fresh dispatcher (as in a new process)
+    loads the cached one and counts no compile (``compiled_count``)."""
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path))
+    fresh = njit(_twice)
+    before = solvers.jit.compiled_count()
+    assert not solvers.jit.ready(fresh, (3.0,))
+    assert not fresh.overloads and solvers.jit.compiled_count() == before
+    assert fresh(3.0) == 6.0
+    assert solvers.jit.compiled_count() == before + 1
+    assert solvers.jit.ready(fresh, (3.0,))
+    again = njit(_twice)
+    assert solvers.jit.ready(again, (3.0,))
+    assert sum(again.stats.cache_hits.values()) == 1 and len(again.overloads) == 1
+    assert again(3.0) == 6.0
+    assert not solvers.jit.ready(again, (3,))  # int64: another overload, not cached
+    assert solvers.jit.compiled_count() == before + 1
