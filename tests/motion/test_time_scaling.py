@@ -50,6 +50,23 @@ def test_a_step_the_limits_cannot_take_at_full_speed_is_slowed_to_the_fastest_th
     assert qp.b[0] == pytest.approx(0.5 + answer.rate * 2.5, abs=1e-12)  # the task it met
 
 
+def test_the_time_scaled_problem_slows_a_step_the_strict_one_takes_at_full_speed() -> None:
+    """Why a slowed streak still tries the strict problem first at each step: the time-scaled
+    problem trades progress for the objective, so its answer is slower than nominal even where
+    the limits allow full speed (here by ``b / (v (2ρ + 1))``: ``½(b − t v)²/2 + ½ρv²t²``
+    least at that ``t = 1 − σ``). Taking it without the strict attempt would slow steps the
+    strict task takes, and a streak would never end."""
+    qp = buffers(1.5)  # feasible at full speed
+    solver = QPSolver(lambda: make_backend("daqp"), qp, task_weight=1e4)
+    solver.feedforward[:] = 1.0
+    answer = solver.solve()
+    assert (answer.status, answer.rate) == ("optimal", 1.0)
+    qp.b[:] = 1.5
+    solution, rate = solver._slow_down()
+    assert solution.found
+    assert rate == pytest.approx(1.0 - 1.5 / (2e4 + 1.0), abs=1e-9) and rate < 1.0
+
+
 def test_a_step_that_cannot_hold_even_at_rest_on_the_path_relaxes_around_rest() -> None:
     qp = buffers(3.5)  # feedback alone (2.5) is past what the bounds allow
     solver = QPSolver(lambda: make_backend("daqp"), qp, task_weight=1e4)
