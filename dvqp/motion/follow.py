@@ -75,6 +75,10 @@ an earlier run of the process), so that the first run after installing compiles 
 its steps need and the next one compiles the loop; ``"always"``; or ``"never"``. A run whose
 loop is neither in the cache nor compiled takes every step in Python: the same run, bit for
 bit, only slower by some microseconds a step."""
+LONG_RUN = 100_000
+"""Steps of a run (its schedule's budget) from which ``"warm"`` compiles the loop even in a
+run that compiled its step: the loop saves 18-34 µs a step on the paper scene (pinv, DAQP),
+more than its 2-3 s of compile over such a run."""
 
 
 @dataclass(frozen=True)
@@ -251,8 +255,10 @@ class Follower:
 
     def compile(self, warm: bool) -> None:
         """Load the loop this run takes from the cache, or compile it if :data:`COMPILE`
-        allows (``warm``: the run's first step compiled nothing), without taking a step."""
-        self.compiles = COMPILE == "always" or (COMPILE == "warm" and warm)
+        allows (``warm``: the run's first step compiled nothing; or the run is long,
+        :data:`LONG_RUN`), without taking a step."""
+        long = self.schedule.budget >= LONG_RUN
+        self.compiles = COMPILE == "always" or (COMPILE == "warm" and (warm or long))
         self.run(0, 0.0, 0.0, until=0)
 
     def _runs(self, kernel: Any, args: tuple[Any, ...]) -> bool:

@@ -150,21 +150,23 @@ def test_a_recorder_outgrown_inside_the_loop_is_grown_and_the_loop_goes_on() -> 
 
 
 @pytest.mark.parametrize(
-    ("policy", "first_step_compiled", "cached", "looped"),
+    ("policy", "first_step_compiled", "cached", "long", "looped"),
     [
-        ("warm", True, False, False),  # the first run after installing: its steps in Python
-        ("warm", False, False, True),  # the next run compiles the loop
-        ("warm", True, True, True),  # a loop in the cache is loaded, whatever compiled
-        ("never", False, False, False),
-        ("never", True, True, True),
-        ("always", True, False, True),
+        ("warm", True, False, False, False),  # the first run after installing: in Python
+        ("warm", False, False, False, True),  # the next run compiles the loop
+        ("warm", True, True, False, True),  # a loop in the cache is loaded, whatever compiled
+        ("warm", True, False, True, True),  # a long run compiles it
+        ("never", False, False, True, False),
+        ("never", True, True, False, True),
+        ("always", True, False, False, True),
     ],
 )
 def test_a_run_compiles_its_loop_as_the_policy_says_and_is_the_same_run_either_way(
-    policy: str, first_step_compiled: bool, cached: bool, looped: bool
+    policy: str, first_step_compiled: bool, cached: bool, long: bool, looped: bool
 ) -> None:
     """:data:`dvqp.motion.follow.COMPILE`: ``"warm"`` compiles the loop in a run whose first
-    step compiled nothing; a loop the cache holds is always taken (``ready``)."""
+    step compiled nothing, or a long one (:data:`~dvqp.motion.follow.LONG_RUN` steps); a loop
+    the cache holds is always taken (``ready``)."""
     simulate = importlib.import_module("dvqp.motion.simulate")
     counted = itertools.count(0, 1 if first_step_compiled else 0)
     asked: list[Any] = []
@@ -177,9 +179,11 @@ def test_a_run_compiles_its_loop_as_the_policy_says_and_is_the_same_run_either_w
         patch.setattr(follow, "COMPILE", policy)
         patch.setattr(simulate, "compiled_count", lambda: next(counted))
         patch.setattr(follow, "ready", in_cache)
+        patch.setattr(follow, "LONG_RUN", 700 if long else 800)  # the run: 760 steps
         run, calls, taken = planned("paper-two-inlets", "daqp", loop=True)
+    assert run.n_steps > 700 and run.brake_start < 800
     assert (taken > 0.5 * run.n_steps) if looped else taken == 0
-    may_compile = policy == "always" or (policy == "warm" and not first_step_compiled)
+    may_compile = policy == "always" or (policy == "warm" and (long or not first_step_compiled))
     # asked when the loop's arguments change (the relaxed backend set up), not every call
     assert not asked if may_compile else 1 <= len(asked) <= 3
     slow, slow_calls, _ = planned("paper-two-inlets", "daqp", loop=False)
