@@ -51,6 +51,7 @@ from scene_benchmark import bracketed
 import dvqp
 import solvers
 from dvqp.kinematics.model import kinematics
+from dvqp.motion import follow
 from dvqp.motion.recorder import TrajectoryRecorder
 from dvqp.resolution.registry import make_resolver
 from dvqp.run.planning import backend_settings
@@ -173,6 +174,18 @@ def stage_times(scene: dvqp.Scene, backend: str, traj: dvqp.Trajectory) -> dict[
     return {k: float(np.median(v)) for k, v in found.items() if v}
 
 
+def without_loop(scene: dvqp.Scene, backend: str, repeat: int) -> float:
+    """The median step (s) of runs whose loop is neither cached nor compiled (a run that
+    compiled its step: :data:`dvqp.motion.follow.COMPILE`), every step from Python."""
+    policy, ready = follow.COMPILE, follow.ready
+    follow.COMPILE, follow.ready = "never", lambda kernel, args: False
+    try:
+        runs = [dvqp.plan(scene, backend) for _ in range(repeat)]
+    finally:
+        follow.COMPILE, follow.ready = policy, ready
+    return float(np.median(np.concatenate([r.step_time[1:] for r in runs])))
+
+
 def paper_rows(repeat: int) -> dict[str, dict[str, float]]:
     """The paper scene's floor and each backend's step and stages (medians, s)."""
     scene = dvqp.load_scene(str(PAPER))
@@ -185,6 +198,7 @@ def paper_rows(repeat: int) -> dict[str, dict[str, float]]:
         solver = np.concatenate([r.solver_time[1:] for r in runs])
         row = stage_times(scene, backend, runs[0])
         row["step"] = float(np.median(step))
+        row["no loop"] = without_loop(scene, backend, repeat)
         if backend == "daqp":
             row["solve"] = float(np.median(solver))
             row["backend layer"] = float(np.median(solve - solver)) - row["QP assembly"]
@@ -220,6 +234,13 @@ def print_paper(rows: dict[str, dict[str, float]]) -> None:
     print(
         f"daqp step {rows['daqp']['step'] / total:.2f}x the floor (target <= 2), "
         f"pinv step {rows['pinv']['step'] / total:.2f}x (target <= 1.5)"
+    )
+    print(
+        "without the loop (a run that compiled its step): "
+        + ", ".join(
+            f"{b} {rows[b]['no loop'] * 1e6:.2f} us ({rows[b]['no loop'] / rows[b]['step']:.2f}x)"
+            for b in ("daqp", "pinv")
+        )
     )
 
 
