@@ -338,7 +338,9 @@ def compiled_count() -> int:
 def ready(dispatcher: Dispatcher, args: tuple[Any, ...]) -> bool:
     """Whether a call ``dispatcher(*args)`` from Python runs without compiling: its overload
     for these arguments' types is compiled in this process, or is loaded now from the cache
-    (as numba's ``Dispatcher.compile`` loads it). Never compiles."""
+    (as numba's ``Dispatcher.compile`` loads it). Never compiles that overload (a separate
+    kernel its cached code calls is compiled if the cache has lost it,
+    :func:`solvers.linking.provide`)."""
     argtypes = tuple(dispatcher.typeof_pyval(a) for a in args)
     with global_compiler_lock:
         if argtypes in getattr(dispatcher, "_native_only", ()) or linking.is_native_only():
