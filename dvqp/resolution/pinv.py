@@ -67,6 +67,10 @@ class PseudoinverseResolver(Resolver):
         super().__init__(spec)
         self.damping = _validate.positive("damping", damping, strict=False)
 
+    def baseline_damping(self) -> float:
+        """:attr:`damping`: the step is the baseline's."""
+        return self.damping
+
 
 @njit
 def _cholesky(a: Array, info: Array) -> bool:

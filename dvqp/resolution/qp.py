@@ -52,6 +52,7 @@ from dvqp.workspace import QPBuffers, as_struct
 from solvers.accuracy import AccuracyTally, kernel_metrics
 from solvers.daqp_c import ACCEPTED, WARM, solve_dropped
 from solvers.jit import njit
+from solvers.rows import RowDropping
 
 #: A watcher of the backend calls: ``(kind, problem, solution)``, kind ``"strict"``,
 #: ``"scaled"`` or ``"relaxed"``.
@@ -105,6 +106,19 @@ class QPResolver(Resolver):
         self.name = backend if isinstance(backend, str) else factory().name
         if isinstance(backend, str):
             factory()  # an unknown name fails here, not in the first step
+
+    def solver(
+        self,
+        qp: QPBuffers,
+        task_weight: float,
+        levels: NDArray[np.int64],
+        row_weights: NDArray[np.float64],
+    ) -> QPSolver:
+        """A :class:`QPSolver` on backends of :attr:`factory`, each handed only the rows of
+        the QP that apply this step (:class:`solvers.rows.RowDropping`: a far obstacle's
+        damper rows cost the solver nothing)."""
+        factory = self.factory
+        return QPSolver(lambda: RowDropping(factory()), qp, task_weight, levels, row_weights)
 
 
 class Taken(NamedTuple):

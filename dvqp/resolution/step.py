@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.resolution.spec import StepSpec
+
+if TYPE_CHECKING:  # the QP resolver's module imports this one
+    from dvqp.resolution.qp import QPSolver
+    from dvqp.workspace import QPBuffers
 
 
 class Step(NamedTuple):
@@ -68,3 +72,20 @@ class Resolver:
 
     def __init__(self, spec: StepSpec) -> None:
         self.spec = spec
+
+    def solver(
+        self,
+        qp: QPBuffers,
+        task_weight: float,
+        levels: NDArray[np.int64],
+        row_weights: NDArray[np.float64],
+    ) -> QPSolver | None:
+        """The QP solver a step of this resolver calls on the step's QP ``qp`` (the tasks'
+        weight ``ρ``, their ``levels`` (L + 1,) and ``row_weights`` (m,)), or None: the step
+        is computed in the step's compiled code (the baseline, :meth:`baseline_damping`)."""
+        return None
+
+    def baseline_damping(self) -> float | None:
+        """The damping ``μ >= 0`` of the baseline's nested inverse if this resolver's step is
+        the baseline's (eq. 18, in the step's compiled code), else None."""
+        return None

@@ -24,7 +24,6 @@ from dvqp.geometry.shapes import Shape
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.damper import DamperArrays
-from dvqp.resolution.pinv import PseudoinverseResolver
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 from dvqp.step.arrays import (
@@ -202,8 +201,9 @@ def _pinv_arrays(resolver: Resolver, weights: np.ndarray, soft: bool, x: np.ndar
     ParameterError
         A damped inverse with soft tasks (``soft``).
     """
-    baseline = isinstance(resolver, PseudoinverseResolver)
-    damping = resolver.damping if isinstance(resolver, PseudoinverseResolver) else 0.0
+    damping = resolver.baseline_damping()
+    baseline = damping is not None
+    damping = 0.0 if damping is None else damping
     if damping > 0.0 and soft:
         raise ParameterError("damping", "the damped inverse takes no soft tasks")
     return PinvArrays(baseline, weights, soft, damping, np.zeros(3), x)

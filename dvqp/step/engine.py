@@ -11,7 +11,7 @@ the common step, split substeps and interior points of a large step
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import replace
 from typing import Any, NamedTuple
 
@@ -25,7 +25,7 @@ from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState, singular_frame
 from dvqp.limits import Bounds, Constraint, Limit, VelocityDamper
 from dvqp.objective import Term
-from dvqp.resolution.qp import Answer, QPResolver, QPSolver
+from dvqp.resolution.qp import Answer, QPSolver
 from dvqp.resolution.spec import unmeetable
 from dvqp.resolution.step import Resolver
 from dvqp.step import stages
@@ -34,15 +34,8 @@ from dvqp.step.build import lay_out
 from dvqp.step.verification import Verification
 from dvqp.workspace import as_struct
 from solvers import clock
-from solvers.rows import RowDropping
 
 Array = NDArray[np.float64]
-
-
-def dropping(factory: Callable[[], solvers.Backend]) -> Callable[[], solvers.Backend]:
-    """``factory``'s backends, each handed only the rows of the QP that apply this step
-    (:class:`solvers.rows.RowDropping`): a far obstacle's damper rows cost the solver nothing."""
-    return lambda: RowDropping(factory())
 
 
 def paced_rows(tool: NDArray[np.int64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
@@ -154,16 +147,8 @@ class Stepper(Verification):
         self.struct = as_struct(self.arrays)
         assert plan.qp is not None and plan.checks is not None
         tasks = self.layout.tasks
-        self.solver = (
-            QPSolver(
-                dropping(resolver.factory),
-                plan.qp,
-                spec.task_weight,
-                tasks.levels,
-                self.layout.row_weights,
-            )
-            if isinstance(resolver, QPResolver)
-            else None
+        self.solver = resolver.solver(
+            plan.qp, spec.task_weight, tasks.levels, self.layout.row_weights
         )
         self.hooks = self.layout.hooks
         self._prepare = stages.prepare_baseline if self.arrays.pinv.baseline else stages.prepare

@@ -31,6 +31,7 @@ from dvqp.limits import (
     SurfaceHeight,
 )
 from dvqp.objective import Objective
+from dvqp.resolution.step import Resolver
 from dvqp.step import advance
 from tests.common import (
     LINK_LENGTHS,
@@ -278,3 +279,48 @@ def test_bounds_that_cross_fail_the_step_and_name_the_joint(robot: Robot) -> Non
 def test_unknown_backend_lists_the_installed_ones(robot: Robot) -> None:
     with pytest.raises(BackendError, match=r"installed: .*daqp"):
         QPResolver(spec_with(np.zeros(13)), "nosuchsolver")
+
+
+class OwnQP(Resolver):
+    """A resolver of its own, no subclass of the built-in ones: its steps call a DAQP
+    :class:`QPSolver` it makes itself (``solver``), and it counts them."""
+
+    name = "own-qp"
+
+    def __init__(self, spec: StepSpec) -> None:
+        super().__init__(spec)
+        self.inner, self.made = QPResolver(spec, "daqp"), 0
+
+    def solver(self, qp, task_weight, levels, row_weights):  # type: ignore[no-untyped-def]
+        self.made += 1
+        return self.inner.solver(qp, task_weight, levels, row_weights)
+
+
+class OwnBaseline(Resolver):
+    """A resolver of its own whose step is the baseline's, damped (``baseline_damping``)."""
+
+    name = "own-baseline"
+    holds_limits = False
+
+    def baseline_damping(self) -> float:
+        return 0.01
+
+
+def test_a_resolver_of_its_own_joins_the_step_through_its_hooks_not_its_type(
+    q0: np.ndarray,
+) -> None:
+    """The step asks a resolver for its QP solver and whether its step is the baseline's: a
+    class that derives from neither built-in resolver runs as the one it delegates to."""
+    robot = limited_robot()
+    spec = paper_spec(robot, objective_with([]), ObstacleSet(), 0.055, margin=0.005)
+    cmd = jog_commands([JogSegment(0.3, np.array([0.0, 0.06, 0.0, 0.0]))], DT)
+    own = OwnQP(spec)
+    pairs = [
+        (own, QPResolver(spec, "daqp")),
+        (OwnBaseline(spec), PseudoinverseResolver(spec, damping=0.01)),
+    ]
+    for mine, builtin in pairs:
+        a, b = (run(robot, PIPE_RADIUS, r, q0, cmd, DT) for r in (mine, builtin))
+        assert a.ok and a.n_steps == b.n_steps > 50
+        np.testing.assert_array_equal(a.q, b.q)
+    assert own.made == 1
