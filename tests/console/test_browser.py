@@ -103,6 +103,11 @@ def test_jog_in_chromium_moves_the_probe_and_saves_a_trajectory(console, tmp_pat
         before, t_before = probe(page), page.inner_text("#st-time")
         page.keyboard.down("ArrowRight")
         page.wait_for_timeout(1000)
+        page.wait_for_function(  # a loaded machine draws fewer frames a second: waits more
+            "(x0) => parseFloat(document.getElementById('dv').dataset.probe) > x0 + 16",
+            arg=before[0],
+            timeout=10_000,
+        )
         page.keyboard.up("ArrowRight")
         page.wait_for_timeout(500)
         after = probe(page)
