@@ -2,16 +2,13 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.resolution.spec import StepSpec
-
-if TYPE_CHECKING:  # the QP resolver's module imports this one
-    from dvqp.resolution.qp import QPSolver
-    from dvqp.workspace import QPBuffers
+from dvqp.workspace import QPBuffers
 
 
 class Step(NamedTuple):
@@ -79,10 +76,11 @@ class Resolver:
         task_weight: float,
         levels: NDArray[np.int64],
         row_weights: NDArray[np.float64],
-    ) -> QPSolver | None:
-        """The QP solver a step of this resolver calls on the step's QP ``qp`` (the tasks'
-        weight ``ρ``, their ``levels`` (L + 1,) and ``row_weights`` (m,)), or None: the step
-        is computed in the step's compiled code (the baseline, :meth:`baseline_damping`)."""
+    ) -> Any:
+        """The :class:`~dvqp.resolution.qp.QPSolver` a step of this resolver calls on the
+        step's QP ``qp`` (the tasks' weight ``ρ``, their ``levels`` (L + 1,) and
+        ``row_weights`` (m,)), or None: the step is computed in the step's compiled code (the
+        baseline, :meth:`baseline_damping`)."""
         return None
 
     def baseline_damping(self) -> float | None:
