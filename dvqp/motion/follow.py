@@ -203,6 +203,9 @@ class Follower:
         """Whether :meth:`run` compiles the loop when the cache does not hold it (set by
         :meth:`compile`)."""
         self._runs_for: dict[tuple[Any, ...], bool] = {}  # arguments' types -> verdict
+        self.off = False
+        """The loop is not taken in this run (neither cached nor compiled): :meth:`run` returns
+        at once, every step is Python's."""
 
     def _struct(self) -> tuple[FollowArrays, Any]:
         """The loop's arrays and their struct (packed again when the recorder has grown or
@@ -269,6 +272,7 @@ class Follower:
         runs = self._runs_for.get(key)
         if runs is None:
             runs = self._runs_for[key] = self.compiles or ready(kernel, args)
+        self.off = not runs  # nothing this run does compiles it later
         return runs
 
     def run(self, k: int, u: float, started: float, until: int | None = None) -> Followed:
@@ -277,7 +281,7 @@ class Follower:
         steps or step ``until``; each recorded and counted. The step after them, made, is
         handed over when it is not common."""
         stepper, record, schedule = self.stepper, self.record, self.schedule
-        handle = stepper.fused()
+        handle = None if self.off else stepper.fused()
         if handle is None:
             return Followed(k, u, started, None)
         room = min(schedule.budget, record.arrays["qdot"].shape[0], k + BATCH)

@@ -191,15 +191,23 @@ def simulate(
 
 
 def _compiled(stepper: Stepper, follower: Follower, q0: Array, compiled: int) -> None:
-    """Compile (or load) every call of the run's step and loop (a step of its first command,
-    none of the loop; the loop as :data:`dvqp.motion.follow.COMPILE` says: ``compiled``, the
-    kernels compiled in the process before the run's step was made), then start afresh from
-    ``q0``."""
+    """Compile (or load) every call of the run's step and loop (a step of its first command
+    resolved, none of the loop; the loop as :data:`dvqp.motion.follow.COMPILE` says:
+    ``compiled``, the kernels compiled in the process before the run's step was made), and the
+    calls a step taken in Python makes (the schedule's command, the step resolved and moved in
+    one call, the relaxed problem's copy), so that no step's time holds a compile; then start
+    afresh from ``q0``."""
     stepper.start(q0)
     schedule = follower.schedule
     if schedule.n:
-        stepper.resolve(schedule.commands[0], schedule.dt)
+        command, dt = schedule.commands[0], schedule.dt
+        stepper.resolve(command, dt)
         follower.compile(warm=compiled_count() == compiled)
+        schedule.command(0.0, stepper.state.tool)  # and the calls of a step taken in Python
+        stepper.record_at[0] = -1
+        stepper.resolve_and_move(command, dt)
+        if stepper.solver is not None:
+            stepper.solver.load_fallbacks()
         stepper.record_at[0] = 0
         stepper.start(q0)
 

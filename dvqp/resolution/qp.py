@@ -225,6 +225,12 @@ class QPSolver:
             return None
         return self._compiled_attempt(self.backends[1], self.relaxed)
 
+    def load_fallbacks(self) -> None:
+        """Load the relaxed problem from this step's QP (:func:`load_relaxed`, as a refused step
+        does; each refused step loads it anew): its copy compiled (or loaded) before a run's
+        first refused step, not in that step's time."""
+        load_relaxed(self.qp, self.relaxed)
+
     def followed(self) -> None:
         """After a run's compiled loop made the strict backend's attempts (and its cold
         restarts, :func:`dvqp.motion.follow.follow`): the backend takes the warm state the

@@ -9,6 +9,7 @@ statuses, iterations, refusals and accuracy, on scenes with refused strict probl
 
 from __future__ import annotations
 
+import importlib
 from typing import Any
 
 import numpy as np
@@ -25,6 +26,7 @@ pytest.importorskip("daqp")
 from solvers import daqp_abi
 from solvers.daqp_c import solve_dropped
 
+simulation = importlib.import_module("dvqp.motion.simulate")  # the package exports the function
 needs_mirror = pytest.mark.skipif(
     not daqp_abi.available(), reason="the installed daqp's layout is not mirrored"
 )
@@ -46,8 +48,16 @@ def run(scene: dvqp.Scene, monkeypatch: pytest.MonkeyPatch, mode: str) -> tuple[
     :mod:`dvqp.motion.follow`: counted as the steps it took, and the steps it hands over);
     ``"step"`` one compiled call a step (:func:`dvqp.step.stages.resolve_move` from Python,
     the loop turned off; counted with the resolver's own compiled attempts); ``"solve"``
-    every call the backend's ``solve`` (a watcher of the backend calls turns both off)."""
+    every call the backend's ``solve`` (a watcher of the backend calls turns both off).
+    Counted from the run's first step: the calls of the run's compile before it are not the
+    run's (nor shown to its watcher)."""
     made = 0
+    compiled = simulation._compiled
+
+    def from_first_step(*args: Any) -> None:
+        nonlocal made
+        compiled(*args)
+        made = 0
 
     def counted(kernel: Any) -> Any:
         def call(*args: Any) -> Any:
@@ -70,6 +80,7 @@ def run(scene: dvqp.Scene, monkeypatch: pytest.MonkeyPatch, mode: str) -> tuple[
         patch.setattr(qp, "solve_dropped", counted(solve_dropped))
         patch.setattr(stages, "resolve_move", counted(stages.resolve_move))
         patch.setattr(follow, "follow", looped(follow.follow))
+        patch.setattr(simulation, "_compiled", from_first_step)
         if mode != "loop":
             patch.setattr(Stepper, "fused", lambda self: None)
         watch = (lambda step, kind, problem, solution: None) if mode == "solve" else None
