@@ -77,8 +77,8 @@ loop is neither in the cache nor compiled takes every step in Python: the same r
 bit, only slower by some microseconds a step."""
 LONG_RUN = 100_000
 """Steps of a run (its schedule's budget) from which ``"warm"`` compiles the loop even in a
-run that compiled its step: the loop saves about 24-44 µs a step on the paper scene (pinv,
-DAQP: ``benchmarks/floor.py``), more than its 2-3 s of compile over such a run."""
+run that compiled its step: the loop saves about 17-33 µs a step on the paper scene (pinv,
+DAQP: ``benchmarks/floor.py``), about its 2-3 s of compile over such a run."""
 
 
 @dataclass(frozen=True)
