@@ -207,7 +207,7 @@ def _compiled(stepper: Stepper, follower: Follower, q0: Array, compiled: int) ->
         stepper.record_at[0] = -1
         stepper.resolve_and_move(command, dt)
         if stepper.solver is not None:
-            stepper.solver.load_fallbacks()
+            stepper.solver.load_relaxed_problem()
         stepper.record_at[0] = 0
         stepper.start(q0)
 

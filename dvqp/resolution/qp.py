@@ -225,10 +225,10 @@ class QPSolver:
             return None
         return self._compiled_attempt(self.backends[1], self.relaxed)
 
-    def load_fallbacks(self) -> None:
-        """Load the relaxed problem from this step's QP (:func:`load_relaxed`, as a refused step
-        does; each refused step loads it anew): its copy compiled (or loaded) before a run's
-        first refused step, not in that step's time."""
+    def load_relaxed_problem(self) -> None:
+        """Load the relaxed problem from this step's QP (:func:`load_relaxed`, as a relaxed step
+        does; each relaxed step loads it anew): its copy compiled (or loaded) before a run's
+        first relaxed step, not in that step's time."""
         load_relaxed(self.qp, self.relaxed)
 
     def followed(self) -> None:
