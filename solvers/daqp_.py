@@ -78,6 +78,7 @@ EXIT_FLAGS = {
     -5: "nonconvex",
     -6: "overdetermined_initial",
     -7: "timelimit",
+    daqp_c.CERTIFIED: "infeasible (certified)",  # no solve: see DaqpBackend.refutes
 }
 
 _SENSE_EQUALITY = 5
@@ -98,6 +99,17 @@ class DaqpBackend(StatefulBackend):
     default_tolerance: ClassVar[float] = 1e-6
     default_settings: ClassVar[dict[str, Any]] = {"primal_tol": 1e-8}
     restarts: ClassVar[bool] = True
+    refutes: bool = True
+    """Whether a cold restart after a refusal (in DAQP's C functions) first tries the
+    multipliers its workspace holds as a certificate that the problem admits no acceptable
+    answer (:func:`solvers.farkas.refuted`, at :attr:`tolerance`): proved, it is refused
+    without a solve (exit flag :data:`~solvers.daqp_c.CERTIFIED`, status ``"infeasible
+    (certified)"``, 0 iterations). DAQP writes no multipliers when it finds a problem
+    infeasible: they are the last answer's, or those a caller held there for the next
+    restart (:func:`~solvers.daqp_c.hold_multipliers`: a relaxed problem's answer proves the
+    strict one infeasible in most steps of a relaxed streak). A refusal so proved is the one
+    the solve would have ended in (no answer could pass the check): the answers are the same
+    with or without it (False: every restart solves)."""
 
     def __init__(self, *, tolerance: float | None = None, **settings: Any) -> None:
         super().__init__(tolerance=tolerance, **settings)
@@ -296,7 +308,7 @@ class DaqpBackend(StatefulBackend):
             if self._c_args is None:
                 self._c_args = (*self._stack[:9], work.handles, work.words, *self._layout)
             try:
-                out = daqp_c.solve_stacked(*self._c_args, mode, x, lam)
+                out = daqp_c.solve_stacked(*self._c_args, mode, self._refute(), x, lam)
             except TypeError:  # arrays the compiled copy refuses: NumPy copies this problem
                 self._stack = None
         if self._stack is None:
@@ -320,6 +332,7 @@ class DaqpBackend(StatefulBackend):
                 ms,
                 flags,
                 mode,
+                self._refute(),
                 x,
                 lam,
             )  # the set-up's own buffers: the compiled copy onto themselves changes nothing
@@ -342,7 +355,8 @@ class DaqpBackend(StatefulBackend):
             return None
         if not self._warm and self._structure is None:  # a new set-up: solve
             return None
-        if self._attempt_call is None or self._attempt_call.tolerance != self.tolerance:
+        call = self._attempt_call
+        if call is None or (call.tolerance, call.refute) != (self.tolerance, self._refute()):
             given = self._stack[:8]
             if not all(a.flags.writeable or a.size == 0 for a in given):
                 return None
@@ -360,6 +374,7 @@ class DaqpBackend(StatefulBackend):
                 flags,
                 np.zeros(1, dtype=np.int64),
                 self.tolerance,
+                self._refute(),
                 work.x,
                 work.lam,
             )
@@ -393,6 +408,11 @@ class DaqpBackend(StatefulBackend):
         answer."""
         if self._attempt_call is not None:
             self._warm = bool(self._attempt_call.mode[0] == daqp_c.WARM)
+
+    def _refute(self) -> float:
+        """:func:`~solvers.daqp_c.stacked_solve`'s ``refute``: the tolerance at which a
+        restart tries the last refusal's multipliers (:attr:`refutes`), else -1."""
+        return self.tolerance if self.refutes else -1.0
 
     def refusal_of(self, flag: float) -> str:
         """The refusal (:func:`solvers.refusal.refusal`) a refused answer with DAQP's exit
@@ -430,7 +450,7 @@ class DaqpBackend(StatefulBackend):
         solver_time: float,
     ) -> Solution:
         y, z, box = self._cuts
-        return judged(
+        solution = judged(
             problem,
             values,
             x,
@@ -443,3 +463,9 @@ class DaqpBackend(StatefulBackend):
             iterations,
             solver_time,
         )
+        if flag == daqp_c.CERTIFIED:
+            solution.message = (
+                "the multipliers held by the solver prove that no answer passes the check "
+                f"at tolerance {self.tolerance:g} (nothing solved)"
+            )
+        return solution

@@ -20,7 +20,7 @@ from numba import types
 from numba.core.extending import intrinsic
 
 from ._fast import stack_into
-from ._kkt import MISFITTING, _readonly, stacked_values
+from ._kkt import HAS_LB, HAS_UB, MISFITTING, _readonly, stacked_values
 from .clock import now
 from .daqp_abi import (
     _QP_SENSE,
@@ -37,6 +37,7 @@ from .daqp_abi import (
     H_UPDATE,
     H_WORK,
 )
+from .farkas import refuted
 from .jit import compiled_on_first_call, njit
 from .residuals import accepts
 from .rows import compact, resized
@@ -51,6 +52,12 @@ constraints' states DAQP holds); ``RESTART``, start afresh from the set-up's ``s
 caller); ``AS_SET_UP``, solve the data as the set-up left it (no copy, no update)."""
 MISFITTED, UPDATE_FAILED, SOLVED, ACCEPTED = 0.0, 1.0, 2.0, 3.0
 """Stages of :func:`stacked_solve`'s values (and :func:`solve_dropped`'s: ``ACCEPTED``)."""
+CERTIFIED = -101
+"""The exit flag of a cold restart refused without a solve: the multipliers in ``lam`` prove
+that no answer can pass the check (:func:`solvers.farkas.refuted`). DAQP's own flags are -7
+to 2."""
+_NO_ANSWER = (0.0,) + (math.nan,) * 7
+"""The check's values of a certified refusal: no ``x`` (code 0: not finite)."""
 
 
 @intrinsic
@@ -125,6 +132,7 @@ def stacked_solve(
     ms: int,
     flags: int,
     mode: int,
+    refute: float,
     x: np.ndarray,
     lam: np.ndarray,
 ) -> tuple[float, ...]:
@@ -135,15 +143,21 @@ def stacked_solve(
     ``handles`` and ``words`` are a :class:`~solvers.daqp_abi.Workspace`'s ``handles`` and
     the words behind its problem and result; ``mode`` holds the bits :data:`RESTART`,
     :data:`REFACTOR` and :data:`AS_SET_UP` (none: warm, from the working set of the last
-    solve).
+    solve). A cold restart with ``refute`` ≥ 0 (the check's tolerance; negative: never)
+    first tries the multipliers ``lam`` holds (those :func:`hold_multipliers` put there, or
+    the last ones DAQP wrote: it writes none when it finds a problem infeasible) as a
+    certificate that the new data admits no answer within that tolerance
+    (:func:`solvers.farkas.refuted`): if they prove it, nothing is solved, ``x`` is NaN,
+    ``lam`` is kept (the next restart tries it again) and the flag is :data:`CERTIFIED`.
 
     Returns
     -------
     tuple of 12 floats
         ``(stage, flag, iterations, seconds, *values)``: stage :data:`MISFITTED` a size
         misfits (nothing done), :data:`UPDATE_FAILED` (``flag`` its exit flag), or
-        :data:`SOLVED` (``flag`` DAQP's exit flag); ``seconds`` inside DAQP's update and
-        solve; ``values`` those of :func:`solvers._kkt.stacked_values` (NaN unless solved).
+        :data:`SOLVED` (``flag`` DAQP's exit flag, or :data:`CERTIFIED` with 0 iterations and
+        code 0 values); ``seconds`` inside DAQP's update and solve; ``values`` those of
+        :func:`solvers._kkt.stacked_values` (NaN unless solved).
     """
     nan = math.nan
     rows = ms + p + m
@@ -152,6 +166,12 @@ def stacked_solve(
     changed = 0 if mode & AS_SET_UP else stack_into(P, q, A, b, G, h, lb, ub, data, n, p, m, ms)
     if changed < 0:
         return (MISFITTED, nan, nan, 0.0, *MISFITTING)
+    restart = (mode & RESTART) != 0 and (mode & AS_SET_UP) == 0
+    box = (flags & HAS_LB) != 0, (flags & HAS_UB) != 0
+    if restart and refute >= 0.0 and refuted(data, lam, n, p, m, ms, box[0], box[1], refute):
+        for i in range(n):
+            x[i] = nan
+        return (SOLVED, float(CERTIFIED), 0.0, 0.0, *_NO_ANSWER)
     work, problem, result = handles[H_WORK], handles[H_PROBLEM], handles[H_RESULT]
     started = now(handles[H_CLOCK])
     if not mode & AS_SET_UP:
@@ -186,6 +206,7 @@ def stacked_solve(
         _WORDS,
         _WORDS,
         *(types.int64,) * 6,
+        types.float64,
         _VEC_OUT,
         _VEC_OUT,
     )
@@ -208,12 +229,13 @@ def solve_stacked(
     ms: int,
     flags: int,
     mode: int,
+    refute: float,
     x: np.ndarray,
     lam: np.ndarray,
 ) -> tuple[float, ...]:
     """:func:`stacked_solve`, compiled for its one signature, called from Python."""
     return stacked_solve(
-        P, q, A, b, G, h, lb, ub, data, handles, words, n, p, m, ms, flags, mode, x, lam
+        P, q, A, b, G, h, lb, ub, data, handles, words, n, p, m, ms, flags, mode, refute, x, lam
     )
 
 
@@ -223,7 +245,9 @@ class AttemptCall:
     problem's arrays (``P`` .. ``ub``, absent blocks as empty arrays), the set-up's ``data``,
     ``handles`` and ``words``, its sizes and ``flags`` (:func:`stacked_solve`'s), the
     attempt's ``mode`` ((1,): :data:`WARM` or :data:`RESTART`), the check's ``tolerance``
-    (:func:`solvers.residuals.accepts`), and buffers for the answer
+    (:func:`solvers.residuals.accepts`), ``refute`` (:func:`stacked_solve`'s: the tolerance at
+    which a restart tries the multipliers in ``lam`` as a certificate; negative: never),
+    and buffers for the answer
     ``x`` (n,) and ``lam`` (ms + p + m,). Valid
     while its backend keeps the set-up and the problem it was made for
     (:meth:`solvers.daqp_.DaqpBackend.compiled_attempt`)."""
@@ -246,6 +270,7 @@ class AttemptCall:
     flags: int
     mode: np.ndarray
     tolerance: float
+    refute: float
     x: np.ndarray
     lam: np.ndarray
 
@@ -298,9 +323,39 @@ def attempt(c):  # type: ignore[no-untyped-def]
         c.ms,
         c.flags,
         c.mode[0],
+        c.refute,
         c.x,
         c.lam,
     )
     if out[0] == SOLVED and accepts(out[4:], c.tolerance):
         return (ACCEPTED, *out[1:])
     return out
+
+
+@njit(separate=True)  # compiled callers only (dvqp's step loop)
+def hold_multipliers(source, target) -> None:  # type: ignore[no-untyped-def]
+    """The multipliers of ``source``'s last answer held in ``target``'s ``lam``, where
+    ``target``'s next cold restart tries them as a certificate that its problem admits no
+    answer (:func:`stacked_solve`, ``refute``): ``source`` and ``target`` are packed
+    :class:`~solvers.rows.AttemptRows` (their ``call`` an :class:`AttemptCall`) of two problems
+    whose equality rows and inequality rows are the same, row for row (e.g. a task relaxed with
+    slack columns, and the task strict). Each inequality row's multiplier moves from its slot
+    in ``source``'s copy to its slot in ``target``'s (0 where ``source`` has none), the
+    equality rows' as they are; the bounds' are left (the certificate does not read them).
+    Nothing is held if the equality rows differ in number.
+
+    (DAQP leaves ``lam`` as it was when it finds a problem infeasible: without this, a restart
+    tries the multipliers of the last accepted answer.)"""
+    s, t = source.call, target.call
+    if s.m != t.m:
+        return
+    for slot in range(t.p):
+        row = target.row_of[slot]
+        held = 0.0
+        if row >= 0:
+            at = source.slot_of[row]
+            if 0 <= at < s.p:
+                held = s.lam[s.ms + at]
+        t.lam[t.ms + slot] = held
+    for i in range(t.m):
+        t.lam[t.ms + t.p + i] = s.lam[s.ms + s.p + i]

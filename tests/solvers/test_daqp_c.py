@@ -23,10 +23,19 @@ from tests.solvers.test_daqp_fast import FIELDS, Drift
 
 daqp = pytest.importorskip("daqp")
 from solvers import daqp_abi  # noqa: E402  (after the skip: it reads daqp's version)
+from solvers.daqp_ import DaqpBackend  # noqa: E402
 
 needs_mirror = pytest.mark.skipif(
     not daqp_abi.available(), reason="the installed daqp's layout is not mirrored"
 )
+
+
+@pytest.fixture(autouse=True)
+def restarts_solve(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every restart solves: ``daqp.Model`` has no compiled restart, so it cannot prove a
+    refusal from held multipliers without a solve as the C way may
+    (``DaqpBackend.refutes``, tested in ``tests/solvers/test_farkas.py``)."""
+    monkeypatch.setattr(DaqpBackend, "refutes", False)
 
 
 @pytest.fixture

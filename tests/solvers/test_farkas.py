@@ -1,0 +1,145 @@
+"""Refusals proved from the problem data (``solvers.farkas``) and DAQP's restarts that use them.
+
+The law: multipliers never prove a problem infeasible when some ``x`` passes the residual
+check (whatever the multipliers); and a ray of an infeasible problem proves it, unless the
+problem is feasible within the check's tolerance.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from solvers import make_backend
+from solvers._fast import stack
+from solvers.farkas import refuted
+from tests.solvers.test_daqp_fast import Drift
+
+TAU = 1e-6
+
+
+def stacked(A, b, G, h, lb, ub):  # type: ignore[no-untyped-def]
+    """The problem's constraints laid out as DAQP's stacked copy (P = I, q = 0)."""
+    n, m, p = lb.shape[0], b.shape[0], h.shape[0]
+    rows = n + p + m
+    data = np.zeros(n * (n + 1 + p + m) + 2 * rows)
+    data[n * (n + 1 + p + m) + rows + n :] = -np.inf  # lower of the G rows: none
+    A = np.ascontiguousarray(A.reshape(m, n))
+    G = np.ascontiguousarray(G.reshape(p, n))
+    assert stack(np.eye(n), np.zeros(n), A, b, G, h, lb, ub, data, n, p, m, n) >= 0
+    return data, n, p, m
+
+
+def proves(lam_y, lam_z, A, b, G, h, lb, ub, tolerance=TAU):  # type: ignore[no-untyped-def]
+    """Whether ``y``, ``z`` prove the constraints infeasible at ``tolerance``."""
+    data, n, p, m = stacked(A, b, G, h, lb, ub)
+    lam = np.concatenate([np.zeros(n), lam_z, lam_y])
+    return bool(refuted(data, lam, n, p, m, n, True, True, tolerance))
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n=st.integers(1, 6),
+    m=st.integers(0, 4),
+    p=st.integers(0, 5),
+    scale=st.sampled_from([1e-8, 1.0, 1e6]),
+)
+def test_no_multipliers_prove_infeasible_constraints_that_an_answer_meets(
+    seed: int, n: int, m: int, p: int, scale: float
+) -> None:
+    """``x0`` meets every row within the tolerance (off by up to τ): whatever ``y``, ``z``
+    (any sign, any size, rays of a nearby infeasible problem), no proof."""
+    rng = np.random.default_rng(seed)
+    lb, ub = -rng.uniform(0, 2, n), rng.uniform(0, 2, n)
+    x0 = rng.uniform(lb, ub)
+    A, G = rng.standard_normal((m, n)), rng.standard_normal((p, n))
+    b = A @ x0 + rng.uniform(-TAU, TAU, m) * 0.999
+    h = G @ x0 - rng.uniform(-1.0, TAU, p) * 0.999
+    h[rng.random(p) < 0.2] = np.inf
+    for _ in range(20):
+        y, z = scale * rng.standard_normal(m), scale * rng.standard_normal(p)
+        assert not proves(y, z, A, b, G, h, lb, ub)
+        assert not proves(y, np.abs(z), A, b, G, h, lb, ub)
+
+
+def test_a_ray_proves_a_row_the_box_cannot_meet() -> None:
+    """``x0 + x1 = b`` in the box [0, 1]²: ``y = −1`` proves it beyond ``2 + 2τ``, not
+    within (``x = 1 + τ`` meets it within τ), and ``y = +1`` proves nothing."""
+    A, G, h = np.ones((1, 2)), np.zeros((0, 2)), np.zeros(0)
+    lb, ub, none = np.zeros(2), np.ones(2), np.zeros(0)
+    assert proves(np.array([-1.0]), none, A, np.array([3.0]), G, h, lb, ub)
+    assert not proves(np.array([1.0]), none, A, np.array([3.0]), G, h, lb, ub)
+    assert proves(np.array([-2.5]), none, A, np.array([2.0 + 3.5 * TAU]), G, h, lb, ub)
+    assert not proves(np.array([-1.0]), none, A, np.array([2.0 + 2.5 * TAU]), G, h, lb, ub)
+    assert not proves(np.array([-1.0]), none, A, np.array([3.0]), G, h, lb, ub, tolerance=0.4)
+
+
+def test_a_one_sided_row_proves_only_with_a_positive_multiplier_and_a_finite_bound() -> None:
+    """``x0 ≤ −1`` against ``x0 ≥ 0``: ``z = 1`` proves it; ``z = −1`` is of the wrong sign,
+    and a row without a bound (``h = +inf``) takes no part, whatever its multiplier."""
+    A, b, lb, ub = np.zeros((0, 2)), np.zeros(0), np.zeros(2), np.ones(2)
+    G, none = np.array([[1.0, 0.0], [0.0, 1.0]]), np.zeros(0)
+    h = np.array([-1.0, np.inf])
+    assert proves(none, np.array([1.0, 0.0]), A, b, G, h, lb, ub)
+    assert proves(none, np.array([1.0, 5.0]), A, b, G, h, lb, ub)
+    assert not proves(none, np.array([-1.0, 0.0]), A, b, G, h, lb, ub)
+    assert not proves(none, np.array([0.0, 1.0]), A, b, G, h, lb, ub)
+
+
+def test_an_unbounded_variable_that_the_multipliers_weigh_proves_nothing() -> None:
+    data, n, p, m = stacked(
+        np.zeros((0, 1)), np.zeros(0), np.ones((1, 1)), np.array([-1.0]), np.zeros(1), np.ones(1)
+    )
+    lam = np.array([0.0, 1.0])
+    assert refuted(data, lam, n, p, m, n, True, True, TAU)
+    assert not refuted(data, lam, n, p, m, n, False, True, TAU)  # no lower bound: x0 → −inf
+    assert not refuted(data, lam, n, p, m, 0, False, False, TAU)
+
+
+def infeasible(ws: Drift, by: float) -> None:
+    """``x0`` kept below its own lower bound by ``by`` (row 0 of G)."""
+    ws.G[0] = 0.0
+    ws.G[0, 0], ws.h[0] = 1.0, ws.lb[0] - by
+
+
+def test_a_restart_whose_held_multipliers_prove_its_problem_infeasible_solves_nothing() -> None:
+    """DAQP leaves ``lam`` as it was when it finds a problem infeasible; a ray held there
+    (row 0 against ``x0``'s lower bound) proves the next such problem infeasible: nothing
+    solved, 0 iterations, its own status and message, no answer. A feasible problem after it
+    is solved as by a backend that never tries the held multipliers, bitwise."""
+    pytest.importorskip("daqp")
+    proving, solving = make_backend("daqp"), make_backend("daqp")
+    solving.refutes = False
+    sides = Drift(seed=8), Drift(seed=8)
+    for backend, ws in zip((proving, solving), sides, strict=True):
+        backend.solve(ws.problem).require()
+        infeasible(ws, 0.5)
+        assert backend.solve(ws.problem).status == "infeasible"
+    if proving._c is None:
+        pytest.skip("the installed daqp's layout is not mirrored: no compiled restart")
+    lam, ms = proving._c.lam, proving._layout[3]
+    lam[:] = 0.0
+    lam[ms] = 2.0  # z of row 0: x0 <= lb0 - 0.5 against lb0 <= x0
+    held = lam.copy()
+    for ws in sides:
+        ws.move(0.001)
+        infeasible(ws, 0.5)
+    proved, solved = proving.solve(sides[0].problem), solving.solve(sides[1].problem)
+    assert not proved.found and not solved.found
+    assert proved.status == "infeasible (certified)" and proved.iterations == 0
+    assert proved.refusal == solved.refusal == "infeasible" and solved.iterations > 0
+    assert "prove that no answer passes the check" in proved.message
+    assert proved.y is None and proved.z is None
+    np.testing.assert_array_equal(lam, held)  # kept: the next restart tries it again
+    for ws in sides:
+        ws.move(0.001)
+        ws.h[0] = np.inf
+    after, want = proving.solve(sides[0].problem), solving.solve(sides[1].problem)
+    assert after.found and want.found and after.iterations == want.iterations
+    np.testing.assert_array_equal(after.x, want.x)
+    fresh = make_backend("daqp")
+    fresh.refutes = False
+    assert fresh.solve(sides[0].fresh()).iterations == after.iterations
