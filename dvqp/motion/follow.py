@@ -4,7 +4,11 @@ Most steps of a run are common: the command of the schedule, the strict QP's war
 accepted (or the baseline's step), the state reached regular and within every verified limit,
 its largest joint motion below :data:`~dvqp.step.JOINT_STRIDE` (no interior point to check).
 So is a step of a relaxed streak at fixed timing: the strict problem's cold attempt refused
-(the backend restarts cold after a refusal), the relaxed problem's warm attempt accepted.
+(the backend restarts cold after a refusal), the relaxed problem's warm attempt accepted. The
+relaxed (or time-scaled) answer's multipliers are held in the strict backend's workspace
+(:func:`solvers.daqp_c.hold_multipliers`), where the next step's cold attempt tries them
+first as a proof that its strict problem admits no answer (:mod:`solvers.farkas`): proved,
+that refusal solves nothing. Python's steps hold none; either way the refusals are the same.
 :func:`follow` runs such steps one after another in compiled code, each exactly as
 :func:`dvqp.step.advance` and :meth:`~dvqp.resolution.qp.QPSolver.solve` would (the same
 compiled calls, :func:`~dvqp.step.stages.resolve_move`, :func:`~dvqp.motion.schedule.
@@ -47,7 +51,16 @@ from dvqp.workspace import as_struct
 from solvers._kkt import MISFIT
 from solvers.accuracy import add_kernel_metrics
 from solvers.clock import now
-from solvers.daqp_c import ACCEPTED, H_CLOCK, RESTART, SOLVED, WARM, attempt, solve_dropped
+from solvers.daqp_c import (
+    ACCEPTED,
+    H_CLOCK,
+    RESTART,
+    SOLVED,
+    WARM,
+    attempt,
+    hold_multipliers,
+    solve_dropped,
+)
 from solvers.jit import njit, ready
 
 Array = NDArray[np.float64]
@@ -559,7 +572,8 @@ def follow(s, w, r, p, f, k, u, started, until, relaxing, pacing):  # type: igno
 def _refused(s, w, r, p, f, k, out, relaxing, pacing):  # type: ignore[no-untyped-def]
     """Step ``k`` whose strict attempt (``out``, :func:`~dvqp.step.stages.resolve_move`'s) was
     refused or a cold one: restarted cold if it was warm (the backend's ``after_warm``),
-    then, still refused, slowed if paced, else relaxed, and moved. Returns ``(kind,
+    then, still refused, slowed if paced, else relaxed (the answer's multipliers held for the
+    next strict restart), and moved. Returns ``(kind,
     iterations, solver_time, rate)`` of the step taken, its kind −1 (with ``b`` as it was)
     when it cannot be taken here."""
     clock, mode, qp = w.call.handles[H_CLOCK], w.call.mode, s.qp
@@ -581,6 +595,8 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing):  # type: ignore[no-untype
         if not pacing:
             return (-1, 0, 0.0, 0.0)
         again = _slow(s, f, p)
+        if again[0] == ACCEPTED:  # its multipliers: the next strict restart's proof to try
+            hold_multipliers(p, w)
         if again[0] != ACCEPTED or p.call.mode[0] != WARM:
             return (-1, 0, 0.0, 0.0)
         rate = min(max(p.call.x[s.x.shape[0]], 0.0), 1.0)
@@ -596,6 +612,8 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing):  # type: ignore[no-untype
     if not relaxing:  # relaxed, at fixed timing
         return (-1, 0, 0.0, 0.0)
     again = _relax(s, f, r)
+    if again[0] == ACCEPTED:
+        hold_multipliers(r, w)
     if again[0] != ACCEPTED or r.call.mode[0] != WARM or not _move(s, f, r.call.x, clock):
         return (-1, 0, 0.0, 0.0)
     add_kernel_metrics(f.log_sums, again[4:12])
