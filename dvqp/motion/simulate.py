@@ -196,7 +196,8 @@ def _compiled(stepper: Stepper, follower: Follower, q0: Array, compiled: int) ->
     ``compiled``, the kernels compiled in the process before the run's step was made), and the
     calls a step taken in Python makes (the schedule's command, the step resolved and moved in
     one call, the relaxed problem's copy), so that no step's time holds a compile; then start
-    afresh from ``q0``."""
+    afresh from ``q0``, the relaxed problem's backend set up on that step's relaxed problem
+    (:meth:`~dvqp.resolution.qp.QPSolver.set_up_relaxed`: no step's time holds a set-up)."""
     stepper.start(q0)
     schedule = follower.schedule
     if schedule.n:
@@ -210,6 +211,8 @@ def _compiled(stepper: Stepper, follower: Follower, q0: Array, compiled: int) ->
             stepper.solver.load_relaxed_problem()
         stepper.record_at[0] = 0
         stepper.start(q0)
+        if stepper.solver is not None:  # on that step's relaxed problem (start resets it)
+            stepper.solver.set_up_relaxed()
 
 
 def _follow(

@@ -134,7 +134,9 @@ def test_the_last_braking_step_is_the_qp_answer_of_its_problem_exactly() -> None
         answers.append((origin, solvers.make_backend("clarabel").solve(p).x))
     (before, x_before), (last, x_last) = answers
     assert not before and np.abs(x_before - traj.qdot[moving]).max() < 1e-5
-    assert last and np.abs(x_last).max() < 1e-7 and not traj.qdot[-1].any()
+    # to its tolerance: an interior point keeps off a bound that lies at 0 (a run may end with
+    # a joint's bound within 1e-15 of it, Clarabel's answer then 3.5e-6 inside it)
+    assert last and np.abs(x_last).max() < 1e-5 and not traj.qdot[-1].any()
 
 
 def test_a_stop_longer_than_the_room_reserved_grows_the_record() -> None:
