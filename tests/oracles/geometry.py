@@ -319,6 +319,36 @@ def inlet_points(
     return sign * d, sign[:, None] * off / np.maximum(d, 1e-300)[:, None]
 
 
+def inlet_nearest_normals(
+    center: Array, r: float, big: float, point: Array, period: float, within: float = 1e-9
+) -> list[Array]:
+    """Every unit normal ``±(p − c)/‖p − c‖`` of the point ``p`` at an outline point ``c`` as
+    near as the nearest to within ``within`` (m): one where one outline point is nearest, two
+    (or more) on the region's medial axis, where the distance has a kink and either side's
+    normal is its gradient. Each local least of the grid is refined by golden section."""
+    p = np.asarray(point, dtype=np.float64) - center
+    p[0] = wrap(p[0], period)
+    h = 2 * np.pi / INLET_GRID
+    grid = np.arange(INLET_GRID) * h
+    sq = ((_inlet_curve(grid, r, big) - p) ** 2).sum(axis=-1)
+    least = (sq <= np.roll(sq, 1)) & (sq <= np.roll(sq, -1))
+    g = (math.sqrt(5) - 1) / 2
+    found = []
+    for phi in grid[least]:
+        lo, hi = phi - h, phi + h
+        for _ in range(64):
+            x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+            d1 = ((_inlet_curve(x1, r, big) - p) ** 2).sum()
+            d2 = ((_inlet_curve(x2, r, big) - p) ** 2).sum()
+            hi, lo = (x2, lo) if d1 < d2 else (hi, x1)
+        off = p - _inlet_curve(0.5 * (lo + hi), r, big)
+        found.append((math.sqrt((off**2).sum()), off))
+    best = min(d for d, _ in found)
+    inside = abs(p[0]) < 0.5 * np.pi * big and (big * np.sin(p[0] / big)) ** 2 + p[1] ** 2 < r * r
+    sign = -1.0 if inside else 1.0
+    return [sign * off / max(d, 1e-300) for d, off in found if d <= best + within]
+
+
 def inlet_segments(
     center: Array, r: float, big: float, a: Array, b: Array, period: float
 ) -> tuple[Array, Array, Array]:

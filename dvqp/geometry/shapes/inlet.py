@@ -130,29 +130,28 @@ def _curve(phi, r, big):  # type: ignore[no-untyped-def]
     return big * math.asin(k), r * s, dl1, r * c, dl2, -r * s
 
 
-@njit(inline="always")
-def _slope(phi, pl, pz, r, big):  # type: ignore[no-untyped-def]
-    """``(½ D', ½ D'')`` of ``D(φ) = ‖c(φ) − p‖²``."""
-    dl, dz, l1, z1, l2, z2 = _curve(phi, r, big)
-    ol, oz = dl - pl, dz - pz
-    return ol * l1 + oz * z1, l1 * l1 + z1 * z1 + ol * l2 + oz * z2
-
-
 @njit
 def _nearest(pl, pz, r, big, x, lo, hi):  # type: ignore[no-untyped-def]
-    """The ``φ`` in ``(lo, hi)`` where ``D' = 0``, by Newton's method from ``x``; ``nan`` if a
-    step would leave the bracket or ``D'' ≤ 0`` (then :func:`_golden` searches it)."""
+    """``(φ, Δl, Δz, Δl', Δz')``: the ``φ`` in ``(lo, hi)`` where ``D' = 0``, by Newton's
+    method from ``x``, and the outline there; ``φ`` is ``nan`` if a step would leave the
+    bracket or ``D'' ≤ 0`` (then :func:`_golden` searches it). The outline at the last step's
+    end is its Taylor polynomial of first order from where the step was computed (an error
+    of ``~step²``, below 1e-20 m: the step is below 1e-10 rad), not one more evaluation."""
+    nan = math.nan
     for _ in range(NEWTON_STEPS):
-        f, fp = _slope(x, pl, pz, r, big)
+        dl, dz, l1, z1, l2, z2 = _curve(x, r, big)
+        ol, oz = dl - pl, dz - pz
+        f, fp = ol * l1 + oz * z1, l1 * l1 + z1 * z1 + ol * l2 + oz * z2  # ½ D', ½ D''
         if not fp > 0.0:
-            return math.nan
+            return nan, nan, nan, nan, nan
         step = f / fp
         x -= step
         if not lo < x < hi:
-            return math.nan
+            return nan, nan, nan, nan, nan
         if abs(step) < 1e-10:
-            return x
-    return x
+            return x, dl - step * l1, dz - step * z1, l1 - step * l2, z1 - step * z2
+    dl, dz, l1, z1, _, _ = _curve(x, r, big)
+    return x, dl, dz, l1, z1
 
 
 @njit
@@ -189,10 +188,10 @@ def inlet_point(pl, pz, r, big, sl, sz):  # type: ignore[no-untyped-def]
         if here <= before and here <= after:
             curve = before - 2.0 * here + after  # Newton from the samples' parabola's vertex
             guess = k * h + (0.5 * h * (before - after) / curve if curve > 0.0 else 0.0)
-            x = _nearest(pl, pz, r, big, guess, (k - 1) * h, (k + 1) * h)
+            x, cl, cz, cl1, cz1 = _nearest(pl, pz, r, big, guess, (k - 1) * h, (k + 1) * h)
             if x != x:  # nan: no clean Newton's step
                 x = _golden(pl, pz, r, big, (k - 1) * h, (k + 1) * h)
-            cl, cz, cl1, cz1, _, _ = _curve(x, r, big)
+                cl, cz, cl1, cz1, _, _ = _curve(x, r, big)
             d2 = (cl - pl) ** 2 + (cz - pz) ** 2
             if d2 < best:
                 best, phi, dl, dz, l1, z1 = d2, x, cl, cz, cl1, cz1
