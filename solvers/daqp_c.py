@@ -332,6 +332,16 @@ def attempt(c):  # type: ignore[no-untyped-def]
     return out
 
 
+@njit(inline="always")
+def proves(c) -> bool:  # type: ignore[no-untyped-def]
+    """Whether the multipliers in the packed :class:`AttemptCall` ``c``'s ``lam`` prove the
+    problem its ``data`` holds (as an attempt copied it) infeasible at its ``refute``
+    tolerance (:func:`solvers.farkas.refuted`; never if negative): what its next restart
+    finds before it solves."""
+    lower, upper = (c.flags & HAS_LB) != 0, (c.flags & HAS_UB) != 0
+    return c.refute >= 0.0 and refuted(c.data, c.lam, c.n, c.p, c.m, c.ms, lower, upper, c.refute)
+
+
 @njit(separate=True)  # compiled callers only (dvqp's step loop)
 def hold_multipliers(source, target) -> None:  # type: ignore[no-untyped-def]
     """The multipliers of ``source``'s last answer held in ``target``'s ``lam``, where

@@ -35,6 +35,7 @@ from dvqp.motion.recorder import TrajectoryRecorder
 from dvqp.motion.schedule import Schedule, ScheduleArrays, command_into
 from dvqp.resolution.levels import load_columns
 from dvqp.resolution.qp import load_scaled
+from dvqp.resolution.ray import ray_constants
 from dvqp.step import JOINT_STRIDE, Stepper
 from dvqp.step.engine import Made
 from dvqp.step.stages import (
@@ -53,12 +54,14 @@ from solvers.accuracy import add_kernel_metrics
 from solvers.clock import now
 from solvers.daqp_c import (
     ACCEPTED,
+    CERTIFIED,
     H_CLOCK,
     RESTART,
     SOLVED,
     WARM,
     attempt,
     hold_multipliers,
+    proves,
     solve_dropped,
 )
 from solvers.jit import njit, ready
@@ -108,7 +111,9 @@ class FollowArrays:
     problem's ``feedforward`` (m,; size 0 for the baseline) and the rows and command
     components it paces (:meth:`dvqp.step.Stepper.pace`); the relaxed problem's arrays
     (``relaxed_P`` .. ``relaxed_ub``; size 0 for the baseline), the time-scaled problem's
-    (``scaled_P`` .. ``scaled_ub``; size 0 before a step was first slowed), the tasks'
+    (``scaled_P`` .. ``scaled_ub``; size 0 before a step was first slowed), the
+    least-violation problem's (``ray_P`` .. ``ray_ub``, :mod:`dvqp.resolution.ray`; size 0
+    without it) and what its ``Q̇`` block holds (``ray_eye``, ``ray_zero``), the tasks'
     weight ``ρ`` and room to keep ``b`` (m,) while a slowed step is tried; where the velocity is
     observed (``observed`` (n,), size 0: nowhere); the accuracy tally's ``log_sums`` (3,)
     and ``solves`` (1,) counted here; ``start`` (n,) the configuration the last step started
@@ -147,6 +152,14 @@ class FollowArrays:
     scaled_G: Array
     scaled_lb: Array
     scaled_ub: Array
+    ray_P: Array
+    ray_q: Array
+    ray_A: Array
+    ray_G: Array
+    ray_lb: Array
+    ray_ub: Array
+    ray_eye: Array
+    ray_zero: Array
     task_weight: float
     saved_b: Array
     observed: Array
@@ -191,6 +204,12 @@ def _problem(problem: Any, with_b: bool) -> tuple[Array, ...]:
     G = problem.G if problem.G is not None else np.zeros((0, problem.P.shape[0]))
     b = (problem.b,) if with_b else ()
     return (problem.P, problem.q, problem.A, *b, G, problem.lb, problem.ub)
+
+
+def _ray_constants(ray: Any, n: int) -> tuple[Array, Array]:
+    """The least-violation problem's ``Q̇`` block (:func:`dvqp.resolution.ray.ray_constants`),
+    of size 0 without the problem."""
+    return (np.zeros((0, 0)), np.zeros(0)) if ray is None else ray_constants(n)
 
 
 class Follower:
@@ -252,6 +271,8 @@ class Follower:
             components.astype(np.int64),
             *_problem(None if solver is None else solver.relaxed, with_b=False),
             *_problem(scaled, with_b=True),
+            *_problem(None if solver is None else solver.ray, with_b=False),
+            *_ray_constants(None if solver is None else solver.ray, self.stepper.robot.n),
             0.0 if solver is None else float(solver.task_weight),
             np.zeros(0) if solver is None else np.zeros_like(solver.feedforward),
             np.zeros(0) if self.stepper.observed is None else self.stepper.observed,
@@ -305,6 +326,7 @@ class Follower:
             kernel, args = follow_baseline, (stepper.struct, handle, f, k, u, started, stop)
         else:
             relaxed, pacing = solver.relaxed_attempt(), solver.pacing_attempt()
+            ray = solver.ray_attempt()
             kernel, args = (
                 follow,
                 (
@@ -319,6 +341,8 @@ class Follower:
                     stop,
                     relaxed is not None,
                     pacing is not None,
+                    handle if ray is None else ray,
+                    ray is not None,
                 ),
             )
         if not self._runs(kernel, args):
@@ -506,14 +530,15 @@ def _slow(s, f, p):  # type: ignore[no-untyped-def]
 
 
 @njit
-def follow(s, w, r, p, f, k, u, started, until, relaxing, pacing):  # type: ignore[no-untyped-def]
+def follow(s, w, r, p, f, k, u, started, until, relaxing, pacing, e, proving):  # type: ignore[no-untyped-def]
     """A QP run's common steps from step ``k`` at progress ``u`` (the step starting at
     ``started``, s of ``time.perf_counter``'s clock), on the step's struct ``s``, the strict
     backend's packed attempt ``w`` (:meth:`~dvqp.resolution.qp.QPSolver.fused_attempt`), the
     relaxed backend's ``r`` (:meth:`~dvqp.resolution.qp.QPSolver.relaxed_attempt`; used if
     ``relaxing``), the time-scaled problem's ``p`` (:meth:`~dvqp.resolution.qp.QPSolver.
-    pacing_attempt`; used if ``pacing``) and the loop's arrays ``f`` (:class:`FollowArrays`),
-    up to step ``until`` (excluded).
+    pacing_attempt`; used if ``pacing``), the least-violation problem's ``e``
+    (:meth:`~dvqp.resolution.qp.QPSolver.ray_attempt`; used if ``proving``) and the loop's
+    arrays ``f`` (:class:`FollowArrays`), up to step ``until`` (excluded).
 
     Each step's strict problem is solved as :meth:`~dvqp.resolution.qp.QPSolver.solve` and
     its backend solve it: the warm attempt, and if it is refused the cold restart (the
@@ -553,7 +578,9 @@ def follow(s, w, r, p, f, k, u, started, until, relaxing, pacing):  # type: igno
             if out[0] != ATTEMPTED or not _checked(out[3:15]):
                 return _handed(f, out, k, u, started, begun)
             _handed(f, out, k, u, started, begun)  # what Python finishes if it must
-            kind, iterations, solver_time, rate = _refused(s, w, r, p, f, k, out, relaxing, pacing)
+            kind, iterations, solver_time, rate = _refused(
+                s, w, r, p, f, k, out, relaxing, pacing, e, proving
+            )
             if kind < 0:
                 mode[0] = first
                 return (HANDED, float(k), u, started, begun)
@@ -569,20 +596,29 @@ def follow(s, w, r, p, f, k, u, started, until, relaxing, pacing):  # type: igno
 
 
 @njit(separate=True)  # compiled once, called by symbol: the loop stays small to compile
-def _refused(s, w, r, p, f, k, out, relaxing, pacing):  # type: ignore[no-untyped-def]
+def _refused(s, w, r, p, f, k, out, relaxing, pacing, e, proving):  # type: ignore[no-untyped-def]
     """Step ``k`` whose strict attempt (``out``, :func:`~dvqp.step.stages.resolve_move`'s) was
     refused or a cold one: restarted cold if it was warm (the backend's ``after_warm``),
-    then, still refused, slowed if paced, else relaxed (the answer's multipliers held for the
-    next strict restart), and moved. Returns ``(kind,
+    then, still refused, slowed if paced, else relaxed, and moved. A proof that the strict
+    problem admits no answer is held for the strict restarts (:func:`solvers.daqp_c.
+    hold_multipliers`): when the multipliers held do not prove this step's, the
+    least-violation problem's (``e``, if ``proving``: before the cold restart, which they may
+    then spare, or after a refused one), else the relaxed or time-scaled answer's. Returns
+    ``(kind,
     iterations, solver_time, rate)`` of the step taken, its kind −1 (with ``b`` as it was)
     when it cannot be taken here."""
     clock, mode, qp = w.call.handles[H_CLOCK], w.call.mode, s.qp
-    answer, warm = out[3:15], 0.0
+    answer, warm, tried = out[3:15], 0.0, False
     if mode[0] == WARM:  # the cold restart; its time counts the warm attempt's too
         mode[0] = RESTART
-        answer, warm = attempt(w.call), out[6]
+        if proving and not proves(w.call):  # a proof for the restart to try first
+            warm, tried = _prove(s, f, e, w), True
+        answer = attempt(w.call)
+        warm += out[6]
         if not _checked(answer):
             return (-1, 0, 0.0, 0.0)
+    if proving and not tried and answer[0] != ACCEPTED and answer[1] != CERTIFIED:
+        warm += _prove(s, f, e, w)  # the refusal was solved: a proof for the next steps
     solver_time = answer[3] + warm
     if answer[0] == ACCEPTED:  # the strict answer, cold
         mode[0] = WARM
@@ -595,7 +631,7 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing):  # type: ignore[no-untype
         if not pacing:
             return (-1, 0, 0.0, 0.0)
         again = _slow(s, f, p)
-        if again[0] == ACCEPTED:  # its multipliers: the next strict restart's proof to try
+        if again[0] == ACCEPTED and not proving:  # the next strict restart's proof to try
             hold_multipliers(p, w)
         if again[0] != ACCEPTED or p.call.mode[0] != WARM:
             return (-1, 0, 0.0, 0.0)
@@ -612,12 +648,39 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing):  # type: ignore[no-untype
     if not relaxing:  # relaxed, at fixed timing
         return (-1, 0, 0.0, 0.0)
     again = _relax(s, f, r)
-    if again[0] == ACCEPTED:
+    if again[0] == ACCEPTED and not proving:
         hold_multipliers(r, w)
     if again[0] != ACCEPTED or r.call.mode[0] != WARM or not _move(s, f, r.call.x, clock):
         return (-1, 0, 0.0, 0.0)
     add_kernel_metrics(f.log_sums, again[4:12])
     return (RELAXED, int(again[2]), solver_time + again[3], 1.0)
+
+
+@njit(inline="always")
+def _prove(s, f, e, w):  # type: ignore[no-untyped-def]
+    """The least-violation problem loaded (its ``Q̇`` block ``ε I``, no cost:
+    :mod:`dvqp.resolution.ray`) and its first attempt made (``e``); its answer's multipliers,
+    if accepted, held in the strict backend's workspace (``w``), where its restarts try them
+    as a proof (:func:`solvers.daqp_c.hold_multipliers`). Returns the seconds inside DAQP."""
+    qp = s.qp
+    load_columns(
+        f.ray_eye,
+        f.ray_zero,
+        qp.A,
+        qp.G,
+        qp.lb,
+        qp.ub,
+        f.ray_P,
+        f.ray_q,
+        f.ray_A,
+        f.ray_G,
+        f.ray_lb,
+        f.ray_ub,
+    )
+    again = solve_dropped(e)
+    if again[0] == ACCEPTED:
+        hold_multipliers(e, w)
+    return again[3] if again[0] >= 0.0 else 0.0
 
 
 @njit

@@ -196,8 +196,9 @@ def _compiled(stepper: Stepper, follower: Follower, q0: Array, compiled: int) ->
     ``compiled``, the kernels compiled in the process before the run's step was made), and the
     calls a step taken in Python makes (the schedule's command, the step resolved and moved in
     one call, the relaxed problem's copy), so that no step's time holds a compile; then start
-    afresh from ``q0``, the relaxed problem's backend set up on that step's relaxed problem
-    (:meth:`~dvqp.resolution.qp.QPSolver.set_up_relaxed`: no step's time holds a set-up)."""
+    afresh from ``q0``, the relaxed and least-violation problems' backends set up on that
+    step's problems (:meth:`~dvqp.resolution.qp.QPSolver.set_up_fallbacks`: no step's time
+    holds a set-up)."""
     stepper.start(q0)
     schedule = follower.schedule
     if schedule.n:
@@ -212,7 +213,7 @@ def _compiled(stepper: Stepper, follower: Follower, q0: Array, compiled: int) ->
         stepper.record_at[0] = 0
         stepper.start(q0)
         if stepper.solver is not None:  # on that step's relaxed problem (start resets it)
-            stepper.solver.set_up_relaxed()
+            stepper.solver.set_up_fallbacks()
 
 
 def _follow(

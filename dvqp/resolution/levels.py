@@ -94,13 +94,16 @@ def relaxed_problem(
     )
 
 
-def load_relaxed(qp: QPBuffers, problem: solvers.Problem) -> None:
+def load_relaxed(
+    qp: QPBuffers, problem: solvers.Problem, P: Array | None = None, cost: Array | None = None
+) -> None:
     """Copy this step's cost, task rows, constraints and bounds into ``problem``'s ``Q̇``
-    columns (a :func:`relaxed_problem`; :func:`load_columns`)."""
+    columns (a :func:`relaxed_problem`; :func:`load_columns`); ``P`` (n, n) and ``cost``
+    (n,) in place of the step's (e.g. :func:`dvqp.resolution.ray.ray_constants`)."""
     G = problem.G if problem.G is not None else np.zeros((0, problem.P.shape[0]))
     load_columns(
-        qp.P,
-        qp.cost,
+        qp.P if P is None else P,
+        qp.cost if cost is None else cost,
         qp.A,
         qp.G,
         qp.lb,

@@ -46,6 +46,7 @@ from dvqp.resolution.levels import (
     relaxed_problem,
     strict_problem,
 )
+from dvqp.resolution.ray import ray_constants, ray_problem
 from dvqp.resolution.spec import StepSpec
 from dvqp.resolution.step import Resolver
 from dvqp.workspace import QPBuffers, as_struct
@@ -184,6 +185,10 @@ class QPSolver:
             else None
         )
         """The levels of a step with hard tasks at several priorities (None: one level)."""
+        self.ray = None if self.levels is not None else ray_problem(qp)
+        """The strict task's least violation (:mod:`dvqp.resolution.ray`), whose multipliers a
+        run's compiled loop holds to prove strict refusals (None with levels)."""
+        self._prover = None if self.ray is None else factory()
         self.feedforward = np.zeros(m)
         """The hard tasks' nominal motion this step, in their units per s, shape (m,): part
         of ``b``; when it is not zero, a step whose strict problem has no accepted answer slows
@@ -231,14 +236,29 @@ class QPSolver:
         first relaxed step, not in that step's time."""
         load_relaxed(self.qp, self.relaxed)
 
-    def set_up_relaxed(self) -> None:
+    def set_up_fallbacks(self) -> None:
         """Set the relaxed problem's backend up on the relaxed problem as it is loaded
-        (:meth:`load_relaxed_problem`), before a run's steps: its first relaxed step is then a
-        warm attempt that the run's compiled loop makes (:meth:`relaxed_attempt`), not a
-        set-up in Python (0.7-1 ms). Neither counted nor watched: not a step's call. Levels
-        relax each of their own problems: nothing then."""
-        if self.levels is None:
-            self.backends[1].solve(self.relaxed)
+        (:meth:`load_relaxed_problem`), and the least-violation problem's on that step's rows
+        (:mod:`dvqp.resolution.ray`), before a run's steps: a run's first relaxed step is then
+        a warm attempt that its compiled loop makes (:meth:`relaxed_attempt`), not a set-up in
+        Python (0.7-1 ms), and the loop can prove strict refusals (:meth:`ray_attempt`).
+        Neither counted nor watched: no step's calls. Levels relax each of their own problems:
+        nothing then."""
+        if self.ray is None or self._prover is None:
+            return
+        self.backends[1].solve(self.relaxed)
+        eye, zero = ray_constants(self.qp.cost.shape[0])
+        load_relaxed(self.qp, self.ray, eye, zero)
+        self._prover.solve(self.ray)
+
+    def ray_attempt(self) -> Any:
+        """The least-violation problem's backend's packed ``compiled_attempt`` (as
+        :meth:`relaxed_attempt`'s), for a run's compiled loop that proves strict refusals with
+        its multipliers (:func:`dvqp.motion.follow.follow`); None when it cannot (as
+        :meth:`fused_attempt`, or before :meth:`set_up_fallbacks`)."""
+        if self.ray is None or self._prover is None or self.watchers:
+            return None
+        return self._compiled_attempt(self._prover, self.ray)
 
     def followed(self) -> None:
         """After a run's compiled loop made the strict backend's attempts (and its cold
@@ -452,7 +472,7 @@ class QPSolver:
         self.refusals.clear()
         self.accuracy = AccuracyTally()
         self._packs.clear()
-        for backend in (*self.backends, self._pacer):
+        for backend in (*self.backends, self._pacer, self._prover):
             if backend is not None:
                 backend.reset()
         if self.levels is not None:

@@ -7,6 +7,8 @@ problem is feasible within the check's tolerance.
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -15,6 +17,7 @@ from hypothesis import strategies as st
 from solvers import make_backend
 from solvers._fast import stack
 from solvers.farkas import refuted
+from tests.oracles.farkas import gap
 from tests.solvers.test_daqp_fast import Drift
 
 TAU = 1e-6
@@ -63,6 +66,39 @@ def test_no_multipliers_prove_infeasible_constraints_that_an_answer_meets(
         y, z = scale * rng.standard_normal(m), scale * rng.standard_normal(p)
         assert not proves(y, z, A, b, G, h, lb, ub)
         assert not proves(y, np.abs(z), A, b, G, h, lb, ub)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n=st.integers(1, 6),
+    m=st.integers(0, 4),
+    p=st.integers(0, 5),
+    apart=st.floats(-1.0, 1.0),
+)
+def test_the_proof_is_the_inequality_written_out(
+    seed: int, n: int, m: int, p: int, apart: float
+) -> None:
+    """Constraints made for multipliers ``y``, ``z`` to stand ``apart`` (relative) from a proof
+    (positive: a proof): the compiled check says what the NumPy oracle's inequality says,
+    wherever the two sides are not within rounding of each other."""
+    rng = np.random.default_rng(seed)
+    A, G = rng.standard_normal((m, n)), rng.standard_normal((p, n))
+    y, z = rng.standard_normal(m), np.abs(rng.standard_normal(p))
+    z[rng.random(p) < 0.2] = 0.0
+    lb, ub = -rng.uniform(0, 2, n), rng.uniform(0, 2, n)
+    h = rng.standard_normal(p)
+    b = rng.standard_normal(m)
+    v = A.T @ y + G.T @ z
+    least = np.where(v > 0, v * lb, v * ub).sum()
+    if m and np.abs(y).max() > 1e-3:  # b moved along y: yᵀb = L − zᵀh − apart·scale
+        scale = np.abs(v).sum() * 2 + np.abs(y).sum() + np.abs(z).sum() + 1.0
+        b += (least - z @ h - apart * scale - y @ b) * y / (y @ y)
+    problem = SimpleNamespace(A=A, b=b, G=G, h=h, lb=lb, ub=ub)
+    ratio = gap(problem, y, z, TAU)
+    if not abs(ratio) > 1e-9:  # within rounding of a proof (or NaN): either answer is right
+        return
+    assert proves(y, z, A, b, G, h, lb, ub) == (ratio > 0)
 
 
 def test_a_ray_proves_a_row_the_box_cannot_meet() -> None:
