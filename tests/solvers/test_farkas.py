@@ -54,7 +54,7 @@ def test_no_multipliers_prove_infeasible_constraints_that_an_answer_meets(
     seed: int, n: int, m: int, p: int, scale: float
 ) -> None:
     """``x0`` meets every row within the tolerance (off by up to τ): whatever ``y``, ``z``
-    (any sign, any size, rays of a nearby infeasible problem), no proof."""
+    (random, of either sign, of sizes from 1e-8 to 1e6), no proof."""
     rng = np.random.default_rng(seed)
     lb, ub = -rng.uniform(0, 2, n), rng.uniform(0, 2, n)
     x0 = rng.uniform(lb, ub)
