@@ -102,24 +102,24 @@ class FollowArrays:
     """What :func:`follow` reads and writes besides the step's own arrays.
 
     ``schedule`` the run's commands; the recorder's per-step arrays (N steps, n joints, L
-    levels: ``solve_time``, ``solver_time``, ``step_time``, ``task_error`` (N,) s and task
-    units per s, ``level_error`` (N, L), ``iterations`` (N,), ``substeps`` (N,), ``success``
-    (N,), ``qdot`` (N, n) rad/s); each step's ``kinds`` (N,: :data:`OPTIMAL`,
-    :data:`RELAXED`, :data:`SLOWED`) and such a step's strict refusal, its exit ``flags``
-    (N,);
-    ``progress`` (B + 1,): the schedule's progress ``u`` at each sample; the strict
-    problem's ``feedforward`` (m,; size 0 for the baseline) and the rows and command
-    components it paces (:meth:`dvqp.step.Stepper.pace`); the relaxed problem's arrays
-    (``relaxed_P`` .. ``relaxed_ub``; size 0 for the baseline), the time-scaled problem's
-    (``scaled_P`` .. ``scaled_ub``; size 0 before a step was first slowed), the
-    least-violation problem's (``ray_P`` .. ``ray_ub``, :mod:`dvqp.resolution.ray`; size 0
-    without it) and what its ``Q̇`` block holds (``ray_eye``, ``ray_zero``), the tasks'
-    weight ``ρ`` and room to keep ``b`` (m,) while a slowed step is tried; where the velocity is
-    observed (``observed`` (n,), size 0: nowhere); the accuracy tally's ``log_sums`` (3,)
-    and ``solves`` (1,) counted here; ``start`` (n,) the configuration the last step started
-    from, ``made`` (15,) its compiled call's values, ``relaxed_made`` (12,) its relaxed
-    attempt's and ``scaled_made`` (12,) its time-scaled one's (NaN: none), ``moved`` (2,)
-    its move's; ``nominal`` (4,) scratch;
+    levels: ``solve_time``, ``solver_time``, ``step_time``, ``task_error`` (N,) s and task units
+    per s, ``level_error`` (N, L), ``iterations`` (N,), ``substeps`` (N,), ``success`` (N,),
+    ``qdot`` (N, n) rad/s); each step's ``kinds`` (N,: :data:`OPTIMAL`, :data:`RELAXED`,
+    :data:`SLOWED`) and such a step's strict refusal, its exit ``flags`` (N,); ``progress``
+    (B + 1,): the schedule's progress ``u`` at each sample; the strict problem's
+    ``feedforward`` (m,; size 0 for the baseline) and the rows and command components it paces
+    (:meth:`dvqp.step.Stepper.pace`); the relaxed problem's arrays (``relaxed_P`` ..
+    ``relaxed_ub``; size 0 for the baseline), the time-scaled problem's (``scaled_P`` ..
+    ``scaled_ub``; size 0 before a step was first slowed), the least-violation problem's
+    (``ray_P`` .. ``ray_ub``, :mod:`dvqp.resolution.ray`; size 0 without it) and what its ``Q̇``
+    block holds (``ray_eye``, ``ray_zero``), the tasks' weight ``ρ``, the right sides levels
+    hold (``held``, (m,): :attr:`~dvqp.resolution.levels.Levels.fixed`, the ``b`` of their last
+    level's relaxed problem, which the loop relaxes to; size 0 without levels) and room to keep
+    ``b`` (m,) while a slowed step is tried; where the velocity is observed (``observed`` (n,),
+    size 0: nowhere); the accuracy tally's ``log_sums`` (3,) and ``solves`` (1,) counted here;
+    ``start`` (n,) the configuration the last step started from, ``made`` (15,) its compiled
+    call's values, ``relaxed_made`` (12,) its relaxed attempt's and ``scaled_made`` (12,) its
+    time-scaled one's (NaN: none), ``moved`` (2,) its move's; ``nominal`` (4,) scratch;
     ``verify`` (check every limit) and ``stride`` (rad, the largest joint motion of a step
     checked at its end only)."""
 
@@ -161,6 +161,7 @@ class FollowArrays:
     ray_eye: Array
     ray_zero: Array
     task_weight: float
+    held: Array
     saved_b: Array
     observed: Array
     log_sums: Array
@@ -269,11 +270,12 @@ class Follower:
             np.zeros(0) if solver is None else solver.feedforward,
             rows.astype(np.int64),
             components.astype(np.int64),
-            *_problem(None if solver is None else solver.relaxed, with_b=False),
+            *_problem(None if solver is None else solver.loop_relaxed, with_b=False),
             *_problem(scaled, with_b=True),
             *_problem(None if solver is None else solver.ray, with_b=False),
             *_ray_constants(None if solver is None else solver.ray, self.stepper.robot.n),
             0.0 if solver is None else float(solver.task_weight),
+            np.zeros(0) if solver is None or solver.levels is None else solver.levels.fixed,
             np.zeros(0) if solver is None else np.zeros_like(solver.feedforward),
             np.zeros(0) if self.stepper.observed is None else self.stepper.observed,
             np.zeros(3),
@@ -647,13 +649,17 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing, e, proving):  # type: igno
         return (SLOWED, int(again[2]), solver_time + again[3], rate)
     if not relaxing:  # relaxed, at fixed timing
         return (-1, 0, 0.0, 0.0)
+    levels = f.held.shape[0] > 0  # their last level relaxed, those above held at b
+    for i in range(f.held.shape[0]):
+        f.held[i] = qp.b[i]
     again = _relax(s, f, r)
-    if again[0] == ACCEPTED and not proving:
+    if again[0] == ACCEPTED and not proving and not levels:
         hold_multipliers(r, w)
     if again[0] != ACCEPTED or r.call.mode[0] != WARM or not _move(s, f, r.call.x, clock):
         return (-1, 0, 0.0, 0.0)
     add_kernel_metrics(f.log_sums, again[4:12])
-    return (RELAXED, int(again[2]), solver_time + again[3], 1.0)
+    iterations = int(again[2]) + (int(answer[2]) if levels else 0)  # as the cascade counts
+    return (RELAXED, iterations, solver_time + again[3], 1.0)
 
 
 @njit(inline="always")

@@ -43,6 +43,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from time import perf_counter
 
 import numpy as np
 from numpy.typing import NDArray
@@ -163,9 +164,20 @@ class _Calls:
         self.iterations = 0 if refused is None else refused.iterations or 0
         self.counted = refused is None or refused.iterations is not None
 
-    def attempt(self, kind: str, problem: solvers.Problem, backend: solvers.Backend) -> bool:
-        """Solve ``problem`` on ``backend``; whether its answer was accepted (then :attr:`x`)."""
-        solution = backend.solve(problem)
+    def attempt(
+        self,
+        kind: str,
+        problem: solvers.Problem,
+        backend: solvers.Backend,
+        made: tuple[float, ...] | None = None,
+    ) -> bool:
+        """Solve ``problem`` on ``backend``; whether its answer was accepted (then :attr:`x`).
+        ``made``: the values of its first attempt, made in compiled code on the backend's
+        ``compiled_attempt`` (the backend finishes that solve: ``adopt_attempt``)."""
+        if made is None:
+            solution = backend.solve(problem)
+        else:
+            solution = backend.adopt_attempt(problem, perf_counter(), made)  # type: ignore[attr-defined]
         self.count(kind, problem, solution)
         self.spent += solution.solver_time
         self.counted = self.counted and solution.iterations is not None
@@ -249,14 +261,20 @@ class Levels:
         return self.reach == self.count - 1
 
     def solve(
-        self, count: Count, slow: Slow | None = None, refused: solvers.Solution | None = None
+        self,
+        count: Count,
+        slow: Slow | None = None,
+        refused: solvers.Solution | None = None,
+        relaxed_values: tuple[float, ...] | None = None,
     ) -> Outcome:
         """The step: each level met as well as the limits and the levels above let it (see the
         module docstring). ``count`` is shown every backend call; ``slow``, if given, is tried
         once the levels that may be met together are not (time-scaled path following: the
         step then slows along the path, or its task becomes stopping on it, ``qp.b``);
         ``refused``: the levels together (:attr:`together`) were already tried, strict, and
-        had no accepted answer (that call, counted)."""
+        had no accepted answer (that call, counted); ``relaxed_values``: then the last level's
+        relaxed problem, those above held, was attempted in compiled code too (a run's loop:
+        :meth:`~dvqp.resolution.qp.QPSolver.relaxed_attempt`), its values."""
         qp = self.qp
         self.fixed[:] = qp.b
         calls = _Calls(count, qp.cost.shape[0], refused)
@@ -287,7 +305,8 @@ class Levels:
                             status = "slowed"
                             break
                         self.fixed[:] = qp.b  # the task of stopping on the path
-                    if top > settled and attempt("relaxed", *self._loaded(top)):
+                    made, relaxed_values = relaxed_values, None
+                    if top > settled and attempt("relaxed", *self._loaded(top), made):
                         self._hold(top, calls.answer)
                         status, settled = "relaxed", top + 1  # the last level gave way
                         continue

@@ -225,10 +225,29 @@ class QPSolver:
         :meth:`fused_attempt`'s), for a caller that relaxes a step whose strict problem its
         cold attempt refused in compiled code (:func:`dvqp.motion.follow.follow`), then hands
         both attempts' values to :meth:`solve` (``attempted``, ``relaxed_values``) or counts the
-        step (:meth:`count_refused`); None when it cannot (as :meth:`fused_attempt`)."""
-        if self.levels is not None or self.watchers:
+        step (:meth:`count_refused`); None when it cannot (as :meth:`fused_attempt`). With
+        levels that may all be met together, the last level's relaxed problem, the levels above
+        held (:attr:`loop_relaxed`): the first QP of their cascade after that strict refusal
+        (:meth:`~dvqp.resolution.levels.Levels.solve`)."""
+        if self.watchers:
             return None
+        if self.levels is not None:
+            if not self.levels.together:
+                return None
+            problem, backend = self.levels.relaxed(self.levels.count - 1)
+            return self._compiled_attempt(backend, problem)
         return self._compiled_attempt(self.backends[1], self.relaxed)
+
+    @property
+    def loop_relaxed(self) -> solvers.Problem | None:
+        """The problem :meth:`relaxed_attempt` solves (None: none): the relaxed problem, or
+        with levels that may all be met together their last level's, relaxed with those
+        above held at ``b`` (its ``b`` is :attr:`~dvqp.resolution.levels.Levels.fixed`)."""
+        if self.levels is None:
+            return self.relaxed
+        if not self.levels.together:
+            return None
+        return self.levels.relaxed(self.levels.count - 1)[0]
 
     def load_relaxed_problem(self) -> None:
         """Load the relaxed problem from this step's QP (:func:`load_relaxed`, as a relaxed step
@@ -242,8 +261,15 @@ class QPSolver:
         (:mod:`dvqp.resolution.ray`), before a run's steps: a run's first relaxed step is then
         a warm attempt that its compiled loop makes (:meth:`relaxed_attempt`), not a set-up in
         Python (0.7-1 ms), and the loop can prove strict refusals (:meth:`ray_attempt`).
-        Neither counted nor watched: no step's calls. Levels relax each of their own problems:
-        nothing then."""
+        Neither counted nor watched: no step's calls. With levels, their last level's relaxed
+        problem when they may all be met together (:attr:`loop_relaxed`), and no
+        least-violation problem."""
+        levels = self.levels
+        if levels is not None and levels.together:
+            problem, backend = levels.relaxed(levels.count - 1)
+            levels.fixed[:] = self.qp.b
+            load_relaxed(self.qp, problem)
+            backend.solve(problem)
         if self.ray is None or self._prover is None:
             return
         self.backends[1].solve(self.relaxed)
@@ -313,7 +339,7 @@ class QPSolver:
                 return Answer(x, "optimal", solution.iterations, solution.solver_time)
         if levels is not None:
             slow = self._slow_down if not rest and self.feedforward.any() else None
-            out = levels.solve(self._count, slow, refused)
+            out = levels.solve(self._count, slow, refused, relaxed_values)
             if out.x is not None:
                 return Answer(out.x, out.status, out.iterations, out.solver_time, out.rate)
             return self._brake(out.message, out.iterations, out.solver_time, out.rate)

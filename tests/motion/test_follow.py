@@ -102,13 +102,19 @@ def test_a_run_with_its_compiled_loop_is_the_run_step_by_step(name: str, backend
 
 
 @pytest.mark.parametrize(
-    ("name", "kind", "python"), [("probe-into-clamp", "relaxed", 1), ("weld-rush", "slowed", 2)]
+    ("name", "kind", "python"),
+    [
+        ("probe-into-clamp", "relaxed", 1),
+        ("weld-rush", "slowed", 2),
+        ("reach-priorities", "relaxed", 1),
+    ],
 )
 def test_a_refused_streak_runs_in_the_loop_and_each_handed_step_is_finished_by_python(
     name: str, kind: str, python: int
 ) -> None:
     """probe-into-clamp relaxes hundreds of steps in one streak, weld-rush slows 171 in
-    three: a streak's first step (the warm strict attempt refused, restarted cold) and the
+    three, reach-priorities relaxes 193 (its levels together refused, the last level relaxed
+    with the first held: the first QP of their cascade): a streak's first step (the warm strict attempt refused, restarted cold) and the
     others (the cold attempt refused) are the loop's, relaxed or slowed there; the first
     slowed step of a run too, but for its time-scaled backend's set-up (the relaxed
     backend is set up before the run's steps). With a stride of 0 the loop hands every step
