@@ -148,6 +148,11 @@ class RowDropping:
         used = compact(problem.G, problem.h, copy.slot_of, copy.row_of, copy.G, copy.h)
         return self._spread(problem, copy, self.inner.solve(copy.sized(used), initvals))
 
+    def attempts_compiled(self) -> bool:
+        """Whether the inner backend can make attempts in compiled code (it has a
+        ``compiled_call``): only then may :meth:`compiled_attempt` say anything but None."""
+        return getattr(self.inner, "compiled_call", None) is not None
+
     def compiled_attempt(self, problem: Problem) -> AttemptRows | None:
         """What compiled code needs to make the next solve of ``problem`` itself, its rows
         dropped and the inner backend's warm attempt on them (e.g.

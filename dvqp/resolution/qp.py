@@ -263,7 +263,12 @@ class QPSolver:
         Python (0.7-1 ms), and the loop can prove strict refusals (:meth:`ray_attempt`).
         Neither counted nor watched: no step's calls. With levels, their last level's relaxed
         problem when they may all be met together (:attr:`loop_relaxed`), and no
-        least-violation problem."""
+        least-violation problem. Only for backends that make attempts in compiled code
+        (``attempts_compiled``: DAQP's): another's set-up is the first relaxed step's, as before
+        (a warm start changes its answers within its tolerance)."""
+        compiled = getattr(self.backends[1], "attempts_compiled", None)
+        if compiled is None or not compiled():
+            return
         levels = self.levels
         if levels is not None and levels.together:
             problem, backend = levels.relaxed(levels.count - 1)
