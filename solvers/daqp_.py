@@ -107,9 +107,11 @@ class DaqpBackend(StatefulBackend):
     (certified)"``, 0 iterations). DAQP writes no multipliers when it finds a problem
     infeasible: they are the last answer's, or those a caller held there for the next
     restart (:func:`~solvers.daqp_c.hold_multipliers`: a relaxed problem's answer proves the
-    strict one infeasible in most steps of a relaxed streak). A refusal so proved is the one
-    the solve would have ended in (no answer could pass the check): the answers are the same
-    with or without it (False: every restart solves)."""
+    strict one infeasible in most steps of a relaxed streak). A refusal so proved is one the
+    solve could not have escaped (no answer can pass the check): every answer, and which
+    solves are refused, are the same with or without it (False: every restart solves); only
+    the refusal's record differs: 0 iterations, and always infeasible, where DAQP's own solve
+    might have stopped at its iteration or time limit first."""
 
     def __init__(self, *, tolerance: float | None = None, **settings: Any) -> None:
         super().__init__(tolerance=tolerance, **settings)

@@ -15,7 +15,8 @@ and the box bounds it from below: ``vᵀx ≥ L = Σ_j min(v_j (lb_j − τ), v_
 the tolerance). :func:`refuted` makes that test on the data a solve would be given, in
 floating point with a margin of ``1e-12`` of the terms' magnitude (rounding errors are far
 smaller); a row with an infinite bound, or a one-sided row's multiplier of the wrong sign,
-takes no part (its multiplier counts as 0, which keeps the test sound).
+takes no part (its multiplier counts as 0, which keeps the test sound); a product that
+underflows (below the least normal float) proves nothing.
 
 Where a sequence of problems stays infeasible (the strict task of a streak of steps that
 cannot meet it), multipliers that proved one problem infeasible, or the answer's multipliers
@@ -33,6 +34,9 @@ from .jit import njit
 
 MARGIN = 1e-12
 """How far (relative to the magnitude of its terms) ``L`` must exceed ``U``."""
+NORMAL = 2.2250738585072014e-308
+"""The least normal float64: a product of nonzero factors below it lost its relative
+precision (underflow), and the test no longer bounds its error: nothing is proved then."""
 
 
 @njit
@@ -77,22 +81,35 @@ def refuted(
             continue  # a one-sided row: only z ≥ 0 bounds G x from above
         if weight == 0.0 or not math.isfinite(bound) or not math.isfinite(weight):
             continue
+        if _underflows(weight, bound) or _underflows(weight, tolerance):
+            return False
         top += weight * bound + tolerance * abs(weight)
         scale += abs(weight * bound) + tolerance * abs(weight)
         row = M + i * n
         for j in range(n):
-            term = weight * data[row + j]
+            entry = data[row + j]
+            if _underflows(weight, entry):
+                return False
+            term = weight * entry
             v[j] += term
             size[j] += abs(term)
     least = 0.0
     for j in range(n):
         if size[j] == 0.0:
-            continue  # no row weighs this variable: v_j = 0, whatever its bounds
+            continue  # every row's entry is 0 (no product underflowed): v_j = 0 exactly
         lo = data[lower + j] - tolerance if has_lb and ms > 0 else -math.inf
         hi = data[upper + j] + tolerance if has_ub and ms > 0 else math.inf
-        if v[j] > 0.0:
-            least += v[j] * lo
-        elif v[j] < 0.0:
-            least += v[j] * hi
+        side = lo if v[j] > 0.0 else hi
+        if v[j] != 0.0 and _underflows(v[j], side):
+            return False
+        least += v[j] * side if v[j] != 0.0 else 0.0
         scale += size[j] * max(abs(lo), abs(hi))
     return least - top > MARGIN * scale  # False on NaN or an infinite side
+
+
+@njit(inline="always")
+def _underflows(a: float, b: float) -> bool:
+    """Whether ``a · b`` of nonzero finite factors lost its relative precision (below
+    :data:`NORMAL`)."""
+    product = a * b
+    return a != 0.0 and b != 0.0 and abs(product) < NORMAL and math.isfinite(b)

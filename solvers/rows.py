@@ -153,6 +153,11 @@ class RowDropping:
         ``compiled_call``): only then may :meth:`compiled_attempt` say anything but None."""
         return getattr(self.inner, "compiled_call", None) is not None
 
+    def proves_refusals(self) -> bool:
+        """Whether the inner backend's restarts try held multipliers as a proof that a
+        problem admits no answer (its ``refutes``, :mod:`solvers.farkas`)."""
+        return bool(getattr(self.inner, "refutes", False))
+
     def compiled_attempt(self, problem: Problem) -> AttemptRows | None:
         """What compiled code needs to make the next solve of ``problem`` itself, its rows
         dropped and the inner backend's warm attempt on them (e.g.

@@ -605,22 +605,25 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing, e, proving):  # type: igno
     problem admits no answer is held for the strict restarts (:func:`solvers.daqp_c.
     hold_multipliers`): when the multipliers held do not prove this step's, the
     least-violation problem's (``e``, if ``proving``: before the cold restart, which they may
-    then spare, or after a refused one), else the relaxed or time-scaled answer's. Returns
-    ``(kind,
-    iterations, solver_time, rate)`` of the step taken, its kind −1 (with ``b`` as it was)
-    when it cannot be taken here."""
+    then spare, or after a refused one), else (none held, or it proved nothing) the relaxed
+    or time-scaled answer's, not with levels (Python's cascade, which counts the refusal's
+    iterations, holds none). Returns ``(kind, iterations, solver_time, rate)`` of the step
+    taken, its kind −1 (with ``b`` as it was) when it cannot be taken here."""
     clock, mode, qp = w.call.handles[H_CLOCK], w.call.mode, s.qp
-    answer, warm, tried = out[3:15], 0.0, False
+    answer, warm, tried, held = out[3:15], 0.0, False, False
     if mode[0] == WARM:  # the cold restart; its time counts the warm attempt's too
         mode[0] = RESTART
         if proving and not proves(w.call):  # a proof for the restart to try first
-            warm, tried = _prove(s, f, e, w), True
+            warm, held = _prove(s, f, e, w)
+            tried = True
         answer = attempt(w.call)
         warm += out[6]
         if not _checked(answer):
             return (-1, 0, 0.0, 0.0)
     if proving and not tried and answer[0] != ACCEPTED and answer[1] != CERTIFIED:
-        warm += _prove(s, f, e, w)  # the refusal was solved: a proof for the next steps
+        spent, held = _prove(s, f, e, w)  # the refusal was solved: a proof for the next steps
+        warm += spent
+    held = held or answer[1] == CERTIFIED  # keep what proved it
     solver_time = answer[3] + warm
     if answer[0] == ACCEPTED:  # the strict answer, cold
         mode[0] = WARM
@@ -633,7 +636,7 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing, e, proving):  # type: igno
         if not pacing:
             return (-1, 0, 0.0, 0.0)
         again = _slow(s, f, p)
-        if again[0] == ACCEPTED and not proving:  # the next strict restart's proof to try
+        if again[0] == ACCEPTED and not held:  # the next strict restart's proof to try
             hold_multipliers(p, w)
         if again[0] != ACCEPTED or p.call.mode[0] != WARM:
             return (-1, 0, 0.0, 0.0)
@@ -653,7 +656,7 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing, e, proving):  # type: igno
     for i in range(f.held.shape[0]):
         f.held[i] = qp.b[i]
     again = _relax(s, f, r)
-    if again[0] == ACCEPTED and not proving and not levels:
+    if again[0] == ACCEPTED and not held and not levels:
         hold_multipliers(r, w)
     if again[0] != ACCEPTED or r.call.mode[0] != WARM or not _move(s, f, r.call.x, clock):
         return (-1, 0, 0.0, 0.0)
@@ -667,7 +670,8 @@ def _prove(s, f, e, w):  # type: ignore[no-untyped-def]
     """The least-violation problem loaded (its ``Q̇`` block ``ε I``, no cost:
     :mod:`dvqp.resolution.ray`) and its first attempt made (``e``); its answer's multipliers,
     if accepted, held in the strict backend's workspace (``w``), where its restarts try them
-    as a proof (:func:`solvers.daqp_c.hold_multipliers`). Returns the seconds inside DAQP."""
+    as a proof (:func:`solvers.daqp_c.hold_multipliers`). Returns the seconds inside DAQP
+    and whether they were held (not if refused, or if its copy's capacity would change)."""
     qp = s.qp
     load_columns(
         f.ray_eye,
@@ -686,7 +690,7 @@ def _prove(s, f, e, w):  # type: ignore[no-untyped-def]
     again = solve_dropped(e)
     if again[0] == ACCEPTED:
         hold_multipliers(e, w)
-    return again[3] if again[0] >= 0.0 else 0.0
+    return (again[3] if again[0] >= 0.0 else 0.0), again[0] == ACCEPTED
 
 
 @njit

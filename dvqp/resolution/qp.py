@@ -286,10 +286,12 @@ class QPSolver:
         """The least-violation problem's backend's packed ``compiled_attempt`` (as
         :meth:`relaxed_attempt`'s), for a run's compiled loop that proves strict refusals with
         its multipliers (:func:`dvqp.motion.follow.follow`); None when it cannot (as
-        :meth:`fused_attempt`, or before :meth:`set_up_fallbacks`)."""
-        if self.ray is None or self._prover is None or self.watchers:
+        :meth:`fused_attempt`, or before :meth:`set_up_fallbacks`, or when the strict
+        backend proves no refusal: ``proves_refusals``)."""
+        proves = getattr(self.backends[0], "proves_refusals", None)
+        if self.ray is None or self._prover is None or self.watchers or not proves:
             return None
-        return self._compiled_attempt(self._prover, self.ray)
+        return self._compiled_attempt(self._prover, self.ray) if proves() else None
 
     def followed(self) -> None:
         """After a run's compiled loop made the strict backend's attempts (and its cold

@@ -114,12 +114,13 @@ def test_a_refused_streak_runs_in_the_loop_and_each_handed_step_is_finished_by_p
 ) -> None:
     """probe-into-clamp relaxes hundreds of steps in one streak, weld-rush slows 171 in
     three, reach-priorities relaxes 193 (its levels together refused, the last level relaxed
-    with the first held: the first QP of their cascade): a streak's first step (the warm strict attempt refused, restarted cold) and the
-    others (the cold attempt refused) are the loop's, relaxed or slowed there; the first
-    slowed step of a run too, but for its time-scaled backend's set-up (the relaxed
-    backend is set up before the run's steps). With a stride of 0 the loop hands every step
-    over after its move (with every attempt made, and a slowed step's ``b`` put back):
-    Python finishes each as it would have made it."""
+    with the first held: the first QP of their cascade): a streak's first step (the warm
+    strict attempt refused, restarted cold) and the others (the cold attempt refused) are the
+    loop's, relaxed or slowed there; the first slowed step of a run too, but for its
+    time-scaled backend's set-up (the relaxed backend is set up before the run's steps).
+    With a stride of 0 the loop hands every step over after its move (with every attempt
+    made, and a slowed step's ``b`` put back): Python finishes each as it would have made
+    it."""
     fast, _, taken = planned(name, "daqp", loop=True)
     slow, _, _ = planned(name, "daqp", loop=False)
     refused = int(np.sum(fast.status == kind))

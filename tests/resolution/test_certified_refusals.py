@@ -1,8 +1,9 @@
 """Strict refusals proved without a solve (``solvers.farkas``) in a run's relaxed or slowed
-streak: the multipliers of the step's relaxed or time-scaled answer, held by the strict
-backend (``solvers.daqp_c.hold_multipliers``), prove the next step's strict problem
-infeasible. A refusal so proved is one that no answer could have escaped: the run is the run
-that solves every strict problem, bit for bit."""
+streak: the multipliers the strict backend holds (``solvers.daqp_c.hold_multipliers``: the
+least-violation problem's, ``dvqp.resolution.ray``, or the relaxed or time-scaled answer's)
+prove the next steps' strict problems infeasible. A refusal so proved is one no answer could
+have escaped: the run's steps are those of the run that solves every strict problem, bit for
+bit; only the work recorded differs where a step counts its refusal's iterations (levels)."""
 
 from __future__ import annotations
 
@@ -174,3 +175,23 @@ def test_the_least_violation_proves_a_slight_violation_that_the_relaxed_answer_d
         assert proves(strict, answer.y, answer.z, TOLERANCE)
         by_relaxed += proves(strict, relaxed.y, relaxed.z, TOLERANCE)
     assert by_relaxed < 0.2 * len(pairs)
+
+
+def test_levels_proving_refusals_take_the_same_steps_and_count_the_work_saved() -> None:
+    """reach-priorities' relaxed steps count their strict refusal's iterations with their own
+    (as the levels' cascade counts them): where the loop proves a refusal, that step records
+    fewer; its steps, statuses and refusals are those of the run that solves every one, and
+    of the run step by step in Python."""
+    solving, _ = flags_of_a_run("reach-priorities", refutes=False, loop=True)
+    proving, flags = flags_of_a_run("reach-priorities", refutes=True, loop=True)
+    stepwise, _ = flags_of_a_run("reach-priorities", refutes=True, loop=False)
+    relaxed = solving.status == "relaxed"
+    assert int(relaxed.sum()) > 100 and flags[daqp_c.CERTIFIED] > 0.8 * int(relaxed.sum())
+    for name in ("q", "qdot", "tool", "task_error", "level_error", "min_clearance"):
+        np.testing.assert_array_equal(getattr(proving, name), getattr(solving, name), name)
+    assert list(proving.status) == list(solving.status)
+    assert proving.refusals == solving.refusals == {"infeasible": int(relaxed.sum())}
+    assert np.all(proving.iterations <= solving.iterations)
+    assert np.sum(proving.iterations[relaxed]) < 0.8 * np.sum(solving.iterations[relaxed])
+    np.testing.assert_array_equal(proving.iterations[~relaxed], solving.iterations[~relaxed])
+    assert_same_run(stepwise, proving)

@@ -125,6 +125,16 @@ def test_a_one_sided_row_proves_only_with_a_positive_multiplier_and_a_finite_bou
     assert not proves(none, np.array([0.0, 1.0]), A, b, G, h, lb, ub)
 
 
+def test_a_product_that_underflows_proves_nothing() -> None:
+    """``1e-300 x = 1`` met by ``x = 1e300`` (inside a box of ±1e301): ``y = −1e-30`` makes
+    ``y A`` underflow to 0, which would make ``v = 0`` and ``L = 0 > U = −1e-30`` a false
+    proof; the check proves nothing where a product loses its precision."""
+    A, b, G, h, none = np.array([[1e-300]]), np.ones(1), np.zeros((0, 1)), np.zeros(0), np.zeros(0)
+    wide = np.array([1e301])
+    assert not proves(np.array([-1e-30]), none, A, b, G, h, -wide, wide)
+    assert proves(np.array([-1.0]), none, A, b, G, h, -np.ones(1), np.ones(1))  # x ≤ 1: none
+
+
 def test_an_unbounded_variable_that_the_multipliers_weigh_proves_nothing() -> None:
     data, n, p, m = stacked(
         np.zeros((0, 1)), np.zeros(0), np.ones((1, 1)), np.array([-1.0]), np.zeros(1), np.ones(1)
