@@ -188,7 +188,7 @@ class QPSolver:
         self.ray = None if self.levels is not None else ray_problem(qp)
         """The strict task's least violation (:mod:`dvqp.resolution.ray`), whose multipliers a
         run's compiled loop holds to prove strict refusals (None with levels)."""
-        self._prover = None if self.ray is None else factory()
+        self._prover: solvers.Backend | None = None  # the ray's, made by set_up_fallbacks
         self.feedforward = np.zeros(m)
         """The hard tasks' nominal motion this step, in their units per s, shape (m,): part
         of ``b``; when it is not zero, a step whose strict problem has no accepted answer slows
@@ -275,8 +275,10 @@ class QPSolver:
             levels.fixed[:] = self.qp.b
             load_relaxed(self.qp, problem)
             backend.solve(problem)
-        if self.ray is None or self._prover is None:
+        if self.ray is None:
             return
+        if self._prover is None:
+            self._prover = self.factory()
         self.backends[1].solve(self.relaxed)
         eye, zero = ray_constants(self.qp.cost.shape[0])
         load_relaxed(self.qp, self.ray, eye, zero)

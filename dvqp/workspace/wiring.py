@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
+from inspect import getattr_static
 from typing import Any, Protocol
 
 import numpy as np
@@ -70,9 +71,10 @@ class DamperBlock:
 
 
 def overrides(part: object, base: type, *names: str) -> bool:
-    """Whether ``part``'s class replaces any of ``base``'s methods ``names`` (a subclass of a
-    built-in that computes its own rows, which then joins as a part of your own)."""
-    return any(getattr(type(part), name) is not getattr(base, name) for name in names)
+    """Whether ``part`` replaces any of ``base``'s methods ``names`` (a subclass of a built-in
+    that computes its own rows, which then joins as a part of your own): the member ``part``
+    finds under each name (:func:`inspect.getattr_static`, not bound) is not ``base``'s."""
+    return any(getattr_static(part, name) is not getattr_static(base, name) for name in names)
 
 
 class StepWiring:
