@@ -31,7 +31,9 @@ first timed run), medians in µs:
 - **Per bundled scene**, pinv's and DAQP's median step and its ratio to the paper scene's
   (bracketed: the mean of the paper scene's runs just before and after it, this machine's
   speed drifting; median over the repeats), and, within each DAQP run, the median of its
-  ``slowed`` and of its ``relaxed`` steps against its strict (``optimal``) ones.
+  ``slowed`` and of its ``relaxed`` steps against its strict (``optimal``) ones, and the
+  same of those that start a streak (the step before was strict: its warm strict attempt is
+  made and refused before the fallback is solved) and of those within one.
 
 Timing is noisy on a shared machine: compare the ratios, taken within one run.
 """
@@ -244,22 +246,26 @@ def print_paper(rows: dict[str, dict[str, float]]) -> None:
     )
 
 
-def kinds(files: list[str], repeat: int) -> dict[str, tuple[float, float, int, int]]:
+def kinds(files: list[str], repeat: int) -> dict[str, tuple[float, ...]]:
     """Per scene file, the median of the DAQP runs' slowed and of their relaxed steps over
-    that of their strict ones (``repeat`` runs; NaN: none), and how many of each a run has."""
+    that of their strict ones (``repeat`` runs; NaN: none), then the same of those that start
+    a streak (the step before was strict) and of those within one, and how many of each a
+    run has: ``(slowed, relaxed, start, within, n_slowed, n_relaxed, n_start, n_within)``."""
     out = {}
     for f in files:
         scene = dvqp.load_scene(f)
         runs = [dvqp.plan(scene, "daqp") for _ in range(repeat)]
         status = np.concatenate([np.asarray(t.status)[1:] for t in runs])
+        before = np.concatenate([np.asarray(t.status)[:-1] for t in runs])
         times = np.concatenate([t.step_time[1:] for t in runs])
         strict = np.median(times[status == "optimal"])
-        cells = []
-        for kind in ("slowed", "relaxed"):
-            chosen = status == kind
-            cells.append(np.median(times[chosen]) / strict if chosen.any() else np.nan)
-            cells.append(int(chosen.sum()) // repeat)
-        out[Path(f).stem] = (cells[0], cells[2], cells[1], cells[3])
+        fallen = (status == "slowed") | (status == "relaxed")
+        start = fallen & (before == "optimal")
+        ratios, counts = [], []
+        for chosen in (status == "slowed", status == "relaxed", start, fallen & ~start):
+            ratios.append(np.median(times[chosen]) / strict if chosen.any() else np.nan)
+            counts.append(int(chosen.sum()) // repeat)
+        out[Path(f).stem] = (*ratios, *counts)
     return out
 
 
@@ -274,7 +280,7 @@ def print_scenes(files: list[str], repeat: int) -> None:
     found = kinds(files, repeat)
     header = (
         f"{'scene':<20} {'pinv us':>8} {'/paper':>6} {'daqp us':>8} {'/paper':>6} "
-        f"{'slowed':>13} {'relaxed':>13}"
+        f"{'slowed':>13} {'relaxed':>13} {'start':>13} {'within':>13}"
     )
     print(header)
     print("-" * len(header))
@@ -284,11 +290,16 @@ def print_scenes(files: list[str], repeat: int) -> None:
         for b in ("pinv", "daqp"):
             steps, ratios = zip(*got[name, b], strict=True)
             cells += f" {np.median(steps) * 1e6:8.1f} {np.median(ratios):6.2f}"
-        slowed, relaxed, n_slowed, n_relaxed = found[name]
-        for ratio, count in ((slowed, n_slowed), (relaxed, n_relaxed)):
+        values = found[name]
+        for ratio, count in zip(values[:4], values[4:], strict=True):
             cells += f" {ratio:6.2f} ({count:4d})" if count else f" {'-':>13}"
         print(f"{name:<20}{cells}")
     print("slowed, relaxed: their median step / the run's strict median (count); target <= 1.5")
+    print(
+        "start, within: the same of the slowed or relaxed steps that start a streak (the step "
+        "before was strict:\n  its strict warm attempt refused, then the fallback solved) and "
+        "of those within one"
+    )
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -104,10 +104,15 @@ class DaqpBackend(StatefulBackend):
     multipliers its workspace holds as a certificate that the problem admits no acceptable
     answer (:func:`solvers.farkas.refuted`, at :attr:`tolerance`): proved, it is refused
     without a solve (exit flag :data:`~solvers.daqp_c.CERTIFIED`, status ``"infeasible
-    (certified)"``, 0 iterations). DAQP writes no multipliers when it finds a problem
-    infeasible: they are the last answer's, or those a caller held there for the next
-    restart (:func:`~solvers.daqp_c.hold_multipliers`: a relaxed problem's answer proves the
-    strict one infeasible in most steps of a relaxed streak). A refusal so proved is one the
+    (certified)"``, 0 iterations). They are the infeasibility direction DAQP's last solve
+    ended on if it found its problem infeasible (DAQP writes no multipliers then; its
+    workspace holds the direction, which :func:`~solvers.daqp_c.stacked_solve` writes out),
+    else the last answer's, or those a caller held there for the next restart
+    (:func:`~solvers.daqp_c.hold_multipliers`: a relaxed problem's answer proves the strict
+    one infeasible in most steps of a relaxed streak). So a warm refusal's restart is
+    certified from the refusal's own direction in most cases, and the refusal of a solve
+    that ended on DAQP's direction carries it as its multipliers (``y``, ``z``): a
+    certificate of infeasibility, unchecked as such. A refusal so proved is one the
     solve could not have escaped (no answer can pass the check): every answer, and which
     solves are refused, are the same with or without it (False: every restart solves); only
     the refusal's record differs: 0 iterations, and always infeasible, where DAQP's own solve

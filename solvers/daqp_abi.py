@@ -137,6 +137,11 @@ class WorkspaceHead(ctypes.Structure):
 
 _SENSE_AT = WorkspaceHead.sense.offset
 """Byte offset of ``DAQPWorkspace.sense``, the constraints' states a warm update keeps."""
+_WS_AT, _ACTIVE_AT = WorkspaceHead.WS.offset, WorkspaceHead.n_active.offset
+_LAM_STAR_AT, _SCALING_AT = WorkspaceHead.lam_star.offset, WorkspaceHead.scaling.offset
+"""Byte offsets of ``DAQPWorkspace.WS`` (int*), ``n_active`` (int), ``lam_star``
+(c_float*) and ``scaling`` (c_float*): the working set and the dual direction DAQP leaves
+when it finds a problem infeasible (:mod:`solvers.daqp_c`)."""
 _QP_SENSE = ProblemData.sense.offset // 8
 _RES_X, _RES_LAM = Result.x.offset // 8, Result.lam.offset // 8
 _RES_FLAG, _RES_ITER = Result.exitflag.offset // 4, Result.iter.offset // 4

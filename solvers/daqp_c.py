@@ -23,12 +23,16 @@ from ._fast import stack_into
 from ._kkt import HAS_LB, HAS_UB, MISFITTING, _readonly, stacked_values
 from .clock import now
 from .daqp_abi import (
+    _ACTIVE_AT,
+    _LAM_STAR_AT,
     _QP_SENSE,
     _RES_FLAG,
     _RES_LAM,
     _RES_WORDS,
     _RES_X,
+    _SCALING_AT,
     _SENSE_AT,
+    _WS_AT,
     H_CLOCK,
     H_PROBLEM,
     H_RESULT,
@@ -52,6 +56,8 @@ constraints' states DAQP holds); ``RESTART``, start afresh from the set-up's ``s
 caller); ``AS_SET_UP``, solve the data as the set-up left it (no copy, no update)."""
 MISFITTED, UPDATE_FAILED, SOLVED, ACCEPTED = 0.0, 1.0, 2.0, 3.0
 """Stages of :func:`stacked_solve`'s values (and :func:`solve_dropped`'s: ``ACCEPTED``)."""
+INFEASIBLE = -1
+"""DAQP's exit flag for a problem it found infeasible (``DAQP_EXIT_INFEASIBLE``)."""
 CERTIFIED = -101
 """The exit flag of a cold restart refused without a solve: the multipliers in ``lam`` prove
 that no answer can pass the check (:func:`solvers.farkas.refuted`). DAQP's own flags are -7
@@ -69,6 +75,62 @@ def _read_word(typingctx, address):  # type: ignore[no-untyped-def]
         return builder.load(pointer)
 
     return types.int64(types.int64), codegen
+
+
+@intrinsic
+def _read_int(typingctx, address):  # type: ignore[no-untyped-def]
+    """The C ``int`` (int32) at ``address``, as an int64."""
+
+    def codegen(context, builder, sig, args):  # type: ignore[no-untyped-def]
+        pointer = builder.inttoptr(args[0], ir.IntType(32).as_pointer())
+        return builder.sext(builder.load(pointer), ir.IntType(64))
+
+    return types.int64(types.int64), codegen
+
+
+@intrinsic
+def _read_float(typingctx, address):  # type: ignore[no-untyped-def]
+    """The C ``double`` at ``address``."""
+
+    def codegen(context, builder, sig, args):  # type: ignore[no-untyped-def]
+        pointer = builder.inttoptr(args[0], ir.DoubleType().as_pointer())
+        return builder.load(pointer)
+
+    return types.float64(types.int64), codegen
+
+
+@njit(inline="always")
+def _write_direction(work: int, lam: np.ndarray) -> None:
+    """DAQP's infeasibility direction written into ``lam`` (ms + p + m,), in its output's
+    order and signs.
+
+    DAQP finds a problem infeasible when the dual direction it would step along
+    (``lam_star`` over the working set ``WS``, the singular direction its last added
+    constraint made) meets no blocking constraint: a nonnegative (signed: a lower side's
+    negative) combination of the working set's rows that vanishes while their bounds
+    combine to a contradiction, the certificate of Farkas' lemma. DAQP writes no multipliers
+    then; this reads the direction from its workspace, undoing the rows' normalisation as
+    DAQP does for an answer's multipliers (``ldp2qp_solution``). Nothing here trusts it: a
+    restart tests it on the data (:func:`solvers.farkas.refuted`). ``lam`` is left zero if
+    the working set does not fit it."""
+    rows = lam.shape[0]
+    for i in range(rows):
+        lam[i] = 0.0
+    active = _read_int(work + _ACTIVE_AT)
+    if active < 0 or active > rows:
+        return
+    ws, star = _read_word(work + _WS_AT), _read_word(work + _LAM_STAR_AT)
+    scaling = _read_word(work + _SCALING_AT)
+    for i in range(active):
+        row = _read_int(ws + 4 * i)
+        if row < 0 or row >= rows:
+            for j in range(rows):
+                lam[j] = 0.0
+            return
+        value = _read_float(star + 8 * i)
+        if scaling != 0:
+            value *= _read_float(scaling + 8 * row)
+        lam[row] = value
 
 
 @intrinsic
@@ -143,12 +205,14 @@ def stacked_solve(
     ``handles`` and ``words`` are a :class:`~solvers.daqp_abi.Workspace`'s ``handles`` and
     the words behind its problem and result; ``mode`` holds the bits :data:`RESTART`,
     :data:`REFACTOR` and :data:`AS_SET_UP` (none: warm, from the working set of the last
-    solve). A cold restart with ``refute`` ≥ 0 (the check's tolerance; negative: never)
-    first tries the multipliers ``lam`` holds (those :func:`hold_multipliers` put there, or
-    the last ones DAQP wrote: it writes none when it finds a problem infeasible) as a
-    certificate that the new data admits no answer within that tolerance
-    (:func:`solvers.farkas.refuted`): if they prove it, nothing is solved, ``x`` is NaN,
-    ``lam`` is kept (the next restart tries it again) and the flag is :data:`CERTIFIED`.
+    solve). With ``refute`` ≥ 0 (the check's tolerance; negative: never), a solve DAQP
+    finds infeasible leaves DAQP's infeasibility direction in ``lam`` (DAQP itself writes no
+    multipliers then: :func:`_write_direction`), and a cold restart first tries the
+    multipliers ``lam`` holds (that direction, those :func:`hold_multipliers` put there, or
+    the last answer's) as a certificate that the new data admits no answer within that
+    tolerance (:func:`solvers.farkas.refuted`): if they prove it, nothing is solved, ``x`` is
+    NaN, ``lam`` is kept (the next restart tries it again) and the flag is
+    :data:`CERTIFIED`.
 
     Returns
     -------
@@ -169,9 +233,7 @@ def stacked_solve(
     restart = (mode & RESTART) != 0 and (mode & AS_SET_UP) == 0
     box = (flags & HAS_LB) != 0, (flags & HAS_UB) != 0
     if restart and refute >= 0.0 and refuted(data, lam, n, p, m, ms, box[0], box[1], refute):
-        for i in range(n):
-            x[i] = nan
-        return (SOLVED, float(CERTIFIED), 0.0, 0.0, *_NO_ANSWER)
+        return certified(x)
     work, problem, result = handles[H_WORK], handles[H_PROBLEM], handles[H_RESULT]
     started = now(handles[H_CLOCK])
     if not mode & AS_SET_UP:
@@ -193,6 +255,8 @@ def stacked_solve(
     spent = now(handles[H_CLOCK]) - started
     both = words[base + _RES_FLAG // 2]  # exitflag and iter, one word (little-endian)
     exitflag, iterations = np.int32(both & 0xFFFFFFFF), both >> 32
+    if exitflag == INFEASIBLE and refute >= 0.0 and rows > 0:  # for the restart to try
+        _write_direction(work, lam)
     values = stacked_values(data, x, lam, n, p, m, ms, flags)
     return (SOLVED, float(exitflag), float(iterations), spent, *values)
 
@@ -333,6 +397,15 @@ def attempt(c):  # type: ignore[no-untyped-def]
 
 
 @njit(inline="always")
+def certified(x: np.ndarray) -> tuple[float, ...]:
+    """The values of a refusal certified without a solve (:data:`CERTIFIED`: 0 iterations
+    and seconds, code 0 values), its ``x`` (n,) written NaN."""
+    for i in range(x.shape[0]):
+        x[i] = math.nan
+    return (SOLVED, float(CERTIFIED), 0.0, 0.0, *_NO_ANSWER)
+
+
+@njit(inline="always")
 def proves(c) -> bool:  # type: ignore[no-untyped-def]
     """Whether the multipliers in the packed :class:`AttemptCall` ``c``'s ``lam`` prove the
     problem its ``data`` holds (as an attempt copied it) infeasible at its ``refute``
@@ -354,8 +427,8 @@ def hold_multipliers(source, target) -> None:  # type: ignore[no-untyped-def]
     equality rows' as they are; the bounds' are left (the certificate does not read them).
     Nothing is held if the equality rows differ in number.
 
-    (DAQP leaves ``lam`` as it was when it finds a problem infeasible: without this, a restart
-    tries the multipliers of the last accepted answer.)"""
+    (A solve refused by DAQP leaves its own infeasibility direction in ``lam``; a refusal
+    certified without a solve leaves ``lam`` as it was.)"""
     s, t = source.call, target.call
     if s.m != t.m:
         return

@@ -72,8 +72,8 @@ def refuted(
     M = n * n + n
     upper = M + (p + m) * n
     lower = upper + rows
-    v = np.zeros(n)
-    size = np.zeros(n)  # Σ |λ_i M_ij|: the magnitude of v's terms
+    sums = np.zeros(2 * n)  # v, then Σ |λ_i M_ij|: the magnitude of v's terms
+    v, size = sums[:n], sums[n:]
     top, scale = 0.0, 0.0
     for i in range(p + m):
         weight, bound = lam[ms + i], data[upper + ms + i]
@@ -86,13 +86,14 @@ def refuted(
         top += weight * bound + tolerance * abs(weight)
         scale += abs(weight * bound) + tolerance * abs(weight)
         row = M + i * n
-        for j in range(n):
-            entry = data[row + j]
-            if _underflows(weight, entry):
-                return False
+        for j in range(n):  # weight is finite and nonzero: _underflows(weight, entry) is
+            entry = data[row + j]  # a nonzero entry whose term is below NORMAL
             term = weight * entry
+            magnitude = abs(term)
+            if magnitude < NORMAL and entry != 0.0:
+                return False
             v[j] += term
-            size[j] += abs(term)
+            size[j] += magnitude
     least = 0.0
     for j in range(n):
         if size[j] == 0.0:

@@ -4,11 +4,13 @@ Most steps of a run are common: the command of the schedule, the strict QP's war
 accepted (or the baseline's step), the state reached regular and within every verified limit,
 its largest joint motion below :data:`~dvqp.step.JOINT_STRIDE` (no interior point to check).
 So is a step of a relaxed streak at fixed timing: the strict problem's cold attempt refused
-(the backend restarts cold after a refusal), the relaxed problem's warm attempt accepted. The
-relaxed (or time-scaled) answer's multipliers are held in the strict backend's workspace
-(:func:`solvers.daqp_c.hold_multipliers`), where the next step's cold attempt tries them
-first as a proof that its strict problem admits no answer (:mod:`solvers.farkas`): proved,
-that refusal solves nothing. Python's steps hold none; either way the refusals are the same.
+(the backend restarts cold after a refusal), the relaxed problem's warm attempt accepted. A
+cold attempt first tries the multipliers the strict backend's workspace holds as a proof that
+its strict problem admits no answer (:mod:`solvers.farkas`): proved, that refusal solves
+nothing. They are DAQP's own infeasibility direction where its last solve was refused, else
+those the loop held there (:func:`solvers.daqp_c.hold_multipliers`: the least violation's, the
+relaxed or the time-scaled answer's). Python's steps hold none; either way the refusals are
+the same.
 :func:`follow` runs such steps one after another in compiled code, each exactly as
 :func:`dvqp.step.advance` and :meth:`~dvqp.resolution.qp.QPSolver.solve` would (the same
 compiled calls, :func:`~dvqp.step.stages.resolve_move`, :func:`~dvqp.motion.schedule.
@@ -60,6 +62,7 @@ from solvers.daqp_c import (
     SOLVED,
     WARM,
     attempt,
+    certified,
     hold_multipliers,
     proves,
     solve_dropped,
@@ -600,30 +603,21 @@ def follow(s, w, r, p, f, k, u, started, until, relaxing, pacing, e, proving):  
 @njit(separate=True)  # compiled once, called by symbol: the loop stays small to compile
 def _refused(s, w, r, p, f, k, out, relaxing, pacing, e, proving):  # type: ignore[no-untyped-def]
     """Step ``k`` whose strict attempt (``out``, :func:`~dvqp.step.stages.resolve_move`'s) was
-    refused or a cold one: restarted cold if it was warm (the backend's ``after_warm``),
-    then, still refused, slowed if paced, else relaxed, and moved. A proof that the strict
-    problem admits no answer is held for the strict restarts (:func:`solvers.daqp_c.
-    hold_multipliers`): when the multipliers held do not prove this step's, the
-    least-violation problem's (``e``, if ``proving``: before the cold restart, which they may
-    then spare, or after a refused one), else (none held, or it proved nothing) the relaxed
-    or time-scaled answer's, not with levels (Python's cascade, which counts the refusal's
+    refused or a cold one: restarted cold if it was warm (the backend's ``after_warm``;
+    certified without a call when the multipliers the workspace holds prove the refusal, as
+    the restart would find them), then, still refused, slowed if paced, else relaxed, and
+    moved. A proof that the strict problem admits no answer is kept for the strict restarts:
+    the multipliers held if they prove this step's refusal (DAQP's direction of a refusal it
+    found, or those held before), else the least-violation problem's (``e``, if ``proving``:
+    before the cold restart, which they may then spare, or after a refused one), else (none
+    held, or it proved nothing) the relaxed or time-scaled answer's (:func:`solvers.daqp_c.
+    hold_multipliers`), not with levels (Python's cascade, which counts the refusal's
     iterations, holds none). Returns ``(kind, iterations, solver_time, rate)`` of the step
     taken, its kind −1 (with ``b`` as it was) when it cannot be taken here."""
     clock, mode, qp = w.call.handles[H_CLOCK], w.call.mode, s.qp
-    answer, warm, tried, held = out[3:15], 0.0, False, False
-    if mode[0] == WARM:  # the cold restart; its time counts the warm attempt's too
-        mode[0] = RESTART
-        if proving and not proves(w.call):  # a proof for the restart to try first
-            warm, held = _prove(s, f, e, w)
-            tried = True
-        answer = attempt(w.call)
-        warm += out[6]
-        if not _checked(answer):
-            return (-1, 0, 0.0, 0.0)
-    if proving and not tried and answer[0] != ACCEPTED and answer[1] != CERTIFIED:
-        spent, held = _prove(s, f, e, w)  # the refusal was solved: a proof for the next steps
-        warm += spent
-    held = held or answer[1] == CERTIFIED  # keep what proved it
+    answer, warm, held = _confirmed(s, f, e, w, out, proving)
+    if not _checked(answer):
+        return (-1, 0, 0.0, 0.0)
     solver_time = answer[3] + warm
     if answer[0] == ACCEPTED:  # the strict answer, cold
         mode[0] = WARM
@@ -663,6 +657,35 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing, e, proving):  # type: igno
     add_kernel_metrics(f.log_sums, again[4:12])
     iterations = int(again[2]) + (int(answer[2]) if levels else 0)  # as the cascade counts
     return (RELAXED, iterations, solver_time + again[3], 1.0)
+
+
+@njit(inline="always")
+def _confirmed(s, f, e, w, out, proving):  # type: ignore[no-untyped-def]
+    """The strict problem's answer after its attempt ``out`` (:func:`_refused`'s): restarted
+    cold if that attempt was warm (certified without a call when the multipliers held prove
+    the refusal, as the restart would find them), and a proof kept for the next restarts.
+    Returns ``(answer, seconds, held)``: the answer's 12 values, the seconds inside DAQP
+    besides the answer's own (the warm attempt's, the least violation's) and whether the
+    multipliers held prove this step's refusal or were just held (then nothing else is)."""
+    mode = w.call.mode
+    answer, warm, tried, held = out[3:15], 0.0, False, False
+    if mode[0] == WARM:  # the cold restart; its time counts the warm attempt's too
+        mode[0] = RESTART
+        if proves(w.call):  # the restart's certificate, found as it would find it
+            answer = certified(w.call.x)
+        else:
+            if proving:  # a proof for the restart to try first
+                warm, held = _prove(s, f, e, w)
+                tried = True
+            answer = attempt(w.call)
+        warm += out[6]
+    if proving and not tried and answer[0] != ACCEPTED and answer[1] != CERTIFIED:
+        if proves(w.call):  # DAQP's direction of the refusal it solved: a proof for the next
+            held = True
+        else:
+            spent, held = _prove(s, f, e, w)
+            warm += spent
+    return answer, warm, held or answer[1] == CERTIFIED  # keep what proved it
 
 
 @njit(inline="always")

@@ -152,8 +152,8 @@ def infeasible(ws: Drift, by: float) -> None:
 
 
 def test_a_restart_whose_held_multipliers_prove_its_problem_infeasible_solves_nothing() -> None:
-    """DAQP leaves ``lam`` as it was when it finds a problem infeasible; a ray held there
-    (row 0 against ``x0``'s lower bound) proves the next such problem infeasible: nothing
+    """A ray held in ``lam`` (row 0 against ``x0``'s lower bound, written there by hand)
+    proves the next such problem infeasible: nothing
     solved, 0 iterations, its own status and message, no answer. A feasible problem after it
     is solved as by a backend that never tries the held multipliers, bitwise."""
     pytest.importorskip("daqp")
@@ -163,7 +163,7 @@ def test_a_restart_whose_held_multipliers_prove_its_problem_infeasible_solves_no
     for backend, ws in zip((proving, solving), sides, strict=True):
         backend.solve(ws.problem).require()
         infeasible(ws, 0.5)
-        assert backend.solve(ws.problem).status == "infeasible"
+        assert backend.solve(ws.problem).refusal == "infeasible"
     if proving._c is None:
         pytest.skip("the installed daqp's layout is not mirrored: no compiled restart")
     lam, ms = proving._c.lam, proving._layout[3]
@@ -189,3 +189,55 @@ def test_a_restart_whose_held_multipliers_prove_its_problem_infeasible_solves_no
     fresh = make_backend("daqp")
     fresh.refutes = False
     assert fresh.solve(sides[0].fresh()).iterations == after.iterations
+
+
+def made_infeasible(ws: Drift, kind: str, by: float, seed: int) -> None:
+    """Make ``ws``'s problem infeasible by ``by`` at least: a row of G that keeps a joint
+    below its lower bound, two rows of G whose half-spaces stand apart, or a task row pushed
+    beyond what the box can reach (``b`` moved by ``20 + by`` times the row's reach)."""
+    rng = np.random.default_rng(seed)
+    n = ws.lb.shape[0]
+    if kind == "row past the box":
+        j = int(rng.integers(n))
+        ws.G[0], ws.h[0] = 0.0, ws.lb[j] - by
+        ws.G[0, j] = 1.0
+    elif kind == "rows apart":
+        d = rng.standard_normal(n)
+        ws.G[1], ws.G[2] = d, -d
+        ws.h[1], ws.h[2] = d @ ws.center - by, -(d @ ws.center) - by
+    else:
+        reach = 0.4 * np.abs(ws.A[0]).sum()
+        ws.b[0] += reach * (1.0 + by) + 1.0
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    kind=st.sampled_from(["row past the box", "rows apart", "task out of reach"]),
+    by=st.floats(1e-3, 1.0),
+)
+def test_a_refusal_daqp_finds_is_proved_by_its_own_direction(
+    seed: int, kind: str, by: float
+) -> None:
+    """DAQP finds a problem infeasible on a dual direction that meets no blocking constraint
+    (a Farkas ray) and writes no multipliers; the compiled solve writes that direction out.
+    A warm attempt DAQP refuses so is then certified at its cold restart, nothing solved, and
+    the direction proves the problem infeasible by the NumPy oracle's inequality (not only by
+    the compiled check). Without proofs (``refutes`` False) the restart solves (iterations >
+    0) and refuses as well."""
+    pytest.importorskip("daqp")
+    proving, solving = make_backend("daqp"), make_backend("daqp")
+    solving.refutes = False
+    sides = Drift(seed=seed % 1000), Drift(seed=seed % 1000)
+    for backend, ws in zip((proving, solving), sides, strict=True):
+        backend.solve(ws.problem).require()  # warm from here
+        ws.move(0.01)
+        made_infeasible(ws, kind, by, seed)
+    if proving._c is None:
+        pytest.skip("the installed daqp's layout is not mirrored: no compiled restart")
+    proved, solved = proving.solve(sides[0].problem), solving.solve(sides[1].problem)
+    assert proved.status == "infeasible (certified)" and proved.iterations == 0
+    assert solved.refusal == "infeasible" and solved.iterations > 0
+    lam, ms, p = proving._c.lam, proving._layout[3], proving._layout[1]
+    y, z = lam[ms + p :], lam[ms : ms + p]
+    assert gap(sides[0].problem, y, z, TAU) > 1e-12
