@@ -28,7 +28,14 @@ from collections.abc import Callable, Iterator, Sequence
 from types import ModuleType
 from typing import Any
 
-from dvqp.bench.execution import OnRows, Progress, Where, pool_context, warm_up
+from dvqp.bench.execution import (
+    OnRows,
+    Progress,
+    Where,
+    pool_context,
+    sigint_deferred,
+    warm_up,
+)
 from dvqp.bench.runner import Job, Row, lost_rows, run_job
 from dvqp.errors import DvqpError, one_line
 
@@ -112,14 +119,15 @@ def dask_client(scheduler: str, workers: int = 1) -> Iterator[tuple[Any, Where]]
                 method = pool_context().get_start_method()  # for the cluster's whole life:
                 key = "distributed.worker.multiprocessing-method"  # a worker restarted too
                 stack.enter_context(dask.config.set({key: method, **LOCAL_WORKER_CONFIG}))
-                cluster = stack.enter_context(
-                    dd.LocalCluster(
-                        n_workers=workers,
-                        threads_per_worker=1,
-                        processes=True,
-                        dashboard_address=None,
+                with sigint_deferred():  # a start cut short is never closed (below)
+                    cluster = stack.enter_context(
+                        dd.LocalCluster(
+                            n_workers=workers,
+                            threads_per_worker=1,
+                            processes=True,
+                            dashboard_address=None,
+                        )
                     )
-                )
                 client = stack.enter_context(dd.Client(cluster))
             else:
                 client = stack.enter_context(dd.Client(scheduler, timeout=CONNECT_TIMEOUT))

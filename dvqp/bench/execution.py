@@ -19,6 +19,7 @@ import functools
 import multiprocessing
 import os
 import signal
+import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ALL_COMPLETED, FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -96,7 +97,14 @@ def warm_up(job: Job) -> float:
 def sigint_deferred() -> Iterator[None]:
     """Ctrl-C held back for the duration and raised after it: ``os.fork`` runs Python hooks
     (logging's lock release) in which a KeyboardInterrupt is printed and ignored, not raised,
-    so a Ctrl-C that landed while the pool forked was lost (the bench ran on to exit 0)."""
+    so a Ctrl-C that landed while the pool forked was lost (the bench ran on to exit 0); and a
+    LocalCluster whose start it cut short was never closed: its event loop's thread went on
+    starting a worker as the bench exited, by Dask's default method once the configuration
+    was restored (``spawn``), and that process printed an ``EOFError`` traceback into the
+    bench's stderr. Outside the main thread (which alone receives Ctrl-C) nothing is held."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
     held: list[int] = []
     previous = signal.signal(signal.SIGINT, lambda signum, frame: held.append(signum))
     try:

@@ -183,3 +183,28 @@ def test_a_ctrl_c_while_a_pool_forks_is_held_back_then_raised() -> None:
         reached.append("the rest of the block ran")
     assert reached == ["the rest of the block ran"]
     assert signal.getsignal(signal.SIGINT) is before  # restored
+
+
+def test_outside_the_main_thread_nothing_is_held_back() -> None:
+    """Only the main thread may set a signal handler (and alone receives Ctrl-C): a bench
+    run from another thread (a library caller's) defers nothing and raises nothing."""
+    import signal
+    import threading
+
+    from dvqp.bench.execution import sigint_deferred
+
+    before = signal.getsignal(signal.SIGINT)
+    outcome: list[object] = []
+
+    def run() -> None:
+        try:
+            with sigint_deferred():
+                outcome.append("ran")
+        except BaseException as exc:  # reported to the test's thread
+            outcome.append(exc)
+
+    thread = threading.Thread(target=run)
+    thread.start()
+    thread.join()
+    assert outcome == ["ran"]
+    assert signal.getsignal(signal.SIGINT) is before
