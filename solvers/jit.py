@@ -7,7 +7,8 @@ numba's own (same folders, same index and data files) with three changes:
 - an entry that cannot be loaded (an index or data file cut short, garbled, empty, missing,
   unreadable, of another kind; a data file numba cannot rebuild) is deleted and its function
   compiled anew, with one line on stderr: ``dvqp: note: compile cache entry <file> could not
-  be read (<reason>): discarded, recompiling``. The next run finds the fresh entry.
+  be read (<reason>): discarded, compiled again when needed``. The next run finds the
+  fresh entry. (A run that only loads the cache, ``ready``, compiles nothing then.)
 - an entry that cannot be saved (a full disk) leaves its function compiled for this process
   only, with one note a process; a function that has no folder to cache in is not cached.
 - each data file holds the SHA-256 of its contents: machine code cut short or overwritten
@@ -110,7 +111,8 @@ class _EntryFiles(IndexDataCacheFile):
         with contextlib.suppress(OSError):
             os.unlink(path)
         note(
-            f"compile cache entry {path} could not be read ({_reason(exc)}): discarded, recompiling"
+            f"compile cache entry {path} could not be read ({_reason(exc)}): "
+            "discarded, compiled again when needed"
         )
 
     def _load_data(self, name: str) -> Any:

@@ -32,7 +32,7 @@ from tests.cli.test_cli import write_scene
 ROOT = Path(__file__).resolve().parents[2]
 NOTE = re.compile(
     r"dvqp: note: compile cache entry (.+) could not be read \((.+)\): "
-    r"discarded, recompiling"
+    r"discarded, compiled again when needed"
 )
 
 
@@ -112,7 +112,7 @@ def test_an_unreadable_index_is_recompiled_with_one_note(
     entry[0].chmod(0)
     capsys.readouterr()
     assert run_kernel() == (0, 1)
-    assert "(Permission denied): discarded, recompiling" in capsys.readouterr().err
+    assert "(Permission denied): discarded, compiled again when needed" in capsys.readouterr().err
 
 
 def test_numba_plain_entries_are_ignored_silently_and_replaced(
