@@ -100,19 +100,17 @@ class DaqpBackend(StatefulBackend):
     default_settings: ClassVar[dict[str, Any]] = {"primal_tol": 1e-8}
     restarts: ClassVar[bool] = True
     refutes: bool = True
-    """Whether a cold restart after a refusal (in DAQP's C functions) first tries the
+    """Whether a cold restart after a refusal (in DAQP's C functions) first tries
     multipliers its workspace holds as a certificate that the problem admits no acceptable
     answer (:func:`solvers.farkas.refuted`, at :attr:`tolerance`): proved, it is refused
     without a solve (exit flag :data:`~solvers.daqp_c.CERTIFIED`, status ``"infeasible
-    (certified)"``, 0 iterations). They are the infeasibility direction DAQP's last solve
-    ended on if it found its problem infeasible (DAQP writes no multipliers then; its
-    workspace holds the direction, which :func:`~solvers.daqp_c.stacked_solve` writes out),
-    else the last answer's, or those a caller held there for the next restart
-    (:func:`~solvers.daqp_c.hold_multipliers`: a relaxed problem's answer proves the strict
-    one infeasible in most steps of a relaxed streak). So a warm refusal's restart is
-    certified from the refusal's own direction in most cases, and the refusal of a solve
-    that ended on DAQP's direction carries it as its multipliers (``y``, ``z``): a
-    certificate of infeasibility, unchecked as such. A refusal so proved is one the
+    (certified)"``, 0 iterations). It tries the last answer's multipliers or those a caller
+    held for the next restart (:func:`~solvers.daqp_c.hold_multipliers`: a relaxed problem's
+    answer proves the strict one infeasible in most steps of a relaxed streak), then the
+    infeasibility direction of the last refusal DAQP found (DAQP writes no multipliers then;
+    its workspace holds the direction, which :func:`~solvers.daqp_c.stacked_solve` reads into
+    a buffer of its own). So a warm refusal's restart is
+    certified from the refusal's own direction in most cases. A refusal so proved is one the
     solve could not have escaped (no answer can pass the check): every answer, and which
     solves are refused, are the same with or without it (False: every restart solves); only
     the refusal's record differs: 0 iterations, and always infeasible, where DAQP's own solve
@@ -315,7 +313,7 @@ class DaqpBackend(StatefulBackend):
             if self._c_args is None:
                 self._c_args = (*self._stack[:9], work.handles, work.words, *self._layout)
             try:
-                out = daqp_c.solve_stacked(*self._c_args, mode, self._refute(), x, lam)
+                out = daqp_c.solve_stacked(*self._c_args, mode, self._refute(), x, lam, work.ray)
             except TypeError:  # arrays the compiled copy refuses: NumPy copies this problem
                 self._stack = None
         if self._stack is None:
@@ -342,6 +340,7 @@ class DaqpBackend(StatefulBackend):
                 self._refute(),
                 x,
                 lam,
+                work.ray,
             )  # the set-up's own buffers: the compiled copy onto themselves changes nothing
         stage, flag, iterations, spent = out[:4]
         if stage != daqp_c.SOLVED:
@@ -384,6 +383,7 @@ class DaqpBackend(StatefulBackend):
                 self._refute(),
                 work.x,
                 work.lam,
+                work.ray,
             )
         self._attempt_call.mode[0] = daqp_c.WARM if self._warm else daqp_c.RESTART
         return self._attempt_call

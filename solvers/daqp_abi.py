@@ -139,9 +139,11 @@ _SENSE_AT = WorkspaceHead.sense.offset
 """Byte offset of ``DAQPWorkspace.sense``, the constraints' states a warm update keeps."""
 _WS_AT, _ACTIVE_AT = WorkspaceHead.WS.offset, WorkspaceHead.n_active.offset
 _LAM_STAR_AT, _SCALING_AT = WorkspaceHead.lam_star.offset, WorkspaceHead.scaling.offset
+_EQ_AT = WorkspaceHead.eq.offset
 """Byte offsets of ``DAQPWorkspace.WS`` (int*), ``n_active`` (int), ``lam_star``
 (c_float*) and ``scaling`` (c_float*): the working set and the dual direction DAQP leaves
-when it finds a problem infeasible (:mod:`solvers.daqp_c`)."""
+when it finds a problem infeasible (:mod:`solvers.daqp_c`); and of ``eq`` (set when DAQP
+eliminates equalities: the workspace then describes the reduced problem)."""
 _QP_SENSE = ProblemData.sense.offset // 8
 _RES_X, _RES_LAM = Result.x.offset // 8, Result.lam.offset // 8
 _RES_FLAG, _RES_ITER = Result.exitflag.offset // 4, Result.iter.offset // 4
@@ -248,8 +250,11 @@ class Workspace:
     ----------
     x, lam : ndarray
         (n,), (ms + rows,): where every solve writes its answer, zeros at first and kept from
-        solve to solve, as ``daqp.Model``'s: DAQP leaves them as they were when it has no
-        answer (exit flag <= 0).
+        solve to solve, as ``daqp.Model``'s. When DAQP has no answer (exit flag <= 0) it
+        writes its last iterate into ``x`` and nothing into ``lam``.
+    ray : ndarray
+        (ms + rows,): DAQP's infeasibility direction of the last refusal it found, which
+        :func:`solvers.daqp_c.stacked_solve` reads from the workspace (zeros until then).
     words : ndarray of int64
         The ``DAQPProblem`` and then the ``DAQPResult`` :func:`solve_stacked` writes.
     flag : int
@@ -275,6 +280,7 @@ class Workspace:
         lib = _library()
         self._kept = [H, f, M, upper, lower, sense]
         self.x, self.lam = np.zeros(f.shape[0]), np.zeros(upper.shape[0])
+        self.ray = np.zeros(upper.shape[0])  # DAQP's direction of a refusal (solvers.daqp_c)
         given = sense.copy() if primal_start is not None else sense  # DAQP marks the start's
         self.words = np.zeros(ctypes.sizeof(ProblemData) // 8 + _RES_WORDS, dtype=np.int64)
         p = self.problem = ProblemData.from_buffer(self.words)
@@ -306,13 +312,17 @@ class Workspace:
             self._mismatch("the workspace does not name its problem where expected")
         if primal_start is not None:
             lib.daqp_set_primal_start(self._work, start.ctypes.data_as(_c_float_p))
-        self.handles = np.array(
+        self.handles = self._handles(lib, sense)
+
+    def _handles(self, lib: ctypes.CDLL, sense: np.ndarray) -> np.ndarray:
+        """What :func:`solvers.daqp_c.stacked_solve` calls and reads (slots ``H_*``)."""
+        return np.array(
             [
                 ctypes.cast(lib.daqp_update_ldp, ctypes.c_void_p).value,
                 ctypes.cast(lib.daqp_solve, ctypes.c_void_p).value,
                 clock.address(),
                 self._work,
-                ctypes.addressof(p),
+                ctypes.addressof(self.problem),
                 self.words.ctypes.data + ctypes.sizeof(ProblemData),
                 _address(sense),
             ],

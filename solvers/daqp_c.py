@@ -24,6 +24,7 @@ from ._kkt import HAS_LB, HAS_UB, MISFITTING, _readonly, stacked_values
 from .clock import now
 from .daqp_abi import (
     _ACTIVE_AT,
+    _EQ_AT,
     _LAM_STAR_AT,
     _QP_SENSE,
     _RES_FLAG,
@@ -100,24 +101,30 @@ def _read_float(typingctx, address):  # type: ignore[no-untyped-def]
 
 
 @njit(inline="always")
-def _write_direction(work: int, lam: np.ndarray) -> None:
+def _write_direction(work: int, n: int, lam: np.ndarray) -> None:
     """DAQP's infeasibility direction written into ``lam`` (ms + p + m,), in its output's
-    order and signs.
+    order and signs, after a solve DAQP found infeasible (exit flag :data:`INFEASIBLE`).
 
-    DAQP finds a problem infeasible when the dual direction it would step along
+    DAQP finds a problem infeasible mostly when the dual direction it would step along
     (``lam_star`` over the working set ``WS``, the singular direction its last added
     constraint made) meets no blocking constraint: a nonnegative (signed: a lower side's
     negative) combination of the working set's rows that vanishes while their bounds
     combine to a contradiction, the certificate of Farkas' lemma. DAQP writes no multipliers
     then; this reads the direction from its workspace, undoing the rows' normalisation as
-    DAQP does for an answer's multipliers (``ldp2qp_solution``). Nothing here trusts it: a
-    restart tests it on the data (:func:`solvers.farkas.refuted`). ``lam`` is left zero if
-    the working set does not fit it."""
+    DAQP does for an answer's multipliers (``ldp2qp_solution``). DAQP's other infeasible
+    exits (an inconsistent dual, its objective bound) leave multipliers that are no ray, and
+    a workspace whose equalities DAQP eliminated (``eq_reduction``: ``work->eq`` set)
+    describes the reduced problem: nothing is written then (``lam`` as DAQP left it). Nothing
+    here trusts the direction: a restart tests it on the data (:func:`solvers.farkas.
+    refuted`). ``lam`` is left zero if the working set does not fit it (DAQP holds at most
+    ``n + 1`` rows, each of ``lam``'s)."""
+    if _read_word(work + _EQ_AT) != 0:
+        return
     rows = lam.shape[0]
+    active = _read_int(work + _ACTIVE_AT)
     for i in range(rows):
         lam[i] = 0.0
-    active = _read_int(work + _ACTIVE_AT)
-    if active < 0 or active > rows:
+    if active < 0 or active > rows or active > n + 1:
         return
     ws, star = _read_word(work + _WS_AT), _read_word(work + _LAM_STAR_AT)
     scaling = _read_word(work + _SCALING_AT)
@@ -197,6 +204,7 @@ def stacked_solve(
     refute: float,
     x: np.ndarray,
     lam: np.ndarray,
+    ray: np.ndarray,
 ) -> tuple[float, ...]:
     """Copy a problem into the set-up's ``data`` (:func:`solvers._fast.stack_into`), update
     DAQP's LDP as ``daqp.Model.update(H, f, A)`` does, solve into ``x`` (n,) and ``lam``
@@ -206,13 +214,16 @@ def stacked_solve(
     the words behind its problem and result; ``mode`` holds the bits :data:`RESTART`,
     :data:`REFACTOR` and :data:`AS_SET_UP` (none: warm, from the working set of the last
     solve). With ``refute`` ≥ 0 (the check's tolerance; negative: never), a solve DAQP
-    finds infeasible leaves DAQP's infeasibility direction in ``lam`` (DAQP itself writes no
-    multipliers then: :func:`_write_direction`), and a cold restart first tries the
-    multipliers ``lam`` holds (that direction, those :func:`hold_multipliers` put there, or
-    the last answer's) as a certificate that the new data admits no answer within that
-    tolerance (:func:`solvers.farkas.refuted`): if they prove it, nothing is solved, ``x`` is
-    NaN, ``lam`` is kept (the next restart tries it again) and the flag is
-    :data:`CERTIFIED`.
+    finds infeasible whose answer the check refuses leaves DAQP's infeasibility direction in
+    ``ray`` (ms + p + m,; DAQP itself writes no multipliers then: :func:`_write_direction`),
+    and a cold restart first tries the multipliers ``lam`` holds (those
+    :func:`hold_multipliers` put there, or the last answer's), then that direction, as a
+    certificate that the new
+    data admits no answer within that tolerance (:func:`solvers.farkas.refuted`): if either
+    proves it, nothing is solved, ``x`` is NaN, ``ray`` and ``lam`` are kept (the next
+    restart tries them again) and the flag is :data:`CERTIFIED`. ``lam`` itself is only
+    ever DAQP's (or held there by a caller): an answer is judged with the same multipliers
+    with or without proofs.
 
     Returns
     -------
@@ -225,14 +236,14 @@ def stacked_solve(
     """
     nan = math.nan
     rows = ms + p + m
-    if x.shape[0] != n or lam.shape[0] != rows:
+    if x.shape[0] != n or lam.shape[0] != rows or ray.shape[0] != rows:
         return (MISFITTED, nan, nan, 0.0, *MISFITTING)
     changed = 0 if mode & AS_SET_UP else stack_into(P, q, A, b, G, h, lb, ub, data, n, p, m, ms)
     if changed < 0:
         return (MISFITTED, nan, nan, 0.0, *MISFITTING)
     restart = (mode & RESTART) != 0 and (mode & AS_SET_UP) == 0
     box = (flags & HAS_LB) != 0, (flags & HAS_UB) != 0
-    if restart and refute >= 0.0 and refuted(data, lam, n, p, m, ms, box[0], box[1], refute):
+    if restart and refute >= 0.0 and _either_proves(data, ray, lam, n, p, m, ms, box, refute):
         return certified(x)
     work, problem, result = handles[H_WORK], handles[H_PROBLEM], handles[H_RESULT]
     started = now(handles[H_CLOCK])
@@ -255,10 +266,21 @@ def stacked_solve(
     spent = now(handles[H_CLOCK]) - started
     both = words[base + _RES_FLAG // 2]  # exitflag and iter, one word (little-endian)
     exitflag, iterations = np.int32(both & 0xFFFFFFFF), both >> 32
-    if exitflag == INFEASIBLE and refute >= 0.0 and rows > 0:  # for the restart to try
-        _write_direction(work, lam)
     values = stacked_values(data, x, lam, n, p, m, ms, flags)
+    if exitflag == INFEASIBLE and refute >= 0.0 and rows > 0 and not accepts(values, refute):
+        _write_direction(work, n, ray)  # for the restart to try first
     return (SOLVED, float(exitflag), float(iterations), spent, *values)
+
+
+@njit(inline="always")
+def _either_proves(data, ray, lam, n, p, m, ms, box, refute) -> bool:  # type: ignore[no-untyped-def]
+    """Whether the multipliers ``lam`` holds or DAQP's last infeasibility direction (``ray``)
+    prove the problem in ``data`` infeasible at ``refute`` (:func:`solvers.farkas.refuted`):
+    ``lam`` first, where a caller holds the multipliers that proved the last refusals (a
+    streak's: one test a step), then the direction (a warm refusal's, fresh)."""
+    return refuted(data, lam, n, p, m, ms, box[0], box[1], refute) or refuted(
+        data, ray, n, p, m, ms, box[0], box[1], refute
+    )
 
 
 @compiled_on_first_call(
@@ -271,6 +293,7 @@ def stacked_solve(
         _WORDS,
         *(types.int64,) * 6,
         types.float64,
+        _VEC_OUT,
         _VEC_OUT,
         _VEC_OUT,
     )
@@ -296,10 +319,31 @@ def solve_stacked(
     refute: float,
     x: np.ndarray,
     lam: np.ndarray,
+    ray: np.ndarray,
 ) -> tuple[float, ...]:
     """:func:`stacked_solve`, compiled for its one signature, called from Python."""
     return stacked_solve(
-        P, q, A, b, G, h, lb, ub, data, handles, words, n, p, m, ms, flags, mode, refute, x, lam
+        P,
+        q,
+        A,
+        b,
+        G,
+        h,
+        lb,
+        ub,
+        data,
+        handles,
+        words,
+        n,
+        p,
+        m,
+        ms,
+        flags,
+        mode,
+        refute,
+        x,
+        lam,
+        ray,
     )
 
 
@@ -310,9 +354,9 @@ class AttemptCall:
     ``handles`` and ``words``, its sizes and ``flags`` (:func:`stacked_solve`'s), the
     attempt's ``mode`` ((1,): :data:`WARM` or :data:`RESTART`), the check's ``tolerance``
     (:func:`solvers.residuals.accepts`), ``refute`` (:func:`stacked_solve`'s: the tolerance at
-    which a restart tries the multipliers in ``lam`` as a certificate; negative: never),
-    and buffers for the answer
-    ``x`` (n,) and ``lam`` (ms + p + m,). Valid
+    which a restart tries DAQP's direction ``ray`` and the multipliers in ``lam`` as a
+    certificate; negative: never), and buffers for the answer ``x`` (n,) and ``lam``
+    (ms + p + m,) and for DAQP's infeasibility direction ``ray`` (ms + p + m,). Valid
     while its backend keeps the set-up and the problem it was made for
     (:meth:`solvers.daqp_.DaqpBackend.compiled_attempt`)."""
 
@@ -337,6 +381,7 @@ class AttemptCall:
     refute: float
     x: np.ndarray
     lam: np.ndarray
+    ray: np.ndarray
 
 
 @njit(separate=True, python=True)  # dvqp's step calls it, and its resolver from Python
@@ -390,6 +435,7 @@ def attempt(c):  # type: ignore[no-untyped-def]
         c.refute,
         c.x,
         c.lam,
+        c.ray,
     )
     if out[0] == SOLVED and accepts(out[4:], c.tolerance):
         return (ACCEPTED, *out[1:])
@@ -407,12 +453,14 @@ def certified(x: np.ndarray) -> tuple[float, ...]:
 
 @njit(inline="always")
 def proves(c) -> bool:  # type: ignore[no-untyped-def]
-    """Whether the multipliers in the packed :class:`AttemptCall` ``c``'s ``lam`` prove the
-    problem its ``data`` holds (as an attempt copied it) infeasible at its ``refute``
-    tolerance (:func:`solvers.farkas.refuted`; never if negative): what its next restart
-    finds before it solves."""
-    lower, upper = (c.flags & HAS_LB) != 0, (c.flags & HAS_UB) != 0
-    return c.refute >= 0.0 and refuted(c.data, c.lam, c.n, c.p, c.m, c.ms, lower, upper, c.refute)
+    """Whether the multipliers in the packed :class:`AttemptCall` ``c``'s ``lam``, or DAQP's
+    direction in its ``ray``, prove the problem its ``data`` holds (as an attempt copied
+    it) infeasible at its ``refute`` tolerance (:func:`solvers.farkas.refuted`; never if
+    negative): what its next restart finds before it solves."""
+    box = (c.flags & HAS_LB) != 0, (c.flags & HAS_UB) != 0
+    return c.refute >= 0.0 and _either_proves(
+        c.data, c.ray, c.lam, c.n, c.p, c.m, c.ms, box, c.refute
+    )
 
 
 @njit(separate=True)  # compiled callers only (dvqp's step loop)
@@ -427,8 +475,8 @@ def hold_multipliers(source, target) -> None:  # type: ignore[no-untyped-def]
     equality rows' as they are; the bounds' are left (the certificate does not read them).
     Nothing is held if the equality rows differ in number.
 
-    (A solve refused by DAQP leaves its own infeasibility direction in ``lam``; a refusal
-    certified without a solve leaves ``lam`` as it was.)"""
+    (A restart tries DAQP's direction of the last refusal it found, in ``ray``, after
+    these.)"""
     s, t = source.call, target.call
     if s.m != t.m:
         return

@@ -101,12 +101,22 @@ def sigint_deferred() -> Iterator[None]:
     LocalCluster whose start it cut short was never closed: its event loop's thread went on
     starting a worker as the bench exited, by Dask's default method once the configuration
     was restored (``spawn``), and that process printed an ``EOFError`` traceback into the
-    bench's stderr. Outside the main thread (which alone receives Ctrl-C) nothing is held."""
+    bench's stderr. A process forked meanwhile (a pool's, a cluster's worker) inherits the
+    handler: there Ctrl-C ends it at once, silently (exit 130), as :func:`~dvqp.run.
+    comparison.quiet_worker` has it. Outside the main thread (which alone receives Ctrl-C)
+    nothing is held."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     held: list[int] = []
-    previous = signal.signal(signal.SIGINT, lambda signum, frame: held.append(signum))
+    here = os.getpid()
+
+    def hold(signum: int, frame: object) -> None:
+        if os.getpid() != here:
+            os._exit(130)
+        held.append(signum)
+
+    previous = signal.signal(signal.SIGINT, hold)
     try:
         yield
     finally:

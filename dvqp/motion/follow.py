@@ -5,12 +5,12 @@ accepted (or the baseline's step), the state reached regular and within every ve
 its largest joint motion below :data:`~dvqp.step.JOINT_STRIDE` (no interior point to check).
 So is a step of a relaxed streak at fixed timing: the strict problem's cold attempt refused
 (the backend restarts cold after a refusal), the relaxed problem's warm attempt accepted. A
-cold attempt first tries the multipliers the strict backend's workspace holds as a proof that
-its strict problem admits no answer (:mod:`solvers.farkas`): proved, that refusal solves
-nothing. They are DAQP's own infeasibility direction where its last solve was refused, else
-those the loop held there (:func:`solvers.daqp_c.hold_multipliers`: the least violation's, the
-relaxed or the time-scaled answer's). Python's steps hold none; either way the refusals are
-the same.
+cold attempt first tries, as a proof that its strict problem admits no answer
+(:mod:`solvers.farkas`), the multipliers the loop held in the strict backend's workspace
+(:func:`solvers.daqp_c.hold_multipliers`: the least violation's, the relaxed or the
+time-scaled answer's), then DAQP's infeasibility direction of the last refusal it found:
+proved, that refusal solves nothing. Python's steps hold none; either way the refusals are the
+same.
 :func:`follow` runs such steps one after another in compiled code, each exactly as
 :func:`dvqp.step.advance` and :meth:`~dvqp.resolution.qp.QPSolver.solve` would (the same
 compiled calls, :func:`~dvqp.step.stages.resolve_move`, :func:`~dvqp.motion.schedule.
@@ -607,8 +607,8 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing, e, proving):  # type: igno
     certified without a call when the multipliers the workspace holds prove the refusal, as
     the restart would find them), then, still refused, slowed if paced, else relaxed, and
     moved. A proof that the strict problem admits no answer is kept for the strict restarts:
-    the multipliers held if they prove this step's refusal (DAQP's direction of a refusal it
-    found, or those held before), else the least-violation problem's (``e``, if ``proving``:
+    DAQP's direction of the last refusal it found or the multipliers held, if either proves
+    this step's refusal, else the least-violation problem's (``e``, if ``proving``:
     before the cold restart, which they may then spare, or after a refused one), else (none
     held, or it proved nothing) the relaxed or time-scaled answer's (:func:`solvers.daqp_c.
     hold_multipliers`), not with levels (Python's cascade, which counts the refusal's
@@ -662,11 +662,12 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing, e, proving):  # type: igno
 @njit(inline="always")
 def _confirmed(s, f, e, w, out, proving):  # type: ignore[no-untyped-def]
     """The strict problem's answer after its attempt ``out`` (:func:`_refused`'s): restarted
-    cold if that attempt was warm (certified without a call when the multipliers held prove
-    the refusal, as the restart would find them), and a proof kept for the next restarts.
-    Returns ``(answer, seconds, held)``: the answer's 12 values, the seconds inside DAQP
-    besides the answer's own (the warm attempt's, the least violation's) and whether the
-    multipliers held prove this step's refusal or were just held (then nothing else is)."""
+    cold if that attempt was warm (certified without a call when DAQP's direction or the
+    multipliers held prove the refusal, as the restart would find them), and a proof kept
+    for the next restarts. Returns ``(answer, seconds, held)``: the answer's 12 values, the
+    seconds inside DAQP besides the answer's own (the warm attempt's, the least violation's)
+    and whether what the workspace holds proves this step's refusal, or the least
+    violation's multipliers were just held (then the fallback's are not held over them)."""
     mode = w.call.mode
     answer, warm, tried, held = out[3:15], 0.0, False, False
     if mode[0] == WARM:  # the cold restart; its time counts the warm attempt's too
@@ -680,7 +681,7 @@ def _confirmed(s, f, e, w, out, proving):  # type: ignore[no-untyped-def]
             answer = attempt(w.call)
         warm += out[6]
     if proving and not tried and answer[0] != ACCEPTED and answer[1] != CERTIFIED:
-        if proves(w.call):  # DAQP's direction of the refusal it solved: a proof for the next
+        if proves(w.call):  # DAQP's direction of the refusal it solved, or those held
             held = True
         else:
             spent, held = _prove(s, f, e, w)

@@ -107,6 +107,7 @@ def attempt_rows(
         1e-6,
         np.zeros(n),
         np.array(lam, float),
+        np.zeros(len(lam)),
     )
     packed = as_struct(
         AttemptRows(

@@ -227,7 +227,9 @@ def check_arrays(path: Path) -> None:
             continue
         bad = ~np.isfinite(value)
         if key == "task_error":
-            bad &= ~failed  # a failed step has no task error to speak of
+            bad &= ~failed  # a failed step has no task error to speak of (+inf)
+        if key == "level_error":
+            bad &= ~failed[:, None]  # nor errors of its levels (+inf)
         if key.endswith("clearance") and not len(obstacles):
             bad &= ~np.isposinf(value)  # no obstacle: +inf
         assert not bad.any(), key

@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 from solvers import make_backend
 from solvers._fast import stack
 from solvers.farkas import refuted
+from solvers.problem import Problem
 from tests.oracles.farkas import gap
 from tests.solvers.test_daqp_fast import Drift
 
@@ -238,6 +239,43 @@ def test_a_refusal_daqp_finds_is_proved_by_its_own_direction(
     proved, solved = proving.solve(sides[0].problem), solving.solve(sides[1].problem)
     assert proved.status == "infeasible (certified)" and proved.iterations == 0
     assert solved.refusal == "infeasible" and solved.iterations > 0
-    lam, ms, p = proving._c.lam, proving._layout[3], proving._layout[1]
-    y, z = lam[ms + p :], lam[ms : ms + p]
+    ray, ms, p = proving._c.ray, proving._layout[3], proving._layout[1]
+    y, z = ray[ms + p :], ray[ms : ms + p]
     assert gap(sides[0].problem, y, z, TAU) > 1e-12
+
+
+def test_proofs_leave_every_answers_verdict_as_it_was() -> None:
+    """``x ≤ −δ/2`` and ``−x ≤ −δ/2``, infeasible by ``δ`` = 1e-7 < τ, after a feasible warm
+    solve: DAQP finds it infeasible, and its iterate meets the rows within τ. Whether that
+    answer passes the check depends on the multipliers it is judged with, which DAQP leaves
+    as they were (the last answer's): DAQP's direction, read for the restart, is kept apart
+    (a review found it judged with the direction, and accepted, where without proofs it was
+    refused). With or without proofs: the same verdict, the same answer and multipliers."""
+    pytest.importorskip("daqp")
+    seen = []
+    for refutes in (True, False):
+        backend = make_backend("daqp")
+        backend.refutes = refutes
+        backend.solve(Problem(np.eye(1), np.zeros(1), G=ROWS, h=np.array([-5.0, 10.0]))).require()
+        got = backend.solve(Problem(np.eye(1), np.zeros(1), G=ROWS, h=np.full(2, -0.5e-7)))
+        seen.append((got.found, got.status, got.retried, got.x.tolist(), got.z.tolist()))
+    assert seen[0] == seen[1]
+
+
+ROWS = np.array([[1.0], [-1.0]])
+
+
+def test_nothing_is_read_where_daqp_eliminated_the_equalities() -> None:
+    """With ``eq_reduction = 1`` DAQP solves a reduced problem and its workspace describes
+    that one: no direction is read (``ray`` stays zero) and the restart solves."""
+    pytest.importorskip("daqp")
+    backend = make_backend("daqp", eq_reduction=1)
+    ws = Drift(seed=8)
+    backend.solve(ws.problem).require()
+    if backend._c is None:
+        pytest.skip("the installed daqp's layout is not mirrored: no compiled restart")
+    ws.move(0.01)
+    made_infeasible(ws, "row past the box", 0.5, 8)
+    refused = backend.solve(ws.problem)
+    assert refused.refusal == "infeasible" and refused.iterations > 0
+    assert not backend._c.ray.any()

@@ -8,9 +8,11 @@ catches SIGINT itself during a solve and answers ``interrupted``.
 from __future__ import annotations
 
 import dataclasses
+import os
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import numpy as np
@@ -208,3 +210,22 @@ def test_outside_the_main_thread_nothing_is_held_back() -> None:
     thread.join()
     assert outcome == ["ran"]
     assert signal.getsignal(signal.SIGINT) is before
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="forks")
+def test_a_process_forked_while_ctrl_c_is_held_back_ends_on_it_at_once() -> None:
+    """A worker forked inside the block (a pool's, a LocalCluster's) inherits the handler:
+    Ctrl-C ends it at once with exit code 130, not held back for a raise that never comes."""
+    import signal
+
+    from dvqp.bench.execution import sigint_deferred
+
+    with pytest.raises(KeyboardInterrupt), sigint_deferred():
+        pid = os.fork()
+        if pid == 0:  # the child: Ctrl-C must end it; if it is held, it exits 0 after 5 s
+            signal.raise_signal(signal.SIGINT)
+            time.sleep(5)
+            os._exit(0)
+        _, status = os.waitpid(pid, 0)
+        signal.raise_signal(signal.SIGINT)  # the parent's own: held, then raised
+    assert os.waitstatus_to_exitcode(status) == 130
