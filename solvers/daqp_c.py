@@ -101,9 +101,10 @@ def _read_float(typingctx, address):  # type: ignore[no-untyped-def]
 
 
 @njit(inline="always")
-def _write_direction(work: int, n: int, lam: np.ndarray) -> None:
-    """DAQP's infeasibility direction written into ``lam`` (ms + p + m,), in its output's
-    order and signs, after a solve DAQP found infeasible (exit flag :data:`INFEASIBLE`).
+def _write_direction(work: int, n: int, ray: np.ndarray) -> None:
+    """DAQP's infeasibility direction written into ``ray`` (ms + p + m,), in the order and
+    signs of its multipliers, after a solve DAQP found infeasible (exit flag
+    :data:`INFEASIBLE`).
 
     DAQP finds a problem infeasible mostly when the dual direction it would step along
     (``lam_star`` over the working set ``WS``, the singular direction its last added
@@ -114,16 +115,16 @@ def _write_direction(work: int, n: int, lam: np.ndarray) -> None:
     DAQP does for an answer's multipliers (``ldp2qp_solution``). DAQP's other infeasible
     exits (an inconsistent dual, its objective bound) leave multipliers that are no ray, and
     a workspace whose equalities DAQP eliminated (``eq_reduction``: ``work->eq`` set)
-    describes the reduced problem: nothing is written then (``lam`` as DAQP left it). Nothing
-    here trusts the direction: a restart tests it on the data (:func:`solvers.farkas.
-    refuted`). ``lam`` is left zero if the working set does not fit it (DAQP holds at most
-    ``n + 1`` rows, each of ``lam``'s)."""
+    describes the reduced problem: ``ray`` is left as it was then. Nothing here trusts the
+    direction: a restart tests it on the data (:func:`solvers.farkas.refuted`). ``ray`` is
+    left zero if the working set does not fit it (DAQP holds at most ``n + 1`` rows, each of
+    ``ray``'s)."""
     if _read_word(work + _EQ_AT) != 0:
         return
-    rows = lam.shape[0]
+    rows = ray.shape[0]
     active = _read_int(work + _ACTIVE_AT)
     for i in range(rows):
-        lam[i] = 0.0
+        ray[i] = 0.0
     if active < 0 or active > rows or active > n + 1:
         return
     ws, star = _read_word(work + _WS_AT), _read_word(work + _LAM_STAR_AT)
@@ -132,12 +133,12 @@ def _write_direction(work: int, n: int, lam: np.ndarray) -> None:
         row = _read_int(ws + 4 * i)
         if row < 0 or row >= rows:
             for j in range(rows):
-                lam[j] = 0.0
+                ray[j] = 0.0
             return
         value = _read_float(star + 8 * i)
         if scaling != 0:
             value *= _read_float(scaling + 8 * row)
-        lam[row] = value
+        ray[row] = value
 
 
 @intrinsic
@@ -218,8 +219,8 @@ def stacked_solve(
     ``ray`` (ms + p + m,; DAQP itself writes no multipliers then: :func:`_write_direction`),
     and a cold restart first tries the multipliers ``lam`` holds (those
     :func:`hold_multipliers` put there, or the last answer's), then that direction, as a
-    certificate that the new
-    data admits no answer within that tolerance (:func:`solvers.farkas.refuted`): if either
+    certificate that the new data admits no answer within that tolerance
+    (:func:`solvers.farkas.refuted`): if either
     proves it, nothing is solved, ``x`` is NaN, ``ray`` and ``lam`` are kept (the next
     restart tries them again) and the flag is :data:`CERTIFIED`. ``lam`` itself is only
     ever DAQP's (or held there by a caller): an answer is judged with the same multipliers

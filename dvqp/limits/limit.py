@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from dvqp.kinematics.state import KinematicState
 from dvqp.workspace import Kernel, StepPlan
-from dvqp.workspace.wiring import StepWiring
+from dvqp.workspace.wiring import StepWiring, overrides
 
 
 @dataclass(frozen=True)
@@ -154,7 +154,7 @@ class Limit:
     def observes(self) -> bool:
         """Whether the limit keeps the velocity it is shown: its class has an :meth:`observe`
         of its own (the run then shows it every step's)."""
-        return type(self).observe is not Limit.observe
+        return overrides(self, Limit, "observe")
 
     def observed_into(self) -> NDArray[np.float64] | None:
         """Where a run's compiled loop may write the joint velocity (rad/s, (n,)) applied
