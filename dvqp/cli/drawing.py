@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.errors import ParameterError
+from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.developed_view import unwrap, wrap
 
 if TYPE_CHECKING:
@@ -42,6 +43,8 @@ class View(NamedTuple):
     weld: float | None
     limits: tuple[float, float, float, float]
     min_height: float | None = None
+    labels: tuple[str, ...] = ()
+    """What reports call each obstacle (its name, else ``obstacles[j]``)."""
 
     @property
     def aspect(self) -> float:
@@ -94,7 +97,8 @@ def make_view(
     lo, hi = (-edge, edge) if arc is None else arc
     limits = (lo, hi, float(zs.min()) - pad, float(zs.max()) + pad)
     floor = None if min_height is None else float(min_height)
-    return View(traj, radius, tuple(obstacles), h, weld, limits, floor)
+    labels = ObstacleSet.of(obstacles).labels
+    return View(traj, radius, tuple(obstacles), h, weld, limits, floor, labels)
 
 
 def arc_extent(
@@ -166,22 +170,45 @@ def draw_developed_view(ax: Axes, view: View) -> None:
 
 def _draw_obstacles(ax: Axes, view: View) -> None:
     """Every obstacle's outline, wrapped, with its copies one period left and right; a band
-    as a strip across the whole view."""
+    as a strip across the whole view. Each is labelled as reports name it, with its height
+    if it has one (one without stands to the sky); an obstacle with a height is hatched."""
     from matplotlib.patches import Polygon as Patch
 
     period = 2.0 * np.pi * view.radius
     style = {"fc": "tab:red", "ec": "darkred", "alpha": 0.3}
+    shown: set[bool] = set()
     for j, o in enumerate(view.obstacles):
-        ring = o.outline()
+        ring, bounded = o.outline(), o.bounded
+        kind = "obstacle with a height" if bounded else "obstacle (unbounded)"
+        label = None if bounded in shown else kind
+        shown.add(bounded)
+        look = {**style, "hatch": "//" if bounded else None}
         if np.isnan(ring[:, 0]).all():  # a band: every l
-            ax.axhspan(ring[0, 1], ring[1, 1], **style, label="obstacle" if j == 0 else None)
-            continue
-        ref = float(np.mean(ring[:, 0]))
-        shift = float(wrap_arc(ref, view.radius)) - ref
-        for s in SHIFTS:
-            label = "obstacle" if j == 0 and s == 0 else None
-            moved = ring + np.array([shift + s * period, 0.0])
-            ax.add_patch(Patch(moved, closed=True, **style, label=label))
+            ax.axhspan(ring[0, 1], ring[1, 1], **look, label=label)
+            at = (view.limits[0] + 0.02 * (view.limits[1] - view.limits[0]), ring[:, 1].mean())
+        else:
+            ref = float(np.mean(ring[:, 0]))
+            shift = float(wrap_arc(ref, view.radius)) - ref
+            for s in SHIFTS:
+                moved = ring + np.array([shift + s * period, 0.0])
+                ax.add_patch(Patch(moved, closed=True, **look, label=label if s == 0 else None))
+            at = (ref + shift, float(np.mean(ring[:, 1])))
+        ax.annotate(
+            obstacle_caption(view.labels[j] if view.labels else f"obstacles[{j}]", o),
+            at,
+            ha="left" if np.isnan(ring[:, 0]).all() else "center",
+            va="center",
+            fontsize="x-small",
+            color="darkred",
+            zorder=4,
+            annotation_clip=True,
+        )
+
+
+def obstacle_caption(label: str, shape: Shape) -> str:
+    """An obstacle's caption in pictures: what reports call it, and its height if it has one
+    (``"support, 25 mm high"``)."""
+    return f"{label}, {shape.height * 1e3:.3g} mm high" if shape.bounded else label
 
 
 def _draw_tool_path(ax: Axes, view: View) -> None:
@@ -227,14 +254,23 @@ def draw_section(ax: Axes, view: View, instants: Sequence[tuple[int, Any]]) -> N
     if h_star is not None:
         orbit = (radius + h_star) * circle
         ax.plot(*orbit, color="0.3", ls="--", lw=1.0, label="orbital level R + h*")
-    for j, o in enumerate(view.obstacles):
+    shown: set[bool] = set()
+    for o in view.obstacles:
         ring = o.outline()
         if np.isnan(ring[:, 0]).all():  # a band covers the whole circumference
             lo, hi = -np.pi * radius, np.pi * radius
         else:
             lo, hi = float(ring[:, 0].min()), float(ring[:, 0].max())
         arc = np.linspace(lo, hi, 90) / radius
-        label = "obstacle (l extent)" if j == 0 else None
+        label = None if o.bounded in shown else "obstacle (l extent)"
+        shown.add(o.bounded)
+        if o.bounded:  # drawn at its height: the sector from the surface up to it
+            label = label and "obstacle (l extent, to its height)"
+            outer = radius + o.height
+            x = np.concatenate([radius * np.cos(arc), outer * np.cos(arc[::-1])])
+            y = np.concatenate([radius * np.sin(arc), outer * np.sin(arc[::-1])])
+            ax.fill(x, y, fc="tab:red", ec="darkred", alpha=0.35, hatch="//", label=label)
+            continue
         xy = radius * np.cos(arc), radius * np.sin(arc)
         ax.plot(*xy, color="tab:red", lw=5, alpha=0.5, solid_capstyle="butt", label=label)
     for i, color in instants:  # the body at sample i (from the rail point), tool ▲ at its end

@@ -6,6 +6,12 @@ them by those addresses (:func:`solvers.linking.indirect`), so that a run compil
 measures and no other; :func:`user_rows` writes the rows of shapes of your own (their NumPy
 methods), and :func:`penalties` every row's objective penalty ``e = d (d + 2ρ)`` and
 ``∇e = 2 (d + ρ) ∇d``.
+
+The kernels measure an obstacle's footprint; a point's row to an obstacle with a height is
+the solid's (:func:`~dvqp.geometry.solid.solid`, its normal with respect to ``[l, z, h]``),
+while a link's row stays its straight DV segment's footprint distance, from which
+:mod:`dvqp.geometry.real_links` and :func:`~dvqp.geometry.link_pieces.straight_solids` derive
+the links' clearances to the solid.
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ from numpy.typing import NDArray
 from dvqp.geometry.broad_phase import box_bound, chain_box, obstacle_bound
 from dvqp.geometry.shapes import Shape
 from dvqp.geometry.shapes.shape import UNKNOWN, ShapeKernels
+from dvqp.geometry.solid import solid
 from dvqp.workspace import ProximityBuffers, struct_type
 from solvers.jit import njit
 from solvers.linking import address_of, indirect
@@ -47,6 +54,8 @@ class ShapeArrays:
         (:attr:`~dvqp.geometry.shapes.Inlet.samples`, from its centre).
     size : (J,)
         ``ρ`` of each obstacle's penalty, m.
+    height : (J,)
+        Each obstacle's height above the pipe surface, m (``inf``: unbounded).
     refine : (J,)
         Below what clearance (m) a link's to each obstacle is measured on its real DV image to
         the last :data:`~dvqp.geometry.bend.PRECISION` (its obstacle damper's margin,
@@ -76,6 +85,7 @@ class ShapeArrays:
     vl: Array
     vz: Array
     size: Array
+    height: Array
     refine: Array
     box: Array
     far: Array
@@ -114,6 +124,7 @@ class ShapeArrays:
             np.ascontiguousarray(samples[:, 0]),
             np.ascontiguousarray(samples[:, 1]),
             np.array([s.size for s in shapes], float),
+            np.array([s.height for s in shapes], float),
             np.full(count, math.inf),
             box,
             np.full(count, math.inf),
@@ -125,6 +136,11 @@ class ShapeArrays:
         )
         arrays._link([None if packed is None else packed.kernels for packed in compiled])
         return arrays
+
+    @property
+    def bounded(self) -> NDArray[np.bool_]:
+        """(J,) bool: the obstacles with a height."""
+        return np.isfinite(self.height)  # type: ignore[no-any-return]
 
     @property
     def compiled(self) -> NDArray[np.bool_]:
@@ -194,15 +210,32 @@ def point_row(shapes, j, chain, i, near, exact) -> None:  # type: ignore[no-unty
         d, nl, nz = box_bound(shapes, j, pl, pz, pl, pz)
     if d <= shapes.far[j]:
         d, nl, nz = shape_point(shapes, j, pl, pz)
+    height = shapes.height[j]
+    if height < math.inf:  # the solid's row (a footprint's bound lifts to the solid's)
+        d, w2, wh = solid(d, chain[i, 2] - height)
+        nl, nz = w2 * nl, w2 * nz
+        near.point_normal[j, i, 2] = wh
     near.point_distance[j, i] = d
     near.point_normal[j, i, 0], near.point_normal[j, i, 1] = nl, nz
+
+
+@njit(separate=True, python=True)  # also for shapes of your own (user_rows)
+def lift_points(height, h, distance, normal) -> None:  # type: ignore[no-untyped-def]
+    """Points' footprint rows to an obstacle of ``height`` (m) made the solid's, in place:
+    ``distance`` (m,) and ``normal`` (m, 3) (its [l, z] part the footprint's) of the points
+    at heights ``h`` (m,)."""
+    for i in range(distance.shape[0]):
+        d, w2, wh = solid(distance[i], h[i] - height)
+        distance[i] = d
+        normal[i, 0], normal[i, 1], normal[i, 2] = w2 * normal[i, 0], w2 * normal[i, 1], wh
 
 
 @njit(inline="always")
 def _end(shapes, near, j, i):  # type: ignore[no-untyped-def]
     """Point i's row to obstacle j as a segment's end: ``(d, n_l, n_z)`` where it is exact
-    (not beyond ``shapes.far[j]``: :func:`point_row`), else unknown."""
-    if not near.point_distance[j, i] <= shapes.far[j]:
+    (not beyond ``shapes.far[j]``: :func:`point_row`) and the footprint's (no height), else
+    unknown."""
+    if not near.point_distance[j, i] <= shapes.far[j] or shapes.height[j] < math.inf:
         return UNKNOWN
     return near.point_distance[j, i], near.point_normal[j, i, 0], near.point_normal[j, i, 1]
 
@@ -233,7 +266,8 @@ def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
     skipped (``near.skipped``), its rows left alone, ``near.bound`` the boxes' distance
     (:func:`obstacle_bound`); a row farther than it from a ``boxed`` obstacle's box holds the
     box's distance (:func:`~.real_links.real_links` measures those that matter). A kind with
-    a ``rows`` kernel writes all of an obstacle's rows at once."""
+    a ``rows`` kernel writes all of an obstacle's rows at once (its point rows then made the
+    solid's, :func:`lift_points`)."""
     l0, lo, hi, zlo, zhi = chain_box(chain, near.ends, shapes.period)
     for j in range(shapes.point_at.shape[0]):
         near.skipped[j] = False
@@ -244,6 +278,10 @@ def measure_chain(shapes, chain, near) -> None:  # type: ignore[no-untyped-def]
             near.skipped[j], near.bound[j] = True, bound
         elif shapes.rows_at[j] != 0:
             _rows_at(shapes.rows_at[j], shapes, j, chain, near)
+            if shapes.height[j] < math.inf:
+                lift_points(
+                    shapes.height[j], chain[:, 2], near.point_distance[j], near.point_normal[j]
+                )
         else:
             for i in range(chain.shape[0]):
                 point_row(shapes, j, chain, i, near, False)
@@ -259,29 +297,41 @@ def fill(near, j) -> None:  # type: ignore[no-untyped-def]
     for i in range(near.point_distance.shape[1]):
         near.point_distance[j, i] = bound
         near.point_normal[j, i, 0], near.point_normal[j, i, 1] = 0.0, 0.0
+        near.point_normal[j, i, 2] = 0.0
     for i in range(near.link_distance.shape[1]):
         near.link_distance[j, i], near.link_t[j, i] = bound, 0.0
         near.link_normal[j, i, 0], near.link_normal[j, i, 1] = 0.0, 0.0
 
 
 @njit(separate=True)
-def penalties(size, near) -> None:  # type: ignore[no-untyped-def]
-    """Every row's penalty ``e = d (d + 2ρ)`` (m²) and ``∇e = 2 (d + ρ) ∇d`` (m), but those of
-    an obstacle the broad phase skipped (its repulsion, acting only inside, is 0)."""
-    for j in range(size.shape[0]):
+def penalties(shapes, near) -> None:  # type: ignore[no-untyped-def]
+    """Every row's penalty ``e = d (d + 2ρ)`` (m²) and ``∇e = 2 (d + ρ) ∇d`` (m, with respect
+    to ``[l, z, h]``), but those of an obstacle the broad phase skipped (its repulsion, acting
+    only inside, is 0). A link's is its straight DV segment's: the footprint's row, or for an
+    obstacle with a height the solid's (``near.straight_*``); ``link_penalty_at`` the segment
+    parameters its [l, z] part and its h part hold at."""
+    for j in range(shapes.size.shape[0]):
         if near.skipped[j]:
             continue
-        rho = size[j]
+        rho, bounded = shapes.size[j], shapes.height[j] < math.inf
         for i in range(near.point_distance.shape[1]):
             d = near.point_distance[j, i]
             near.point_penalty[j, i] = d * (d + 2.0 * rho)
-            for c in range(2):
+            for c in range(3):
                 near.point_penalty_gradient[j, i, c] = 2.0 * (d + rho) * near.point_normal[j, i, c]
         for i in range(near.link_distance.shape[1]):
-            d = near.link_distance[j, i]
+            if bounded:
+                d, n = near.straight_distance[j, i], near.straight_normal[j, i]
+                at, at_h = near.straight_at[j, i, 0], near.straight_at[j, i, 1]
+                nl, nz, nh = n[0], n[1], n[2]
+            else:
+                d, at = near.link_distance[j, i], near.link_t[j, i]
+                nl, nz, nh, at_h = near.link_normal[j, i, 0], near.link_normal[j, i, 1], 0.0, at
             near.link_penalty[j, i] = d * (d + 2.0 * rho)
-            for c in range(2):
-                near.link_penalty_gradient[j, i, c] = 2.0 * (d + rho) * near.link_normal[j, i, c]
+            scale = 2.0 * (d + rho)
+            gradient = near.link_penalty_gradient[j, i]
+            gradient[0], gradient[1], gradient[2] = scale * nl, scale * nz, scale * nh
+            near.link_penalty_at[j, i, 0], near.link_penalty_at[j, i, 1] = at, at_h
 
 
 def user_rows(
@@ -293,11 +343,14 @@ def user_rows(
 ) -> None:
     """Rows of the shapes of your own (not ``compiled``): their NumPy ``point_distance`` of
     the points ``chain`` (m) and ``segment_distance`` of the links ``near.ends``, into
-    ``near``."""
+    ``near`` (a point's made the solid's where the shape has a height)."""
     lz, ends = np.ascontiguousarray(chain[:, :2]), near.ends
     for j in np.flatnonzero(~compiled):
         shape = shapes[j]
-        near.point_distance[j], near.point_normal[j] = shape.point_distance(lz, period)
+        near.point_distance[j], near.point_normal[j, :, :2] = shape.point_distance(lz, period)
+        if shape.bounded:
+            heights = np.ascontiguousarray(chain[:, 2])
+            lift_points(shape.height, heights, near.point_distance[j], near.point_normal[j])
         if ends.shape[0]:
             d, t, n = shape.segment_distance(lz[ends[:, 0]], lz[ends[:, 1]], period)
             near.link_distance[j], near.link_t[j], near.link_normal[j] = d, t, n

@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 import pinocchio as pin
@@ -48,6 +49,13 @@ class Robot:
     rail_frame
         Name of the frame at the rail point, where the carriage rides its rail: the carriage
         link from it to the first body point is then guarded too. None: no such link.
+    base_frame
+        Name of the frame of the arm's base (a URDF's root link). Where the arm has no rail
+        and its base stands off the pipe axis (an arm standing on the pipe, placed by
+        :meth:`placed`), the base is guarded as the arm's lead point, with the base link from
+        it to the first body point: every part from the base on is kept out of the pipe and
+        the obstacles (:attr:`base_frame` is then that name, else None; a base that is itself
+        a listed body point is guarded as one).
     q_min, q_max
         Joint position limits, rad, scalar or shape (n,); ``±inf`` for none.
         Default: the model's own limits.
@@ -57,7 +65,8 @@ class Robot:
         A label for reports.
     names
         The guarded parts' names in labels and reports (default: dvqp's numbering,
-        ``point1``, ``probe``, ``link1``, ``holder``, …; :meth:`from_urdf`: the frames').
+        ``point1``, ``probe``, ``link1``, ``holder``, …; ``"frames"``, as :meth:`from_urdf`
+        names them: the frames' own, :meth:`~dvqp.workspace.PartNames.of_frames`).
     """
 
     def __init__(
@@ -67,11 +76,12 @@ class Robot:
         tool_frame: str,
         *,
         rail_frame: str | None = None,
+        base_frame: str | None = None,
         q_min: ArrayLike | None = None,
         q_max: ArrayLike | None = None,
         qd_max: ArrayLike = DEFAULT_QD_MAX,
         name: str = "robot",
-        names: PartNames | None = None,
+        names: PartNames | Literal["frames"] | None = None,
     ) -> None:
         if model.nq != model.nv:
             raise ParameterError("model", "only joints with nq == nv (revolute, prismatic)")
@@ -80,10 +90,25 @@ class Robot:
             raise ParameterError("points", "need at least two body-point frames")
         self.point_frames, self.tool_frame = tuple(point_frames), tool_frame
         self.rail_frame = rail_frame
-        rail = rail_frame is not None
-        self.part_names = PartNames.numbered(len(point_frames), rail) if names is None else names
+        self.root_frame = base_frame
+        """The base frame's name as given (guarded or not: :attr:`base_frame`)."""
+        standing = rail_frame is None and base_frame not in (*point_frames, tool_frame)
+        self.base_frame = _standing_base(model, base_frame) if standing else None
+        """The guarded base frame's name, or None (see the parameter)."""
+        lead = rail_frame if rail_frame is not None else self.base_frame
+        self.named_by_frames = names == "frames"
+        if names is None:
+            names = PartNames.numbered(len(point_frames), lead is not None)
+        elif names == "frames":
+            base = self.base_frame is not None
+            names = PartNames.of_frames(point_frames, tool_frame, lead, base)
+        self.part_names: PartNames = names
         """The guarded parts' names in labels and reports (:class:`~dvqp.workspace.PartNames`)."""
-        if (self.part_names.k, self.part_names.rail) != (len(point_frames), rail):
+        if (names.k, names.rail, names.base) != (
+            len(point_frames),
+            lead is not None,
+            self.base_frame is not None,
+        ):
             raise ParameterError("names", "not the names of this arm's body points and rail")
         for fname in self.frame_names:
             if not model.existFrame(fname):
@@ -110,10 +135,16 @@ class Robot:
         return dataclasses.replace(a, work=np.zeros_like(a.work), world=np.zeros_like(a.world))
 
     @property
+    def lead_frame(self) -> str | None:
+        """The guarded frame before the first body point: the rail point's, the base's, or
+        None."""
+        return self.rail_frame if self.rail_frame is not None else self.base_frame
+
+    @property
     def frame_names(self) -> tuple[str, ...]:
-        """Names of the guarded frames: the body points, the tool, the rail point (if any)."""
-        rail = () if self.rail_frame is None else (self.rail_frame,)
-        return (*self.point_frames, self.tool_frame, *rail)
+        """Names of the guarded frames: the body points, the tool, the lead point (if any)."""
+        lead = () if self.lead_frame is None else (self.lead_frame,)
+        return (*self.point_frames, self.tool_frame, *lead)
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -153,17 +184,19 @@ class Robot:
             self.point_frames,
             self.tool_frame,
             rail_frame=self.rail_frame,
+            base_frame=self.root_frame,
             q_min=self.q_min,
             q_max=self.q_max,
             qd_max=self.qd_max,
             name=self.name,
-            names=self.part_names,
+            names="frames" if self.named_by_frames else self.part_names,
         )
 
     @property
     def has_rail(self) -> bool:
-        """Whether the carriage link (rail point to body point 1) is guarded."""
-        return self.rail_frame is not None
+        """Whether the arm has a lead point, guarded with the lead link from it to body point
+        1: the rail point and the carriage link, or the base and the base link."""
+        return self.lead_frame is not None
 
     @property
     def n(self) -> int:
@@ -313,9 +346,11 @@ class Robot:
         reports (:meth:`~dvqp.workspace.PartNames.of_frames`).
 
         The URDF's base frame is the pipe's frame (its z axis the pipe axis) unless ``base``
-        places it (:meth:`placed`). ``continuous`` joints become revolute joints without
-        position limits (``±inf``); ``revolute`` and ``prismatic`` joints keep their limits. A
-        joint with a ``<mimic>`` follows its master, ``multiplier · q + offset``, with no
+        places it (:meth:`placed`); an arm without a rail placed off the pipe axis stands on
+        the pipe, and its base (the root link) is guarded from there on (``base_frame``).
+        ``continuous`` joints become revolute joints without position limits (``±inf``);
+        ``revolute`` and ``prismatic`` joints keep their limits. A joint with a ``<mimic>``
+        follows its master, ``multiplier · q + offset``, with no
         coordinate of its own (Pinocchio's mimic joints): its master's limits are narrowed to
         keep it within its own. Velocity limits default to the URDF's, or
         :data:`DEFAULT_QD_MAX` where it gives none. The file is checked before Pinocchio's
@@ -346,10 +381,29 @@ class Robot:
             points,
             tool,
             rail_frame=rail,
+            base_frame=root_frame(model),
             q_min=q_min,
             q_max=q_max,
             qd_max=qd_max,
             name=model.name,
-            names=PartNames.of_frames(points, tool, rail),
+            names="frames",
         )
         return robot if base is None else robot.placed(base)
+
+
+def root_frame(model: pin.Model) -> str | None:
+    """The name of the model's root link frame (a URDF's base link: the first body frame on
+    the world), or None."""
+    for frame in model.frames:
+        if frame.parentJoint == 0 and frame.type == pin.FrameType.BODY:
+            return str(frame.name)
+    return None
+
+
+def _standing_base(model: pin.Model, frame: str | None) -> str | None:
+    """``frame`` if the arm's base stands off the pipe axis (its origin farther than 1 µm from
+    it: an arm on the pipe, not one whose base is the pipe's own frame), else None."""
+    if frame is None or not model.existFrame(frame):
+        return None
+    x, y = model.frames[model.getFrameId(frame)].placement.translation[:2]
+    return frame if float(np.hypot(x, y)) > 1e-6 else None

@@ -6,6 +6,7 @@ and the exact verification of its distances.
 """
 
 from dvqp.limits.acceleration import DEFAULT_QDD_MAX, AccelerationLimit
+from dvqp.limits.base_height import BaseHeight
 from dvqp.limits.damper import DEFAULT_DECELERATION, Distances, VelocityDamper, damper_value
 from dvqp.limits.excess import NO_EXCESS, Excess, StartBroken, start_broken_lines
 from dvqp.limits.height import ProbeHeight, SurfaceHeight, lowest_link
@@ -20,6 +21,7 @@ __all__ = [
     "DEFAULT_QDD_MAX",
     "NO_EXCESS",
     "AccelerationLimit",
+    "BaseHeight",
     "Bounds",
     "Constraint",
     "Distances",

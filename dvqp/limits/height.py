@@ -28,8 +28,8 @@ from solvers.jit import njit
 
 
 class SurfaceHeight(VelocityDamper):
-    """``h ≥ h_min`` for every body point and the lowest point of every body link (and of the
-    carriage link), one damper row each (``"point3/height"``, ``"link2/height"``,
+    """``h ≥ h_min`` for every body point and the lowest point of every body link (and of a
+    rail arm's carriage link), one damper row each (``"point3/height"``, ``"link2/height"``,
     ``"carriage/height"``).
 
     Parameters
@@ -58,7 +58,7 @@ class SurfaceHeight(VelocityDamper):
         deceleration: float = DEFAULT_DECELERATION,
     ) -> None:
         super().__init__(gain, deceleration)
-        self.min_height = _finite("min_height", min_height)
+        self.min_height = finite("min_height", min_height)
 
     @property
     def safe(self) -> float:
@@ -69,7 +69,7 @@ class SurfaceHeight(VelocityDamper):
         """``"point1/height"``, ... one per body point, then per body link (and the carriage
         link if the arm has a rail), by their ``names``."""
         k = names.k
-        links = (*names.links[: k - 1], *names.links[k:])  # the holder has its own limit
+        links = [names.links[i] for i in body_chords(k, names)]
         return (*(f"{p}/height" for p in names.points[:k]), *(f"{a}/height" for a in links))
 
     def series(self, count: int, k: int, rail: bool) -> list[tuple[str, str, slice | list[int]]]:
@@ -78,8 +78,7 @@ class SurfaceHeight(VelocityDamper):
 
     def distances(self, state: KinematicState) -> Distances:
         """The rows its kernels write at ``state``: the body points', then the chords'."""
-        k, rail = state.k, state.rail
-        return _height_rows(self, state, 0, k, [*range(k - 1), *([k] if rail else [])])
+        return height_rows(self, state, 0, state.k, body_chords(state.k, state.part_names))
 
     def join(self, step: StepWiring) -> None:
         """Rows of the k body points, then of the chords of the body links (and the carriage
@@ -87,7 +86,7 @@ class SurfaceHeight(VelocityDamper):
         if overrides(self, SurfaceHeight, "distances", "kernel"):
             return super().join(step)
         k = step.plan.k
-        _join_heights(self, step, 0, k, [*range(k - 1), *([k] if step.plan.rail else [])])
+        join_heights(self, step, 0, k, body_chords(k, step.plan.names))
         return None
 
 
@@ -120,7 +119,7 @@ class ProbeHeight(VelocityDamper):
         self, floor: float = 0.0, gain: float = 0.5, deceleration: float = DEFAULT_DECELERATION
     ) -> None:
         super().__init__(gain, deceleration)
-        self.floor = _finite("floor", floor)
+        self.floor = finite("floor", floor)
 
     @property
     def safe(self) -> float:
@@ -137,22 +136,28 @@ class ProbeHeight(VelocityDamper):
 
     def distances(self, state: KinematicState) -> Distances:
         """The rows its kernels write at ``state``: the probe's, then its holder's chord."""
-        return _height_rows(self, state, state.k, 1, [state.k - 1])
+        return height_rows(self, state, state.k, 1, [state.k - 1])
 
     def join(self, step: StepWiring) -> None:
         """Rows of the probe (guarded point k) and of its holder's chord (link k − 1)."""
         if overrides(self, ProbeHeight, "distances", "kernel"):
             return super().join(step)
         k = step.plan.k
-        _join_heights(self, step, k, 1, [k - 1])
+        join_heights(self, step, k, 1, [k - 1])
         return None
 
 
-def _height_rows(
+def body_chords(k: int, names: PartNames) -> list[int]:
+    """The guarded links whose chords keep ``min_height``: the body links and a rail arm's
+    carriage link (a base link keeps the surface: :class:`~dvqp.limits.BaseHeight`)."""
+    return [*range(k - 1), *([k] if names.rail and not names.base else [])]
+
+
+def height_rows(
     limit: VelocityDamper, state: KinematicState, first: int, points: int, chords: list[int]
 ) -> Distances:
     """What :func:`height_distances` and :func:`chord_heights` write for ``limit`` at
-    ``state`` (the rows :func:`_join_heights` reserves)."""
+    ``state`` (the rows :func:`join_heights` reserves)."""
     k, rail = state.k, state.rail
     distance, gradient, usable = fresh_rows(points + len(chords), state.n)
     guarded, jacobians = state.guarded, state.guarded_jacobians
@@ -173,7 +178,7 @@ def _height_rows(
     return Distances(distance, gradient, limit.safe, lambda: labels, usable)
 
 
-def _join_heights(
+def join_heights(
     limit: VelocityDamper, step: StepWiring, first: int, points: int, chords: list[int]
 ) -> None:
     """Damper rows of guarded points ``first .. first + points − 1``, then of the lowest point
@@ -183,7 +188,8 @@ def _join_heights(
     step.measures["chords"].extend((start + points + c, link) for c, link in enumerate(chords))
 
 
-def _finite(name: str, value: float) -> float:
+def finite(name: str, value: float) -> float:
+    """``value`` as a float, or ParameterError(name) unless it is finite."""
     if not np.isfinite(value):
         raise ParameterError(name, "must be finite")
     return float(value)

@@ -1,7 +1,8 @@
 """Velocity dampers that keep every guarded part out of the obstacles.
 
 For a pair (guarded point or link, obstacle j) with signed clearance ``d`` (m; a circle:
-``‖S_j − p‖ − R_j``) below the influence distance ``d_i``, one damper row (see
+``‖S_j − p‖ − R_j``; to an obstacle with a height, the distance to its solid,
+:mod:`dvqp.geometry.solid`) below the influence distance ``d_i``, one damper row (see
 :mod:`dvqp.limits.damper`) keeps ``d ≥ d_safe``. A link row applies only where its closest
 point is interior; at an end the point's own row holds.
 """
@@ -173,10 +174,12 @@ def obstacle_distances(
     obstacles ``members`` (rows of ``near``, a packed ProximityBuffers), obstacle-major, from
     row ``start``: ``d``, ``∂d/∂Q = n · ∂p/∂Q`` and whether the normal is defined. A link's
     is its real clearance (:func:`~dvqp.geometry.real_links.real_links`, its gradient an
-    envelope), defined where its closest point is inside it. ``jacobians`` (m, 3, n) are the
-    guarded points' DV Jacobians, ``origins`` (m, 3) and ``frame_jacobians`` (m, 6, n) their
-    3-D ones, ``radius`` the pipe's (m); a link row's gradient is written only below its
-    ``reach`` (m, per row), where the row applies (a point row's too)."""
+    envelope), defined where its closest point is inside it (to an obstacle with a height:
+    its footprint's closest point or its lowest point, for the part of the normal that is not
+    0). ``jacobians`` (m, 3, n) are the guarded points' DV Jacobians, ``origins`` (m, 3)
+    and ``frame_jacobians`` (m, 6, n) their 3-D ones, ``radius`` the pipe's (m); a link row's
+    gradient is written only below its ``reach`` (m, per row), where the row applies (a point
+    row's too)."""
     r, points, n, ends = start, near.point_distance.shape[1], gradient.shape[1], near.ends
     for j in members:
         if near.skipped[j]:  # far from the whole arm: its bound, no row applies
@@ -185,11 +188,15 @@ def obstacle_distances(
             r += points
             continue
         for i in range(points):
-            nl, nz = near.point_normal[j, i, 0], near.point_normal[j, i, 1]
-            distance[r], usable[r] = near.point_distance[j, i], nl != 0.0 or nz != 0.0
+            normal = near.point_normal[j, i]
+            nl, nz, nh = normal[0], normal[1], normal[2]
+            distance[r], usable[r] = near.point_distance[j, i], nl != 0.0 or nz != 0.0 or nh != 0.0
             if usable[r] and distance[r] < reach[r]:
                 for c in range(n):
                     gradient[r, c] = nl * jacobians[i, 0, c] + nz * jacobians[i, 1, c]
+                if nh != 0.0:
+                    for c in range(n):
+                        gradient[r, c] += nh * jacobians[i, 2, c]
             r += 1
     for j in members:
         if near.skipped[j]:  # the bound less each link's bend
@@ -199,8 +206,11 @@ def obstacle_distances(
             continue
         for i in range(ends.shape[0]):
             nl, nz, t = near.real_normal[j, i, 0], near.real_normal[j, i, 1], near.real_at[j, i]
+            nh, low = near.real_normal[j, i, 2], near.real_low[j, i]
             distance[r] = near.real_distance[j, i]
-            usable[r] = (nl != 0.0 or nz != 0.0) and 0.0 < t < 1.0
+            usable[r] = ((nl != 0.0 or nz != 0.0) and 0.0 < t < 1.0) or (
+                nh != 0.0 and 0.0 < low < 1.0
+            )
             if usable[r] and distance[r] < reach[r]:
                 real_link_gradient(near, origins, frame_jacobians, radius, j, i, gradient[r])
             r += 1

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dvqp.errors import ParameterError
 from dvqp.limits.acceleration import AccelerationLimit
+from dvqp.limits.base_height import BaseHeight
 from dvqp.limits.height import ProbeHeight, SurfaceHeight
 from dvqp.limits.joints import JointPositionLimit, JointVelocityLimit
 from dvqp.limits.limit import SHARED_KEYS, Limit
@@ -26,6 +27,7 @@ SCENE_LIMITS: list[type[Limit]] = [
     ObstacleDamper,
     SurfaceHeight,
     ProbeHeight,
+    BaseHeight,
     TiltLimit,
     SelfCollision,
 ]

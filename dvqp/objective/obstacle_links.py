@@ -48,10 +48,10 @@ class ObstacleLinks(ObjectiveTerm):
             near.link_penalty,
             near.link_penalty_gradient,
             near.skipped,
-            near.link_t,
+            near.link_penalty_at,
             (self.obstacles.weights[:, None] * gains[None, :])[:, :-1],
             state.guarded_jacobians,
-            np.zeros((state.k, 2)),
+            np.zeros((state.k, 3)),
             value,
             gradient,
         )
@@ -72,7 +72,7 @@ def obstacle_links(
     penalty: Array,
     penalty_gradient: Array,
     skipped: Array,
-    link_t: Array,
+    at: Array,
     coef: Array,
     jacobians: Array,
     at_points: Array,
@@ -81,24 +81,28 @@ def obstacle_links(
 ) -> None:
     """Add ``Σ_j Σ_i ½ c_ji e_ji`` over the body links whose closest point is interior
     (``0 < t < 1``) and inside obstacle j to ``value``, the gradient shared by the link's ends
-    as ``(1 − t, t)`` (the ∂t term vanishes). ``penalty``, ``link_t`` (J, k) and
-    ``penalty_gradient`` (J, k, 2) are the guarded links'; ``coef`` (J, k − 1) is
-    ``w_j k¹_i``; an obstacle ``skipped`` (J,) by the broad phase is outside; ``at_points``
-    (k, 2) is scratch."""
+    as ``(1 − t, t)`` (the ∂t term vanishes). ``penalty`` (J, k) and ``penalty_gradient``
+    (J, k, 3) are the guarded links', ``at`` (J, k, 2) the link parameters their [l, z] part
+    and their h part hold at (the same but for an obstacle with a height; a link is interior
+    if either is); ``coef`` (J, k − 1) is ``w_j k¹_i``; an obstacle ``skipped`` (J,) by the
+    broad phase is outside; ``at_points`` (k, 3) is scratch."""
     at_points[:, :] = 0.0
     total = 0.0
     for j in range(coef.shape[0]):
         if skipped[j]:
             continue
         for i in range(coef.shape[1]):
-            e, t, c = penalty[j, i], link_t[j, i], coef[j, i]
-            if e < 0.0 and t > 0.0 and t < 1.0 and c != 0.0:
+            e, t, th, c = penalty[j, i], at[j, i, 0], at[j, i, 1], coef[j, i]
+            if e < 0.0 and ((t > 0.0 and t < 1.0) or (th > 0.0 and th < 1.0)) and c != 0.0:
                 total += c * e
                 al = c * (-0.5 * penalty_gradient[j, i, 0])
                 az = c * (-0.5 * penalty_gradient[j, i, 1])
+                ah = c * (-0.5 * penalty_gradient[j, i, 2])
                 at_points[i, 0] += al * (1.0 - t)
                 at_points[i, 1] += az * (1.0 - t)
                 at_points[i + 1, 0] += al * t
                 at_points[i + 1, 1] += az * t
+                at_points[i, 2] += ah * (1.0 - th)
+                at_points[i + 1, 2] += ah * th
     value[0] += 0.5 * total
     pull_points(at_points, jacobians, gradient)

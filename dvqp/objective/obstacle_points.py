@@ -18,7 +18,9 @@ class ObstaclePoints(ObjectiveTerm):
     (compiled: :func:`obstacle_points`).
 
     ``e`` is the shape's penalty (:mod:`dvqp.geometry.shapes.shape`): ``‖S_j − p_i‖² − R_j²``
-    for a circle, as in the paper.
+    for a circle, as in the paper; of the distance to the obstacle's solid where it has a
+    height, so that a point inside a low obstacle is pushed up or sideways, whichever face is
+    nearer.
 
     Parameters
     ----------
@@ -49,7 +51,7 @@ class ObstaclePoints(ObjectiveTerm):
             near.skipped,
             self.obstacles.weights[:, None] * gains[None, :],
             state.guarded_jacobians,
-            np.zeros((state.k, 2)),
+            np.zeros((state.k, 3)),
             value,
             gradient,
         )
@@ -78,9 +80,9 @@ def obstacle_points(
 ) -> None:
     """Add ``Σ_j Σ_i ½ c_ji e_ji`` over the body points inside obstacle j (``e < 0``) to
     ``value`` and ``Σ ½ c ∇eᵀ ∂p/∂Q`` to ``gradient``. ``penalty`` (J, k+1) and
-    ``penalty_gradient`` (J, k+1, 2) are the guarded points'; ``coef`` (J, k) is
-    ``w_j k¹_i`` (0 for an obstacle the term does not see); an obstacle ``skipped`` (J,) by
-    the broad phase is outside; ``at_points`` (k, 2) is scratch."""
+    ``penalty_gradient`` (J, k+1, 3, with respect to ``[l, z, h]``) are the guarded points';
+    ``coef`` (J, k) is ``w_j k¹_i`` (0 for an obstacle the term does not see); an obstacle
+    ``skipped`` (J,) by the broad phase is outside; ``at_points`` (k, 3) is scratch."""
     k = coef.shape[1]
     at_points[:, :] = 0.0
     total = 0.0
@@ -93,5 +95,6 @@ def obstacle_points(
                 total += c * e
                 at_points[i, 0] += c * (-0.5 * penalty_gradient[j, i, 0])
                 at_points[i, 1] += c * (-0.5 * penalty_gradient[j, i, 1])
+                at_points[i, 2] += c * (-0.5 * penalty_gradient[j, i, 2])
     value[0] += 0.5 * total
     pull_points(at_points, jacobians, gradient)

@@ -87,11 +87,15 @@ def per_point(name: str, gains: Array, k: int) -> Array:
 
 @njit(inline="always")
 def pull_points(at_points: Array, jacobians: Array, gradient: Array) -> None:
-    """``gradient −= Σ_i at_points[i] · ∂[l, z]_i/∂Q`` over the k body points
-    (``at_points`` (k, 2), ``jacobians`` the guarded points' (k+1, 3, n))."""
+    """``gradient −= Σ_i at_points[i] · ∂[l, z, h]_i/∂Q`` over the k body points
+    (``at_points`` (k, 3), ``jacobians`` the guarded points' (k+1, 3, n); the h part is 0
+    but for obstacles with a height)."""
     for i in range(at_points.shape[0]):
-        al, az = at_points[i, 0], at_points[i, 1]
-        if al == 0.0 and az == 0.0:
+        al, az, ah = at_points[i, 0], at_points[i, 1], at_points[i, 2]
+        if al == 0.0 and az == 0.0 and ah == 0.0:
             continue
         for col in range(gradient.shape[0]):
             gradient[col] -= al * jacobians[i, 0, col] + az * jacobians[i, 1, col]
+        if ah != 0.0:
+            for col in range(gradient.shape[0]):
+                gradient[col] -= ah * jacobians[i, 2, col]

@@ -240,8 +240,10 @@ def _clearances(scene: Scene, traj: Trajectory) -> Row:
         return KinematicState.compute(scene.robot, traj.q[np.argmin(values)], scene.pipe_radius)
 
     if len(scene.obstacles) and np.isfinite(traj.min_clearance).any():
-        _, part, j = proximity(at(traj.min_clearance), scene.obstacles).closest()
-        closest = f"{part}/{scene.obstacles.labels[j]}"
+        near = proximity(at(traj.min_clearance), scene.obstacles)
+        _, part, j = near.closest()
+        side = near.closest_side()
+        closest = f"{part}/{scene.obstacles.labels[j]}" + (f", {side}" if side else "")
     pair = self_distance(at(traj.self_distance))[1] if traj.self_distance.size else None
     link = lowest_link(at(traj.link_height))[1] if traj.link_height.size else None
     return {

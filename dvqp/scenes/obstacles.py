@@ -47,6 +47,8 @@ def _value(f: Fields, t: dict[str, Any], prefix: str, key: str, kind: str, defau
         return f.number(t, key, prefix, within=SIZE)
     if kind == "weight":
         return f.number(t, key, prefix, default, within=WEIGHT)
+    if kind == "height":  # absent: unbounded (the default); given: a finite number > 0
+        return f.number(t, key, prefix, within=SIZE) if key in t else default
     raw = f.get(t, key, prefix)  # "points"
     field = join(prefix, key)
     if isinstance(raw, list) and raw and all(is_number(v) for v in raw):

@@ -139,8 +139,9 @@ def _arm(f: Fields, t: dict[str, Any], base_dir: Path, limits: dict[str, Any]) -
             points,
             tool,
             rail_frame=rail,
+            base_frame=loaded.root_frame,
             name=loaded.name,
-            names=loaded.part_names,
+            names="frames",
             **{"qd_max": loaded.qd_max, **given},
         )
 

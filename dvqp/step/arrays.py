@@ -29,7 +29,7 @@ class ObjectiveArrays:
     """dvqp's objective terms of a run, and ``w``, ``∂w/∂Q`` of the current state: each
     :class:`~dvqp.objective.OrbitalLevel`'s ``h*`` (``levels`` (T,), m) and ``k²``
     (``k_height`` (T, k), 1/m²); ``Σ w_j k¹_i`` of the obstacle-point and obstacle-link terms
-    (``point_coef`` (J, k), ``link_coef`` (J, k − 1); 0 where none sees j); ``scratch`` (k, 2);
+    (``point_coef`` (J, k), ``link_coef`` (J, k − 1); 0 where none sees j); ``scratch`` (k, 3);
     ``w`` and ``∂w/∂Q`` (``value`` (1,), ``gradient`` (n,)); ``gain`` λ."""
 
     levels: Array

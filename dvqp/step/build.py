@@ -108,7 +108,7 @@ def build(
         np.array(step.levels, dtype=float),
         np.array(step.k_height).reshape(-1, k),
         *step.coefficients(),
-        np.zeros((k, 2)),
+        np.zeros((k, 3)),
         plan.objective_value,
         plan.objective_gradient,
         float(spec.objective.gain),

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 
+from dvqp.geometry.link_pieces import straight_solids
 from dvqp.geometry.measure import measure_chain, penalties
 from dvqp.geometry.real_links import real_links
 from dvqp.kinematics.model import kinematics
@@ -67,7 +68,8 @@ def evaluate(s, integrate, first, last) -> int:  # type: ignore[no-untyped-def]
         pair_distances(s.state.origins, s.pairs)
     if first <= LINKS <= last:
         real_links(s.shapes, s.state.guarded, s.state.origins, s.radius, s.model.tool, s.near)
-        penalties(s.shapes.size, s.near)  # the paper's w: of the straight DV links
+        straight_solids(s.shapes, s.state.guarded, s.near)  # obstacles with a height only
+        penalties(s.shapes, s.near)  # the paper's w: of the straight DV links
     if first <= OBJECTIVE <= last:
         _objective(s)
     if first <= DAMPERS <= last:
@@ -125,7 +127,7 @@ def _objective(s) -> None:  # type: ignore[no-untyped-def]
         near.link_penalty,
         near.link_penalty_gradient,
         near.skipped,
-        near.link_t,
+        near.link_penalty_at,
         o.link_coef,
         st.guarded_jacobians,
         o.scratch,

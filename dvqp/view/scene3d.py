@@ -3,8 +3,9 @@
 :func:`scene_3d` turns a scene and a sequence of configurations into arrays: the pipe, each
 obstacle as the real object it stands for (a branch inlet as its tube, a band as a ring, a
 circle or a polygon pad as a raised patch of the surface), the rail, the weld, the probe's
-path, and per sample the arm's chain (rail point, body points, probe: the guarded frames'
-origins, from the compiled kinematics) with the links at their obstacle margin marked.
+path, and per sample the arm's chain (rail point or base, body points, probe: the guarded
+frames' origins, from the compiled kinematics) with the links at their obstacle margin
+marked. An obstacle with a height is drawn as tall as it is.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp.geometry.proximity import proximity
+from dvqp.geometry.shapes import Shape
 from dvqp.kinematics.state import KinematicState
 from dvqp.limits.obstacle_damper import ObstacleDamper
 from dvqp.scenes import Scene
@@ -36,11 +38,12 @@ COLORS: dict[str, Color] = {
 """The view's colours (r, g, b): the pipe blue, the obstacles green, the arm orange and a link
 at its margin red, the rail grey, the weld white, the probe's path purple."""
 PATCH_HEIGHT = 0.01
-"""m: how far a raised patch (a circle or a polygon pad) stands over the surface."""
+"""m: how far a raised patch (a circle or a polygon pad) without a height is drawn over the
+surface (the obstacle itself is unbounded: a wall to the sky)."""
 RING_HEIGHT = 0.03
-"""m: how far a band's ring stands over the surface."""
+"""m: how far a band's ring without a height is drawn over the surface."""
 TUBE_LENGTH = 0.25
-"""m: how far a branch inlet's tube is drawn over the surface."""
+"""m: how far a branch inlet's tube without a height is drawn over the surface."""
 MARGIN_SLACK = 1e-3
 """m: a link whose clearance is within this of the obstacle margin (or below it) is drawn
 at its margin."""
@@ -121,23 +124,28 @@ def scene_3d(scene: Scene, q: Array, t: Array, title: str) -> Scene3D:
     )
 
 
-def obstacle_mesh(name: str, shape: object, radius: float) -> Mesh:
-    """The real object an obstacle shape stands for: an inlet's tube, a band's ring, or
-    (a circle, a polygon pad, a shape of your own) its outline raised as a patch."""
-    color = COLORS["obstacle"]
-    kind = getattr(shape, "kind", "")
+def obstacle_mesh(name: str, shape: Shape, radius: float) -> Mesh:
+    """The real object an obstacle shape stands for, as tall as its height: an inlet's tube
+    (a stub), a band's ring, or (a circle, a polygon pad, a shape of your own) its outline
+    raised as a patch; one without a height is drawn as tall as :data:`TUBE_LENGTH`,
+    :data:`RING_HEIGHT` or :data:`PATCH_HEIGHT`."""
+    color, kind = COLORS["obstacle"], shape.kind
+
+    def tall(default: float) -> float:
+        return float(shape.height) if shape.bounded else default
+
     if kind == "inlet":
-        return _tube(name, shape.center, shape.radius, radius, TUBE_LENGTH, color)  # type: ignore[attr-defined]
+        return _tube(name, shape.center, shape.radius, radius, tall(TUBE_LENGTH), color)  # type: ignore[attr-defined]
     if kind == "band":
-        return ring_mesh(name, shape.z_min, shape.z_max, radius, RING_HEIGHT, color)  # type: ignore[attr-defined]
-    return patch_mesh(name, shape.outline(), radius, PATCH_HEIGHT, color)  # type: ignore[attr-defined]
+        return ring_mesh(name, shape.z_min, shape.z_max, radius, tall(RING_HEIGHT), color)  # type: ignore[attr-defined]
+    return patch_mesh(name, shape.outline(), radius, tall(PATCH_HEIGHT), color)
 
 
 def _lines(scene: Scene, chain: Array) -> tuple[Polyline, ...]:
     """The rail (a circle through the rail point), the circumferential weld, the path."""
     radius, lines = scene.pipe_radius, []
     l_round = np.linspace(0.0, 2.0 * np.pi * radius, ROUND + 1)
-    if scene.robot.has_rail:
+    if scene.robot.rail_frame is not None:  # (a standing arm's base is no rail)
         x, y, z = chain[0, 0]
         lines.append(
             Polyline(

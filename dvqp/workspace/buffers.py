@@ -76,25 +76,55 @@ def link_ends(k: int, rail: bool = False) -> NDArray[np.int64]:
 class ProximityBuffers:
     """Signed distances of the m guarded points and the L guarded links to J obstacles.
 
-    Point i < k is body point i+1, i = k the probe, i = k+1 the rail point (if any); the links
-    are :func:`link_ends`'s (``ends``): the body links, the probe holder, the carriage link.
+    Point i < k is body point i+1, i = k the probe, i = k+1 the rail point or the base (if
+    any); the links are :func:`link_ends`'s (``ends``): the body links, the probe holder, the
+    carriage (or base) link. An obstacle is a solid: its footprint in the (l, z) plane extruded
+    from the pipe surface up to its height (``dvqp.geometry.solid``; unbounded: a wall), so a
+    distance's gradient is taken with respect to the DV ``[l, z, h]``.
 
     Attributes
     ----------
     ends : (L, 2) int64
         The points each link joins (constant).
     point_distance, point_penalty : (J, m)
-        Signed distance ``d`` (m, negative inside) and the objective's penalty ``e`` (m²).
-    point_normal, point_penalty_gradient : (J, m, 2)
-        ``∇d`` and ``∇e`` with respect to the point's ``[l, z]``.
-    link_distance, link_penalty, link_t : (J, L)
-        The same at each link's closest point ``p_a + t (p_b − p_a)``, and its ``t``.
-    link_normal, link_penalty_gradient : (J, L, 2)
+        Signed distance ``d`` to the solid (m, negative inside) and the objective's penalty
+        ``e`` (m²).
+    point_normal, point_penalty_gradient : (J, m, 3)
+        ``∇d`` and ``∇e`` with respect to the point's ``[l, z, h]``.
+    link_distance, link_t : (J, L)
+        The footprint's signed distance (m) at each straight DV segment's closest point
+        ``p_a + t (p_b − p_a)`` in the (l, z) plane, and its ``t``.
+    link_normal : (J, L, 2)
+        ``∇d`` there, with respect to ``[l, z]``.
+    straight_distance : (J, L)
+        Of an obstacle with a height only: the straight DV segment's (its height linear
+        between its ends) signed distance to the solid, m.
+    straight_normal : (J, L, 3)
+        ``∇d`` there with respect to ``[l, z, h]``.
+    straight_at : (J, L, 2)
+        The segment parameters its footprint part and its height part hold at.
+    link_penalty : (J, L)
+        The objective's penalty ``e`` of each straight DV segment (m²): of ``link_distance``,
+        or of ``straight_distance`` for an obstacle with a height.
+    link_penalty_gradient : (J, L, 3)
+        ``∇e`` with respect to ``[l, z, h]``.
+    link_penalty_at : (J, L, 2)
+        The segment parameters its ``[l, z]`` part and its ``h`` part hold at.
     real_distance, real_at : (J, L)
         The clearance (m) of each link's real DV image (the straight 3-D link mapped to the
-        DV; ``dvqp.geometry.real_links``), and the link parameter of its closest point.
-    real_normal : (J, L, 2)
-        ``∇d`` there, with respect to the point's ``[l, z]``.
+        DV; ``dvqp.geometry.real_links``) to the solid, and the link parameter of its closest
+        point in the (l, z) plane.
+    real_normal : (J, L, 3)
+        ``∇d`` there, with respect to the point's ``[l, z, h]``.
+    real_low : (J, L)
+        The link parameter of the lowest point of the piece that has it (where the height
+        part of ``real_normal`` holds).
+    real_footprint : (J, L)
+        ``∂d/∂d₂``: how much of ``real_normal``'s (l, z) part the footprint's distance ``d₂``
+        carries (1 for an unbounded obstacle).
+    real_upper : (J, L)
+        An upper bound of that clearance (m) where the rows were measured exactly, for an
+        obstacle with a height (its row one piece, or the piece that has it).
     real_t0, real_t1 : (J, L)
         The piece ``[t0, t1]`` of the link that has it.
     bends : (L,)
@@ -115,12 +145,19 @@ class ProximityBuffers:
     point_penalty_gradient: Array
     link_distance: Array
     link_normal: Array
+    link_t: Array
+    straight_distance: Array
+    straight_normal: Array
+    straight_at: Array
     link_penalty: Array
     link_penalty_gradient: Array
-    link_t: Array
+    link_penalty_at: Array
     real_distance: Array
     real_normal: Array
     real_at: Array
+    real_low: Array
+    real_footprint: Array
+    real_upper: Array
     real_t0: Array
     real_t1: Array
     bends: Array
@@ -129,7 +166,8 @@ class ProximityBuffers:
 
     @classmethod
     def allocate(cls, count: int, k: int, rail: bool = False) -> ProximityBuffers:
-        """Zeroed buffers for ``count`` obstacles, k body points and the rail point if ``rail``."""
+        """Zeroed buffers for ``count`` obstacles, k body points and the rail point (or the
+        base) if ``rail``."""
         return cls.sized(count, k + 1 + rail, link_ends(k, rail))
 
     @classmethod
@@ -137,24 +175,31 @@ class ProximityBuffers:
         """Zeroed buffers for ``count`` obstacles, ``points`` points and the links ``ends``."""
         p, s = (count, points), (count, ends.shape[0])
         return cls(
-            np.ascontiguousarray(ends, dtype=np.int64),
-            np.zeros(p),
-            np.zeros((*p, 2)),
-            np.zeros(p),
-            np.zeros((*p, 2)),
-            np.zeros(s),
-            np.zeros((*s, 2)),
-            np.zeros(s),
-            np.zeros((*s, 2)),
-            np.zeros(s),
-            np.zeros(s),
-            np.zeros((*s, 2)),
-            np.zeros(s),
-            np.zeros(s),
-            np.ones(s),
-            np.zeros(ends.shape[0]),
-            np.zeros(count, np.bool_),
-            np.zeros(count),
+            ends=np.ascontiguousarray(ends, dtype=np.int64),
+            point_distance=np.zeros(p),
+            point_normal=np.zeros((*p, 3)),
+            point_penalty=np.zeros(p),
+            point_penalty_gradient=np.zeros((*p, 3)),
+            link_distance=np.zeros(s),
+            link_normal=np.zeros((*s, 2)),
+            link_t=np.zeros(s),
+            straight_distance=np.zeros(s),
+            straight_normal=np.zeros((*s, 3)),
+            straight_at=np.zeros((*s, 2)),
+            link_penalty=np.zeros(s),
+            link_penalty_gradient=np.zeros((*s, 3)),
+            link_penalty_at=np.zeros((*s, 2)),
+            real_distance=np.zeros(s),
+            real_normal=np.zeros((*s, 3)),
+            real_at=np.zeros(s),
+            real_low=np.zeros(s),
+            real_footprint=np.ones(s),
+            real_upper=np.zeros(s),
+            real_t0=np.zeros(s),
+            real_t1=np.ones(s),
+            bends=np.zeros(ends.shape[0]),
+            skipped=np.zeros(count, np.bool_),
+            bound=np.zeros(count),
         )
 
 

@@ -1,8 +1,9 @@
 """The names of an arm's guarded parts in labels and reports.
 
 The guarded points are the k body points, the probe (the tool point) and, if the arm has one,
-the rail point; the guarded links are the k−1 body links, the probe holder (last body point to
-the tool) and the carriage link (rail point to body point 1), as
+its lead point: the rail point, or the base of an arm that stands on the pipe; the guarded
+links are the k−1 body links, the probe holder (last body point to the tool) and the lead
+link (the carriage link from the rail point, or the base link, to body point 1), as
 :func:`~dvqp.workspace.link_ends` lays them out. dvqp's own arms number them (``point3``,
 ``probe``, ``link2``, ``holder``, ``carriage``: :meth:`PartNames.numbered`); an arm read from a
 URDF file names them by its frames (:meth:`PartNames.of_frames`: ``panda_link4``, a link
@@ -32,16 +33,23 @@ class PartNames:
     links : tuple of str
         k or k + 1 names: the body links, the probe holder, the carriage link (if a rail).
     rail : bool
-        Whether the arm has a rail point (the last point) and a carriage link (the last link).
+        Whether the arm has a lead point (the last point: a rail point, or its base) and a
+        lead link from it to the first body point (the last link).
+    base : bool
+        Whether that lead point is the arm's base, fixed on the pipe, rather than a rail point
+        (its link keeps the surface, not ``min_height``).
     """
 
     points: tuple[str, ...]
     links: tuple[str, ...]
     rail: bool = False
+    base: bool = False
 
     def __post_init__(self) -> None:
         if len(self.points) < 3 + self.rail or len(self.links) != len(self.points) - 1:
             raise ParameterError("names", "k + 1 points (k >= 2; + 1 with a rail), one link fewer")
+        if self.base and not self.rail:
+            raise ParameterError("names", "a base is a lead point: rail must be True with base")
 
     @classmethod
     def numbered(cls, k: int, rail: bool = False) -> PartNames:
@@ -52,16 +60,18 @@ class PartNames:
         return cls(points, links, rail)
 
     @classmethod
-    def of_frames(cls, points: Sequence[str], tool: str, rail: str | None = None) -> PartNames:
+    def of_frames(
+        cls, points: Sequence[str], tool: str, rail: str | None = None, base: bool = False
+    ) -> PartNames:
         """The frames' own names: each guarded point is its frame's name, each link the names
-        of its two ends, ``"<from>-<to>"``, base to tip (the carriage link ``"<rail>-<first
-        body point>"``)."""
+        of its two ends, ``"<from>-<to>"``, base to tip (the lead link ``"<rail>-<first body
+        point>"``; ``rail`` the lead frame, the arm's base if ``base``)."""
         names = (*points, tool, *(() if rail is None else (rail,)))
         chain = (*points, tool)
         links = [f"{a}{LINK_JOIN}{b}" for a, b in pairwise(chain)]
         if rail is not None:
             links.append(f"{rail}{LINK_JOIN}{points[0]}")
-        return cls(tuple(names), tuple(links), rail is not None)
+        return cls(tuple(names), tuple(links), rail is not None, base and rail is not None)
 
     @property
     def k(self) -> int:
@@ -78,8 +88,13 @@ class PartNames:
         """The probe holder's name."""
         return self.links[self.k - 1]
 
+    @property
+    def lead(self) -> str:
+        """The lead point's name (the rail point or the base; "" if none)."""
+        return self.points[self.k + 1] if self.rail else ""
+
     def point(self, i: int) -> str:
-        """Guarded point i (0-based): a body point (i < k), the probe (i = k), the rail point."""
+        """Guarded point i (0-based): a body point (i < k), the probe (i = k), the lead point."""
         return self.points[i]
 
     def link(self, i: int) -> str:

@@ -38,7 +38,7 @@ def measured(case: Case, state: KinematicState, far: float) -> ProximityBuffers:
     real_links(
         as_struct(packed), chain, np.array(state.origins), case.radius, state.k, as_struct(near)
     )
-    penalties(packed.size, as_struct(near))
+    penalties(as_struct(packed), as_struct(near))
     assert not near.point_penalty[near.skipped].any()  # not written: no repulsion computed
     skipped = near.skipped  # their rows: the bound (the real links' less their bend)
     near.point_distance[skipped] = near.bound[skipped, None]

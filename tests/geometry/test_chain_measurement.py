@@ -76,6 +76,8 @@ def assert_matches_the_oracle(state: KinematicState, obstacles: ObstacleSet) -> 
         if not isinstance(shape, Polygon | Inlet):
             continue
         d, t, n = mine.links.distance[j], mine.links.t[j], mine.links.normal[j]
+        assert not n[:, 2].any()  # an unbounded obstacle's normals lie in the (l, z) plane
+        n = n[:, :2]
         starts, stops = links_of(state)
         ends = short_way(starts, stops, period)
         if isinstance(shape, Inlet):
@@ -137,9 +139,9 @@ def test_the_chain_measurement_equals_per_point_and_per_link_calls(name: str) ->
     rho = np.array([s.size for s in case.obstacles])[:, None]
     for state in states(case, 3, 0.1):
         chain = proximity(state, case.obstacles)
-        lz = state.guarded[:, :2]
-        for i in range(lz.shape[0]):
-            d, n = distances(case.obstacles, lz[i : i + 1], period)
+        lzh = state.guarded
+        for i in range(lzh.shape[0]):
+            d, n = distances(case.obstacles, lzh[i : i + 1], period)
             np.testing.assert_array_equal(chain.points.distance[:, i : i + 1], d)
             np.testing.assert_array_equal(chain.points.normal[:, i : i + 1], n)
         starts, stops = links_of(state)
@@ -147,7 +149,7 @@ def test_the_chain_measurement_equals_per_point_and_per_link_calls(name: str) ->
             d, t, n = segment_distances(case.obstacles, starts[i : i + 1], stops[i : i + 1], period)
             np.testing.assert_array_equal(chain.links.distance[:, i : i + 1], d)
             np.testing.assert_array_equal(chain.links.t[:, i : i + 1], t)
-            np.testing.assert_array_equal(chain.links.normal[:, i : i + 1], n)
+            np.testing.assert_array_equal(chain.links.normal[:, i : i + 1, :2], n)
         assert not chain.points.t.any()
         for part in (chain.points, chain.links):
             d = part.distance
@@ -159,18 +161,17 @@ def test_the_chain_measurement_equals_per_point_and_per_link_calls(name: str) ->
 def test_rows_follow_the_order_of_the_set_not_the_grouping_by_class() -> None:
     case = mixed_case(paper_robot())
     state = case.state(case.q0)
-    lz = state.guarded[:, :2]
     period = 2 * np.pi * case.radius
     chain = proximity(state, case.obstacles)
     assert len({type(s) for s in case.obstacles}) == 4
     for row, shape in enumerate(case.obstacles):
-        d, n = distances([shape], lz, period)
+        d, n = distances([shape], state.guarded, period)
         np.testing.assert_array_equal(chain.points.distance[row], d[0])
         np.testing.assert_array_equal(chain.points.normal[row], n[0])
         d, t, n = segment_distances([shape], *links_of(state), period)
         np.testing.assert_array_equal(chain.links.distance[row], d[0])
         np.testing.assert_array_equal(chain.links.t[row], t[0])
-        np.testing.assert_array_equal(chain.links.normal[row], n[0])
+        np.testing.assert_array_equal(chain.links.normal[row, :, :2], n[0])
 
 
 def test_shapes_of_one_s_own_among_dvqp_s_give_the_rows_of_the_same_geometry() -> None:
@@ -203,7 +204,7 @@ def test_shapes_of_one_s_own_among_dvqp_s_give_the_rows_of_the_same_geometry() -
 def test_an_empty_set_has_empty_rows_and_no_clearance_limit(state0: KinematicState) -> None:
     near = proximity(state0, ObstacleSet())
     assert near.points.distance.shape == (0, 7) and near.links.t.shape == (0, 6)
-    assert near.points.normal.shape == (0, 7, 2) and near.links.penalty_gradient.shape == (0, 6, 2)
+    assert near.points.normal.shape == (0, 7, 3) and near.links.penalty_gradient.shape == (0, 6, 3)
     assert near.min_clearance() == math.inf and near.probe_clearance() == math.inf
     assert min_clearance(state0, ObstacleSet()) == math.inf
     with pytest.raises(ValueError):

@@ -228,7 +228,9 @@ def test_the_circle_is_the_paper_s_closed_form() -> None:
     assert np.all(n[1] == 0.0)  # the centre has no normal
     near = measure([CIRCLE], p, PERIOD, chain_links(p))  # penalty ‖S − p‖² − r², ∇ −2 (S − p)
     np.testing.assert_allclose(near.point_penalty[0], dist**2 - 0.06**2, rtol=0, atol=1e-15)
-    np.testing.assert_allclose(near.point_penalty_gradient[0], -2 * s, rtol=0, atol=1e-15)
+    gradient = near.point_penalty_gradient[0]
+    np.testing.assert_allclose(gradient[:, :2], -2 * s, rtol=0, atol=1e-15)
+    assert np.all(gradient[:, 2] == 0.0)  # an unbounded circle: h does not count
 
 
 @pytest.mark.parametrize("shape", SHAPES, ids=IDS)
@@ -241,6 +243,7 @@ def test_the_penalty_is_d_times_d_plus_twice_the_size_negative_exactly_inside(
     for side in ("point", "link"):
         d, n = getattr(near, f"{side}_distance")[0], getattr(near, f"{side}_normal")[0]
         e, ge = getattr(near, f"{side}_penalty")[0], getattr(near, f"{side}_penalty_gradient")[0]
+        n = np.concatenate([n[:, :2], np.zeros((n.shape[0], 1))], axis=1)  # a footprint: no h
         np.testing.assert_allclose(e, d * (d + 2 * rho), rtol=1e-14, atol=1e-15)
         np.testing.assert_allclose(ge, 2 * (d + rho)[:, None] * n, rtol=1e-14, atol=1e-15)
         assert ((e < 0) == (d < 0)).all()

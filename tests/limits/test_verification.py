@@ -95,17 +95,18 @@ def test_the_tilt_is_folded_into_zero_to_a_right_angle(robot: Robot, q0: np.ndar
     assert floors[:2] == pytest.approx([0.3, 1.4], abs=1e-15)
 
 
-def expected_rows(limit: object, k: int, pairs: int, rail: bool) -> int:
+def expected_rows(limit: object, k: int, pairs: int, rail: bool, base: bool = False) -> int:
     """How many rows of ``G`` (and verified values) one of dvqp's dampers adds (k body points,
-    the rail point and the carriage link if ``rail``)."""
+    the lead point and link if ``rail``: the rail's carriage link, or with ``base`` the base
+    link of an arm standing on the pipe, which keeps the surface, not the body's height)."""
     if isinstance(limit, ObstacleDamper):
         return len(limit.obstacles) * (2 * k + 1 + 2 * rail)
     if isinstance(limit, TiltLimit):
         return int(limit.min_tilt > 0.0)
     # heights: the points, then the link chords (body links and carriage; the holder)
-    return {"SurfaceHeight": 2 * k - 1 + rail, "ProbeHeight": 2, "SelfCollision": pairs}[
-        type(limit).__name__
-    ]
+    rows = {"SurfaceHeight": 2 * k - 1 + (rail and not base), "ProbeHeight": 2}
+    rows["SelfCollision"] = pairs
+    return {**rows, "BaseHeight": 2}[type(limit).__name__]
 
 
 def test_every_bundled_scene_s_limits_are_in_its_step() -> None:
@@ -121,7 +122,8 @@ def test_every_bundled_scene_s_limits_are_in_its_step() -> None:
         dampers = [lim for lim in limits if isinstance(lim, VelocityDamper)]
         rail = sc.robot.has_rail  # the carriage link: against every link but link 1
         pairs = k * (k - 1) // 2 - (k - 1) + (k - 1) * rail
-        rows = sum(expected_rows(lim, k, pairs, rail) for lim in dampers)
+        base = sc.robot.base_frame is not None
+        rows = sum(expected_rows(lim, k, pairs, rail, base) for lim in dampers)
         G = s.problem().G
         assert (0 if G is None else G.shape[0]) == rows, path.stem
         joints = 2 * sc.robot.n * any(isinstance(lim, JointPositionLimit) for lim in limits)

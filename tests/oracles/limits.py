@@ -26,6 +26,7 @@ from dvqp.geometry.proximity import measure as measure_chain
 from dvqp.limits import (
     NO_EXCESS,
     AccelerationLimit,
+    BaseHeight,
     Excess,
     JointPositionLimit,
     JointVelocityLimit,
@@ -148,13 +149,19 @@ def link_pairs(k: int, rail: bool = False) -> tuple[NDArray[np.int64], NDArray[n
     return np.array([p[0] for p in pairs], np.int64), np.array([p[1] for p in pairs], np.int64)
 
 
-def link_name(i: int, k: int) -> str:
-    """``"link3"``; ``"holder"`` for guarded link k−1, ``"carriage"`` for k."""
+def link_name(i: int, k: int, state: KinematicState | None = None) -> str:
+    """``"link3"``; ``"holder"`` for guarded link k−1, ``"carriage"`` for k (a standing
+    base's link: by the arm's own names, from ``state``)."""
+    if state is not None and state.part_names.base and i == k:
+        return state.part_names.link(i)
     return {k - 1: "holder", k: "carriage"}.get(i, f"link{i + 1}")
 
 
-def point_name(i: int, k: int) -> str:
-    """``"point3"``; ``"probe"`` for guarded point k, ``"rail"`` for k+1."""
+def point_name(i: int, k: int, state: KinematicState | None = None) -> str:
+    """``"point3"``; ``"probe"`` for guarded point k, ``"rail"`` for k+1 (a standing base: by
+    the arm's own names, from ``state``)."""
+    if state is not None and state.part_names.base and i == k + 1:
+        return state.part_names.point(i)
     return {k: "probe", k + 1: "rail"}.get(i, f"point{i + 1}")
 
 
@@ -224,7 +231,7 @@ def measure(
     k, n = state.k, state.n
     if type(limit) is ObstacleDamper:
         return _clearances(limit, state, refine, closest)
-    if type(limit) in (SurfaceHeight, ProbeHeight):
+    if type(limit) in (SurfaceHeight, ProbeHeight, BaseHeight):
         return _heights(limit, state)
     if type(limit) is TiltLimit:
         u, du = tilt_cosine(state)
@@ -279,9 +286,11 @@ def _heights(limit: object, state: KinematicState) -> Measured:
     """The points' heights (their DV rows' gradient), then the lowest point of each link chord
     (body links and carriage for the body; the holder for the probe; gradient by differences)."""
     k, o = state.k, np.asarray(state.origins)
-    body = type(limit) is SurfaceHeight
+    body, base = type(limit) is SurfaceHeight, state.part_names.base
     points = list(range(k)) if body else [k]
-    links = [*range(k - 1), *([k] if state.rail else [])] if body else [k - 1]
+    links = [*range(k - 1), *([k] if state.rail and not base else [])] if body else [k - 1]
+    if type(limit) is BaseHeight:  # the base (lead point k + 1) and its link to point 1
+        points, links = ([k + 1], [k]) if base else ([], [])
     ends = guarded_links(k, state.rail)
 
     def inside(a: Array, b: Array) -> bool:  # the lowest point inside the link: ρ² falls at a
@@ -297,8 +306,8 @@ def _heights(limit: object, state: KinematicState) -> Measured:
 
     value = np.array([*state.guarded[points, 2], *(low(i) for i in links)])
     labels = (
-        *(f"{point_name(i, k)}/height" for i in points),
-        *(f"{link_name(i, k)}/height" for i in links),
+        *(f"{point_name(i, k, state)}/height" for i in points),
+        *(f"{link_name(i, k, state)}/height" for i in links),
     )
 
     applies = [inside(o[ends[i, 0]], o[ends[i, 1]]) for i in links]
@@ -494,7 +503,7 @@ def _clearances(
     if count == 0:
         return Measured(np.zeros(0), np.zeros((0, n)), np.zeros(0), (), np.zeros(0, bool))
     points = proximity(state, limit.obstacles).points
-    jac = np.array(state.guarded_jacobians[:, :2, :])  # (m, 2, n)
+    jac = np.array(state.guarded_jacobians[:, :3, :])  # (m, 3, n): l, z, h
     point_rows = np.einsum("jpc,pcn->jpn", points.normal, jac)  # (J, m, n)
     if refine is None:
         refine = np.full(count, limit.margin)

@@ -38,8 +38,8 @@ def obstacle_points(term: ObstaclePoints, state: KinematicState) -> Term:
     k = state.k  # the body points; the probe (last guarded point) is the task's
     excess = near.penalty[:, :k]
     coef = term.obstacles.weights[:, None] * gains(term.k_obstacle, k)[None, :] * (excess < 0.0)
-    v = (coef[..., None] * (-0.5 * near.penalty_gradient[:, :k])).sum(axis=0)  # (k, 2)
-    grad = -np.einsum("kc,kcn->n", v, state.point_jacobians[:, :2, :])
+    v = (coef[..., None] * (-0.5 * near.penalty_gradient[:, :k])).sum(axis=0)  # (k, 3)
+    grad = -np.einsum("kc,kcn->n", v, state.point_jacobians[:, :3, :])
     return Term(0.5 * float(np.sum(coef * excess)), grad)
 
 
@@ -54,11 +54,11 @@ def obstacle_links(term: ObstacleLinks, state: KinematicState) -> Term:
     excess = near.penalty[:, : k - 1]
     active = (excess < 0.0) & (t > 0.0) & (t < 1.0)
     coef = term.obstacles.weights[:, None] * gains(term.k_obstacle, k)[None, :-1] * active
-    a = coef[..., None] * (-0.5 * near.penalty_gradient[:, : k - 1])  # (J, k-1, 2)
-    at_points = np.zeros((k, 2))
+    a = coef[..., None] * (-0.5 * near.penalty_gradient[:, : k - 1])  # (J, k-1, 3)
+    at_points = np.zeros((k, 3))
     at_points[:-1] += (a * (1.0 - t)[..., None]).sum(axis=0)
     at_points[1:] += (a * t[..., None]).sum(axis=0)
-    grad = -np.einsum("kc,kcn->n", at_points, state.point_jacobians[:, :2, :])
+    grad = -np.einsum("kc,kcn->n", at_points, state.point_jacobians[:, :3, :])
     return Term(0.5 * float(np.sum(coef * excess)), grad)
 
 

@@ -46,7 +46,9 @@ def test_the_panda_scene_counts_its_independent_joints() -> None:
     assert s.robot.model.njoints - 1 == 9  # the mimic finger is a joint, with no coordinate
     np.testing.assert_allclose(s.robot.q_max[[3, 7]], [-0.0698, 0.04])  # the URDF's own
     state = KinematicState.compute(s.robot, s.q0, s.pipe_radius)
-    assert np.all(state.guarded[:, 2] > 0.05)  # placed on the pipe: every part above it
+    assert s.robot.base_frame == "panda_link0"  # standing on the pipe: its base is guarded
+    assert np.all(state.guarded[:-1, 2] > 0.05)  # placed on the pipe: every part above it,
+    assert 0.0 < state.guarded[-1, 2] < 0.05  # the base on its foot, 2 cm above the surface
 
 
 def test_the_panda_plans_safely_on_every_step_and_holds_its_forearm_at_the_margin() -> None:

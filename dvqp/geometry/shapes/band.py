@@ -10,7 +10,14 @@ import numpy as np
 
 from dvqp import _validate
 from dvqp.errors import ParameterError
-from dvqp.geometry.shapes.shape import Array, CompiledShape, Shape, ShapeKernels
+from dvqp.geometry.shapes.shape import (
+    HEIGHT_FIELD,
+    Array,
+    CompiledShape,
+    Shape,
+    ShapeKernels,
+    checked_height,
+)
 from dvqp.workspace.wiring import overrides
 from solvers.jit import njit
 
@@ -30,15 +37,19 @@ class Band(Shape):
         m, ``z_min < z_max``.
     weight
         The objective weight ``w_j`` (>= 0).
+    height
+        m above the pipe surface, > 0 (default ``inf``: unbounded, a wall to the sky).
     """
 
     z_min: float
     z_max: float
     weight: float = 1.0
+    height: float = math.inf
     kind: ClassVar[str] = "band"
     SCENE_FIELDS: ClassVar[dict[str, tuple[str, Any]]] = {
         "z": ("interval", None),
         "weight": ("weight", 1.0),
+        **HEIGHT_FIELD,
     }
 
     def __post_init__(self) -> None:
@@ -50,11 +61,12 @@ class Band(Shape):
         object.__setattr__(self, "z_min", lo)
         object.__setattr__(self, "z_max", hi)
         object.__setattr__(self, "weight", _validate.positive("weight", self.weight, strict=False))
+        object.__setattr__(self, "height", checked_height(self.height))
 
     @classmethod
     def from_scene(cls, values: dict[str, Any], pipe_radius: float) -> Band:
         """From a scene file's ``[[obstacles]]`` table (keys :attr:`SCENE_FIELDS`)."""
-        return cls(values["z"][0], values["z"][1], values["weight"])
+        return cls(values["z"][0], values["z"][1], values["weight"], values["height"])
 
     @property
     def size(self) -> float:

@@ -10,7 +10,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from dvqp import _validate
-from dvqp.geometry.shapes.shape import Array, CompiledShape, Shape, ShapeKernels
+from dvqp.geometry.shapes.shape import (
+    HEIGHT_FIELD,
+    Array,
+    CompiledShape,
+    Shape,
+    ShapeKernels,
+    checked_height,
+)
 from dvqp.kinematics.developed_view import wrap_period
 from dvqp.workspace.wiring import overrides
 from solvers.jit import njit
@@ -33,16 +40,20 @@ class Circle(Shape):
         Radius, m, > 0.
     weight
         The objective weight ``w_j`` (>= 0).
+    height
+        m above the pipe surface, > 0 (default ``inf``: unbounded, a wall to the sky).
     """
 
     center: NDArray[np.float64]
     radius: float
     weight: float = 1.0
+    height: float = math.inf
     kind: ClassVar[str] = "circle"
     SCENE_FIELDS: ClassVar[dict[str, tuple[str, Any]]] = {
         "center": ("point", None),
         "radius": ("length", None),
         "weight": ("weight", 1.0),
+        **HEIGHT_FIELD,
     }
 
     def __post_init__(self) -> None:
@@ -50,11 +61,12 @@ class Circle(Shape):
         object.__setattr__(self, "center", center)
         object.__setattr__(self, "radius", _validate.positive("radius", self.radius))
         object.__setattr__(self, "weight", _validate.positive("weight", self.weight, strict=False))
+        object.__setattr__(self, "height", checked_height(self.height))
 
     @classmethod
     def from_scene(cls, values: dict[str, Any], pipe_radius: float) -> Circle:
         """From a scene file's ``[[obstacles]]`` table (keys :attr:`SCENE_FIELDS`)."""
-        return cls(values["center"], values["radius"], values["weight"])
+        return cls(values["center"], values["radius"], values["weight"], values["height"])
 
     @property
     def size(self) -> float:

@@ -19,7 +19,15 @@ from numpy.typing import NDArray
 
 from dvqp import _validate
 from dvqp.errors import ParameterError
-from dvqp.geometry.shapes.shape import UNKNOWN, Array, CompiledShape, Shape, ShapeKernels
+from dvqp.geometry.shapes.shape import (
+    HEIGHT_FIELD,
+    UNKNOWN,
+    Array,
+    CompiledShape,
+    Shape,
+    ShapeKernels,
+    checked_height,
+)
 from dvqp.kinematics.developed_view import wrap_period
 from dvqp.workspace.wiring import overrides
 from solvers.jit import njit
@@ -51,17 +59,21 @@ class Inlet(Shape):
         ``R``, m.
     weight
         The objective weight ``w_j`` (>= 0).
+    height
+        m above the pipe surface, > 0 (default ``inf``: unbounded, a wall to the sky).
     """
 
     center: NDArray[np.float64]
     radius: float
     pipe_radius: float
     weight: float = 1.0
+    height: float = math.inf
     kind: ClassVar[str] = "inlet"
     SCENE_FIELDS: ClassVar[dict[str, tuple[str, Any]]] = {
         "center": ("point", None),
         "radius": ("length", None),
         "weight": ("weight", 1.0),
+        **HEIGHT_FIELD,
     }
     samples: Array = field(init=False, repr=False)
 
@@ -76,6 +88,7 @@ class Inlet(Shape):
             )
         object.__setattr__(self, "radius", r)
         object.__setattr__(self, "weight", _validate.positive("weight", self.weight, strict=False))
+        object.__setattr__(self, "height", checked_height(self.height))
         samples = _validate.readonly(self.curve(SAMPLES) - self.center)
         object.__setattr__(self, "samples", samples)
 
@@ -89,7 +102,9 @@ class Inlet(Shape):
     @classmethod
     def from_scene(cls, values: dict[str, Any], pipe_radius: float) -> Inlet:
         """From a scene file's ``[[obstacles]]`` table (keys :attr:`SCENE_FIELDS`)."""
-        return cls(values["center"], values["radius"], pipe_radius, values["weight"])
+        return cls(
+            values["center"], values["radius"], pipe_radius, values["weight"], values["height"]
+        )
 
     @property
     def size(self) -> float:

@@ -16,7 +16,14 @@ import numpy as np
 from dvqp import _validate
 from dvqp.errors import ParameterError, ShapeError
 from dvqp.geometry.shapes import polygon_geometry as geo
-from dvqp.geometry.shapes.shape import Array, CompiledShape, Shape, ShapeKernels
+from dvqp.geometry.shapes.shape import (
+    HEIGHT_FIELD,
+    Array,
+    CompiledShape,
+    Shape,
+    ShapeKernels,
+    checked_height,
+)
 from dvqp.kinematics.developed_view import wrap_period
 from dvqp.workspace.wiring import overrides
 from solvers.jit import njit
@@ -33,14 +40,18 @@ class Polygon(Shape):
         seam ``l = ±πR``).
     weight
         The objective weight ``w_j`` (>= 0).
+    height
+        m above the pipe surface, > 0 (default ``inf``: unbounded, a wall to the sky).
     """
 
     vertices: Array
     weight: float = 1.0
+    height: float = math.inf
     kind: ClassVar[str] = "polygon"
     SCENE_FIELDS: ClassVar[dict[str, tuple[str, Any]]] = {
         "vertices": ("points", None),
         "weight": ("weight", 1.0),
+        **HEIGHT_FIELD,
     }
     l_ref: float = field(init=False)
     local_vertices: Array = field(init=False, repr=False)
@@ -54,6 +65,7 @@ class Polygon(Shape):
         _check_simple(v)
         object.__setattr__(self, "vertices", _validate.readonly(v))
         object.__setattr__(self, "weight", _validate.positive("weight", self.weight, strict=False))
+        object.__setattr__(self, "height", checked_height(self.height))
         l_ref = float(v[:, 0].mean())
         object.__setattr__(self, "l_ref", l_ref)
         object.__setattr__(self, "local_vertices", _validate.readonly(v - [l_ref, 0.0]))
@@ -65,7 +77,7 @@ class Polygon(Shape):
         Every vertex must lie within half the circumference of the vertices' mean l: a wider
         polygon would wrap onto itself around the pipe.
         """
-        shape = cls(values["vertices"], values["weight"])
+        shape = cls(values["vertices"], values["weight"], values["height"])
         half = np.pi * pipe_radius
         if np.abs(shape.local_vertices[:, 0]).max() >= half:
             raise ParameterError(

@@ -1,4 +1,9 @@
-"""What every obstacle shape is: a region of the developed view's (l, z) plane with a weight.
+"""What every obstacle shape is: a region of the developed view's (l, z) plane with a weight
+and a height.
+
+A shape is the footprint of an obstacle; its :attr:`Shape.height` (m above the pipe surface,
+``inf`` by default: a wall to the sky) extrudes it into a solid, whose distance
+:mod:`dvqp.geometry.solid` derives from the footprint's. Everything below is the footprint's.
 
 A shape's signed distance ``d`` (m) is negative inside; its normal ``∇d`` is a unit vector away
 from the nearest outline point. For a segment ``[a, b]`` (a link) the smallest signed distance
@@ -26,6 +31,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
+
+from dvqp.errors import ParameterError
 
 Array = NDArray[np.float64]
 
@@ -97,14 +104,19 @@ class Shape(ABC):
     SCENE_FIELDS : dict
         The keys of its scene table: ``key -> (kind of value, default or None)``, the kinds
         being ``point`` ([l, z], m), ``length`` (m, > 0), ``interval`` ([lo, hi], m),
-        ``points`` ([[l, z], ...], m) and ``weight`` (>= 0).
+        ``points`` ([[l, z], ...], m), ``weight`` (>= 0) and ``height`` (m, > 0, finite;
+        absent: unbounded).
     weight : float
         The objective weight ``w_j`` (>= 0).
+    height : float
+        How high the obstacle stands above the pipe surface, m (> 0; ``inf``, the default:
+        unbounded, a wall to the sky). A part above it is clear by its height above the top.
     """
 
     kind: ClassVar[str] = "shape"
     SCENE_FIELDS: ClassVar[dict[str, tuple[str, Any]]] = {}
     weight: float
+    height: float = math.inf
 
     @classmethod
     def from_scene(cls, values: dict[str, Any], pipe_radius: float) -> Shape:
@@ -129,6 +141,11 @@ class Shape(ABC):
         ``[[nan, z_min], [nan, z_max]]``.
         """
 
+    @property
+    def bounded(self) -> bool:
+        """Whether the obstacle has a height (a finite one)."""
+        return math.isfinite(self.height)
+
     def compiled(self) -> CompiledShape | None:
         """How the compiled measurement reads this shape; None (a shape of your own): its
         NumPy :meth:`point_distance` and :meth:`segment_distance`."""
@@ -143,3 +160,22 @@ class Shape(ABC):
         """Smallest signed distance ``(m,)``, its parameter ``t`` ``(m,)`` and the normal there
         ``(m, 2)`` of m segments from ``a`` to ``b`` (each (m, 2)), for a shape of your own."""
         raise NotImplementedError(f"{type(self).__name__} has no segment_distance")
+
+
+HEIGHT_FIELD: dict[str, tuple[str, Any]] = {"height": ("height", math.inf)}
+"""The scene key every shape has: its height above the pipe surface (absent: unbounded)."""
+
+
+def checked_height(value: Any) -> float:
+    """``value`` as a height (m): a number > 0, finite or ``inf`` (unbounded).
+
+    Raises
+    ------
+    ParameterError
+        ``height``: not a real number, NaN, or not > 0.
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ParameterError("height", f"must be a number > 0 (m), got {type(value).__name__}")
+    if not float(value) > 0.0:
+        raise ParameterError("height", f"must be a number > 0 (m above the surface), got {value!r}")
+    return float(value)
