@@ -10,7 +10,7 @@ put points and links inside every class and the rows of a class are not contiguo
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import ClassVar
 
@@ -71,9 +71,11 @@ def scene_case(name: str) -> Case:
     return Case(scene.robot, scene.pipe_radius, scene.obstacles, np.array(scene.q0))
 
 
-def mixed_case(robot: Robot, seam: bool = False) -> Case:
+def mixed_case(robot: Robot, seam: bool = False, heights: bool = False) -> Case:
     """Shapes of every class, interleaved, around the guarded points at the start (with
-    ``seam``: the arm turned round the pipe so that it straddles ``l = ±πR``)."""
+    ``seam``: the arm turned round the pipe so that it straddles ``l = ±πR``; with
+    ``heights``: each but two with a height, a few cm above or below the parts near it, so
+    that parts are over, beside and past the edge of a solid)."""
     q0 = np.array(Q0)
     if seam:
         q0[0] += SEAM_SHIFT
@@ -93,6 +95,9 @@ def mixed_case(robot: Robot, seam: bool = False) -> Case:
         Band(g[5, 1] + 0.005, g[5, 1] + 0.04, 2.0),
         Inlet(g[3] + [0.01, -0.015], 0.05, PIPE_RADIUS, 6.0),
     ]
+    if heights:  # m above the surface; the body points ride at 0.07 to 0.09 m
+        tops = (0.05, 0.03, 0.095, 0.06, math.inf, 0.02, 0.07, math.inf, 0.065)
+        shapes = [replace(shape, height=top) for shape, top in zip(shapes, tops, strict=True)]
     return Case(robot, PIPE_RADIUS, ObstacleSet(shapes), q0)
 
 

@@ -19,6 +19,7 @@ from dvqp import (
     load_scene,
 )
 from dvqp.errors import SingularConfigurationError
+from dvqp.geometry import proximity
 from dvqp.limits import (
     Limit,
     ObstacleDamper,
@@ -57,6 +58,19 @@ def configurations(
             continue
         found.append(q)
     return found
+
+
+def clearance_of(robot: Robot, q: np.ndarray, obstacles: ObstacleSet, label: str) -> float:
+    """The clearance a row's label (``<part>/<obstacle>``) names, measured by ``proximity``
+    alone."""
+    state = KinematicState.compute(robot, q, PIPE_RADIUS)
+    near = proximity(state, obstacles)
+    part, name = label.split("/")
+    j = obstacles.labels.index(name)
+    names = state.part_names
+    if part in names.points:
+        return float(near.point_clearance[j, names.points.index(part)])
+    return float(near.link_clearance[j, names.links.index(part)])
 
 
 def near_obstacles(state: KinematicState) -> ObstacleSet:

@@ -1,11 +1,12 @@
 """Limits of a configuration recomputed independently of dvqp, for the tests.
 
 The frames come from Pinocchio, not dvqp's compiled kinematics; clearances from every shape's
-signed distance written in NumPy, each guarded link taken as the real straight 3-D segment,
-sampled densely and each sample mapped to the developed view (not the closest-point
-computations the planner uses); heights of the points and of those sampled links (the body
-links' lowest points, the holder's) and the tilt from the frames' Cartesian positions; self
-distances from an exact closest-point formulation of its own (``tests/oracles/resolution.py``).
+signed distance written in NumPy (to its solid, for an obstacle with a height), each guarded
+link taken as the real straight 3-D segment, sampled densely and each sample mapped to the
+developed view's ``[l, z, h]`` (not the closest-point computations the planner uses);
+heights of the points and of those sampled links (the body links' lowest points, the
+holder's) and the tilt from the frames' Cartesian positions; self distances from an exact
+closest-point formulation of its own (``tests/oracles/resolution.py``).
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ def clearances(scene: Scene, q: np.ndarray) -> tuple[float, float]:
     k, radius = f.k, scene.pipe_radius
     period = 2.0 * math.pi * radius
     links = real_link_distances(scene.obstacles, f, radius)
-    points = point_distances(scene.obstacles, f.guarded[:, :2], period)
+    points = point_distances(scene.obstacles, f.guarded[:, :3], period)
     return float(min(links.min(), points.min())), float(links[:, k - 1].min())
 
 
@@ -73,8 +74,10 @@ def _links(f: Frames, samples: int = 801) -> list[np.ndarray]:
 
 
 def _dv(p: np.ndarray, radius: float) -> np.ndarray:
-    """``[l, z]`` of 3-D points (m): ``l = R atan2(y, x)``."""
-    return np.column_stack([radius * np.arctan2(p[:, 1], p[:, 0]), p[:, 2]])
+    """``[l, z, h]`` of 3-D points (m): ``l = R atan2(y, x)``, ``h = √(x² + y²) − R``."""
+    return np.column_stack(
+        [radius * np.arctan2(p[:, 1], p[:, 0]), p[:, 2], np.hypot(p[:, 0], p[:, 1]) - radius]
+    )
 
 
 def heights(scene: Scene, q: np.ndarray) -> tuple[float, float]:

@@ -43,6 +43,11 @@ class ShapeDistances:
         ``∇e``, m.
     t : ndarray, shape (J, m)
         For segments: parameter in [0, 1] of the closest point (zeros for points).
+    t_height : ndarray, shape (J, m), optional
+        For the straight segments' rows to an obstacle with a height: the parameter of the
+        point whose height the row's h part holds (its piece's lower end; ``t`` elsewhere).
+        The row's ``∇d`` is shared between the segment's ends as ``(1 − t, t)`` in its
+        ``[l, z]`` part and ``(1 − t_height, t_height)`` in its h part. None: ``t``.
     """
 
     distance: Array
@@ -50,6 +55,7 @@ class ShapeDistances:
     penalty: Array
     penalty_gradient: Array
     t: Array
+    t_height: Array | None = None
 
 
 @dataclass(frozen=True)
@@ -110,6 +116,7 @@ class Proximity:
             near.link_penalty,
             near.link_penalty_gradient,
             near.link_penalty_at[..., 0].copy(),
+            near.link_penalty_at[..., 1].copy(),
         )
         none = np.zeros_like(near.real_distance)
         real = ShapeDistances(

@@ -243,27 +243,30 @@ def chord_heights(
 
 
 @njit(separate=True, python=True)  # Python calls it in every plan too
-def lowest_chords(guarded, origins, ends, k, radius):  # type: ignore[no-untyped-def]
+def lowest_chords(guarded, origins, ends, k, radius, skip):  # type: ignore[no-untyped-def]
     """``(h, i, h_holder)``: the lowest height (m) of the chords of the guarded links ``ends``
-    (L, 2) other than the probe holder (link ``k − 1``): the body links and the carriage link,
-    each at its lowest point (:func:`chord_low`); the link i that has it (−1: none); and the
-    holder's lowest height (m; inf: none)."""
+    (L, 2) other than the probe holder (link ``k − 1``) and link ``skip`` (−1: none): the
+    body links and the carriage link, each at its lowest point (:func:`chord_low`); the link
+    i that has it (−1: none); and the holder's lowest height (m; inf: none). A standing arm's
+    base link is skipped in the body's figure: it keeps the surface, not ``min_height``
+    (:class:`~dvqp.limits.BaseHeight`)."""
     low, which, holder = math.inf, -1, math.inf
     for i in range(ends.shape[0]):
         h = chord_low(guarded, origins, ends[i, 0], ends[i, 1], radius)[0]
         if i == k - 1:
             holder = h
-        elif h < low:
+        elif h < low and i != skip:
             low, which = h, i
     return low, which, holder
 
 
 def lowest_link(state: KinematicState) -> tuple[float, str]:
     """The lowest height (m) of the body links' and the carriage link's chords at ``state``
-    (:func:`lowest_chords`) and that link's name (``"link2"``, ``"carriage"``; inf and ``""``
-    without links)."""
+    (:func:`lowest_chords`; not a standing arm's base link) and that link's name
+    (``"link2"``, ``"carriage"``; inf and ``""`` without links)."""
     ends = link_ends(state.k, state.rail)
+    skip = state.k if state.part_names.base else -1
     low, which, _ = lowest_chords(
-        np.array(state.guarded), np.array(state.origins), ends, state.k, state.radius
+        np.array(state.guarded), np.array(state.origins), ends, state.k, state.radius, skip
     )
     return float(low), state.part_names.link(int(which)) if which >= 0 else ""

@@ -94,7 +94,12 @@ def _links_outside(f: Fields, state: KinematicState) -> None:
     into the pipe, naming the lowest."""
     k, names = state.k, state.part_names
     low, which, holder = lowest_chords(
-        np.array(state.guarded), np.array(state.origins), link_ends(k, state.rail), k, state.radius
+        np.array(state.guarded),
+        np.array(state.origins),
+        link_ends(k, state.rail),
+        k,
+        state.radius,
+        -1,  # every link, a standing arm's base link too
     )
     for h, link in ((low, int(which)), (holder, k - 1)):
         if h < 0.0 and link >= 0:

@@ -157,7 +157,8 @@ class Pipeline:
     ``dt`` (1,) and ``command`` (4,) are this step's, ``x`` (n,) the joint velocity it
     integrates, ``motion`` (2,) the integrated step's ``[‖A x − b‖∞, largest joint motion]``;
     ``joint_values`` and ``damper_values`` where the joint room and the damper rows start
-    among the verified values (−1: none);
+    among the verified values (−1: none); ``base_link`` a standing arm's base link, left out
+    of the body's lowest link (−1: none);
     ``diagnostics`` (7,) the state's ``[tilt, self distance, min clearance, probe clearance,
     index of the closest part]`` over the ``recorded`` obstacle rows, and the lowest height of
     the body and carriage links' chords and of the probe holder's.
@@ -184,6 +185,7 @@ class Pipeline:
     checks: CheckBuffers
     joint_values: int
     damper_values: int
+    base_link: int
     recorded: Index
     diagnostics: Array
     record: RecordArrays

@@ -264,6 +264,7 @@ def lay_out(
         plan.checks,
         layout.joint_values,
         layout.damper_values,
+        k if plan.names.base else -1,
         rows,
         np.zeros(7),
         record,

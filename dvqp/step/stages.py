@@ -185,7 +185,7 @@ def _diagnostics(s) -> None:  # type: ignore[no-untyped-def]
     r's point i, or ``+ m`` of its link i, m, m)."""
     st, near, out, k = s.state, s.near, s.diagnostics, s.model.tool
     out[0] = tilt_angle(st.origins, st.axes, k)
-    out[5], _, out[6] = lowest_chords(st.guarded, st.origins, near.ends, k, s.radius)
+    out[5], _, out[6] = lowest_chords(st.guarded, st.origins, near.ends, k, s.radius, s.base_link)
     out[1] = math.inf
     for p in range(s.pairs.distance.shape[0]):
         out[1] = min(out[1], s.pairs.distance[p])

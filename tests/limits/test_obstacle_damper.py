@@ -11,7 +11,14 @@ from dvqp.geometry.shapes import Band, Inlet, Polygon
 from dvqp.limits import ObstacleDamper
 from tests import stepping
 from tests.common import PIPE_RADIUS, central_difference
-from tests.limit_fixtures import DT, configurations, damper_rows, near_obstacles, problem_rows
+from tests.limit_fixtures import (
+    DT,
+    clearance_of,
+    configurations,
+    damper_rows,
+    near_obstacles,
+    problem_rows,
+)
 from tests.oracles.limits import damper_rhs, measure
 
 
@@ -35,21 +42,6 @@ def test_pairs_outside_the_influence_distance_add_no_row(
     empty = stepping.stepper(robot, q0, limits=[ObstacleDamper(ObstacleSet())], backend="daqp")
     empty.prepare(np.zeros(4), DT)
     assert empty.problem().G is None  # no obstacle: no row at all
-
-
-def clearance_of(robot: Robot, q: np.ndarray, obstacles: ObstacleSet, label: str) -> float:
-    """The clearance a row's label names, measured by ``proximity`` alone."""
-    state = KinematicState.compute(robot, q, PIPE_RADIUS)
-    near = proximity(state, obstacles)
-    kind, name = label.split("/")
-    j = obstacles.labels.index(name)
-    if kind == "probe":
-        return float(near.point_clearance[j, state.k])
-    if kind == "holder":
-        return float(near.link_clearance[j, state.k - 1])
-    if kind.startswith("point"):
-        return float(near.point_clearance[j, int(kind[5:]) - 1])
-    return float(near.link_clearance[j, int(kind[4:]) - 1])
 
 
 def test_damper_rows_are_minus_the_clearance_gradient(robot: Robot, q0: np.ndarray) -> None:

@@ -49,6 +49,7 @@ def cases() -> list[tuple[str, Case]]:
     robot = paper_robot()
     found = [(name, scene_case(name)) for name in BUNDLED_WITH_OBSTACLES]
     found += [("mixed", mixed_case(robot)), ("mixed-seam", mixed_case(robot, seam=True))]
+    found += [("mixed-heights", mixed_case(robot, heights=True))]
     return found
 
 
@@ -88,12 +89,17 @@ def test_the_objective_is_the_sum_of_the_oracle_terms(name: str, case: Case) -> 
     assert_objective(case, objective, case.configurations(20, 0.1))
 
 
-@pytest.mark.parametrize("seam", [False, True], ids=["mixed", "mixed-seam"])
-def test_the_gradient_is_the_derivative_of_w(seam: bool) -> None:
+@pytest.mark.parametrize(
+    ("seam", "heights"),
+    [(False, False), (True, False), (False, True), (True, True)],
+    ids=["mixed", "mixed-seam", "mixed-heights", "mixed-heights-seam"],
+)
+def test_the_gradient_is_the_derivative_of_w(seam: bool, heights: bool) -> None:
     """Central differences of the step's own ``w``, every shape class in the points' term;
     the links' term over the circles and bands (the deepest point of a link inside a polygon
-    can sit on a kink, where the penalty has no derivative)."""
-    case = mixed_case(paper_robot(), seam=seam)
+    can sit on a kink, where the penalty has no derivative); with ``heights`` each obstacle a
+    solid (parts over, beside and past the edge of them)."""
+    case = mixed_case(paper_robot(), seam=seam, heights=heights)
     smooth = ObstacleSet([o for o in case.obstacles if type(o) in (Circle, Band)])
     paper = paper_objective(case.obstacles, vector_gains=True)
     terms = (paper.terms[0], paper.terms[1], ObstacleLinks(smooth, K_OBSTACLE))

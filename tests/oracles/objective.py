@@ -45,19 +45,22 @@ def obstacle_points(term: ObstaclePoints, state: KinematicState) -> Term:
 
 def obstacle_links(term: ObstacleLinks, state: KinematicState) -> Term:
     """``Σ_j Σ_i ½ w_j k¹_i e_ij`` over the body links whose closest point is interior and
-    inside obstacle j; the gradient shared by the link's ends as ``(1 − t, t)``."""
+    inside obstacle j; the gradient shared by the link's ends as ``(1 − t, t)`` (its h part,
+    to an obstacle with a height, as ``(1 − t_height, t_height)``)."""
     if not len(term.obstacles):
         return Term(0.0, np.zeros(state.n))
     near = proximity(state, term.obstacles).links
     k = state.k  # the body links; the holder (last guarded link) is left to the dampers
     t = near.t[:, : k - 1]
+    t_height = near.t_height[:, : k - 1]  # where the h part holds (t, for an unbounded one)
     excess = near.penalty[:, : k - 1]
     active = (excess < 0.0) & (t > 0.0) & (t < 1.0)
     coef = term.obstacles.weights[:, None] * gains(term.k_obstacle, k)[None, :-1] * active
     a = coef[..., None] * (-0.5 * near.penalty_gradient[:, : k - 1])  # (J, k-1, 3)
+    share = np.stack([t, t, t_height], axis=-1)
     at_points = np.zeros((k, 3))
-    at_points[:-1] += (a * (1.0 - t)[..., None]).sum(axis=0)
-    at_points[1:] += (a * t[..., None]).sum(axis=0)
+    at_points[:-1] += (a * (1.0 - share)).sum(axis=0)
+    at_points[1:] += (a * share).sum(axis=0)
     grad = -np.einsum("kc,kcn->n", at_points, state.point_jacobians[:, :3, :])
     return Term(0.5 * float(np.sum(coef * excess)), grad)
 

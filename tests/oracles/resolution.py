@@ -177,24 +177,47 @@ def _polygon(vertices: Array, p: Array, period: float) -> Array:
     return out
 
 
+def with_height(footprint: Array, h: Array, height: float) -> Array:
+    """Signed distance (m) to a footprint extruded from the surface up to ``height``, from the
+    footprint's plane distance and the points' heights: case by case (beside and below the
+    top, above the top face, past the top edge, inside the solid)."""
+    above = h - height
+    out = np.array(footprint, dtype=np.float64)
+    over = (footprint <= 0.0) & (above > 0.0)
+    corner = (footprint > 0.0) & (above > 0.0)
+    inside = (footprint <= 0.0) & (above <= 0.0)
+    out[over] = above[over]
+    out[corner] = np.sqrt(footprint[corner] ** 2 + above[corner] ** 2)
+    out[inside] = np.maximum(footprint[inside], above[inside])
+    return out
+
+
 def point_distances(obstacles: Sequence[Shape], p: Array, period: float) -> Array:
-    """Signed distance (m) of points ``p`` (m, 2) ``[l, z]`` to every obstacle: (J, m)."""
-    out = []
-    for shape in obstacles:
-        if type(shape) is Circle:
-            d = np.column_stack(
-                [wrapped(p[:, 0] - shape.center[0], period), p[:, 1] - shape.center[1]]
-            )
-            out.append(np.linalg.norm(d, axis=1) - shape.radius)
-        elif type(shape) is Band:
-            out.append(np.maximum(shape.z_min - p[:, 1], p[:, 1] - shape.z_max))
-        elif type(shape) is Polygon:
-            out.append(_polygon(np.asarray(shape.vertices), p, period))
-        elif type(shape) is Inlet:  # the exact intersection curve, searched in NumPy
-            out.append(inlet_points(shape.center, shape.radius, shape.pipe_radius, p, period)[0])
-        else:
-            raise TypeError(f"no oracle for {type(shape).__name__}")
+    """Signed distance (m) of points ``p`` to every obstacle: (J, m). ``p`` (m, 2) ``[l, z]``:
+    to the footprints (as if every obstacle were unbounded); (m, 3) ``[l, z, h]``: to each
+    obstacle's solid (:func:`with_height`, for an obstacle with a height)."""
+    out = [_footprint_distance(shape, p, period) for shape in obstacles]
+    if p.shape[1] == 3:
+        out = [
+            with_height(d, p[:, 2], shape.height) if math.isfinite(shape.height) else d
+            for d, shape in zip(out, obstacles, strict=True)
+        ]
     return np.array(out).reshape(len(out), p.shape[0])
+
+
+def _footprint_distance(shape: Shape, p: Array, period: float) -> Array:
+    """Signed distance (m) of points ``p`` (m, ≥ 2) ``[l, z, ...]`` to a footprint: (m,)."""
+    if type(shape) is Circle:
+        d = np.column_stack([wrapped(p[:, 0] - shape.center[0], period), p[:, 1] - shape.center[1]])
+        return np.linalg.norm(d, axis=1) - shape.radius  # type: ignore[no-any-return]
+    if type(shape) is Band:
+        return np.maximum(shape.z_min - p[:, 1], p[:, 1] - shape.z_max)  # type: ignore[no-any-return]
+    if type(shape) is Polygon:
+        return _polygon(np.asarray(shape.vertices), p, period)
+    if type(shape) is Inlet:  # the exact intersection curve, searched in NumPy
+        lz = np.ascontiguousarray(p[:, :2])
+        return inlet_points(shape.center, shape.radius, shape.pipe_radius, lz, period)[0]  # type: ignore[no-any-return]
+    raise TypeError(f"no oracle for {type(shape).__name__}")
 
 
 def link_distances(
@@ -278,6 +301,15 @@ def verified_values(limits: tuple, robot: Robot, q: Array, radius: float) -> lis
         if kind is JointPositionLimit:
             values = np.concatenate([limit.q_max - q, q - limit.q_min])
             out.append(Verified(values, 0.0, limit.tolerance, "joint position"))
+        elif kind is ObstacleDamper and any(math.isfinite(o.height) for o in limit.obstacles):
+            from tests.safety import real_link_distances  # (it imports this module)
+
+            # the solids' true clearances: the real links sampled in 3-D (dvqp's are within
+            # PRECISION below them where they matter, not the footprints' rule rebuilt)
+            points = point_distances(limit.obstacles, f.guarded[:, :3], period)
+            links = real_link_distances(limit.obstacles, f, radius)
+            values = np.concatenate([points.ravel(), links.ravel()])
+            out.append(Verified(values, limit.margin, limit.tolerance, limit.quantity))
         elif kind is ObstacleDamper and len(limit.obstacles):
             points = point_distances(limit.obstacles, f.guarded[:, :2], period)
             dampers = [d for d in limits if type(d) is ObstacleDamper]

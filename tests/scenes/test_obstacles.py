@@ -90,10 +90,35 @@ BAD = [
         "obstacles[0]: covers the tool's start point [l, z] = [0.2973, 0.35] m "
         "(50 mm inside the band)",
     ),
+    (
+        'shape = "band"\nz = [0.30, 0.40]\nheight = 0.1',
+        "obstacles[0]: covers the tool's start point [l, z, h] = [0.2973, 0.35, 0.08168] m "
+        "(18.3 mm inside the band)",
+    ),
+    *(
+        (f"{table}\nheight = {value}", f"obstacles[0].height: {message}")
+        for table in (
+            'shape = "band"\nz = [0.6, 0.7]',
+            "center = [0.2, 0.6]\nradius = 0.05",
+            'shape = "inlet"\ncenter = [0.2, 0.6]\nradius = 0.05',
+            'shape = "polygon"\nvertices = [[0.4, 0.6], [0.5, 0.6], [0.45, 0.7]]',
+        )
+        for value, message in (
+            ("0.0", "must be > 0, got 0.0"),
+            ("-0.01", "must be > 0, got -0.01"),
+            ("nan", "must be finite, got nan"),
+            ("inf", "must be finite, got inf"),
+            ('"tall"', "expected a number, got a string"),
+            ("[0.01, 0.02]", "expected a number, got an array"),
+            ("true", "expected a number, got a boolean"),
+        )
+    ),
 ]
 
 
-@pytest.mark.parametrize(("table", "message"), BAD, ids=[m.split(": ")[1][:40] for _, m in BAD])
+@pytest.mark.parametrize(
+    ("table", "message"), BAD, ids=[f"{t[:12]} {m.split(': ')[1][:40]}" for t, m in BAD]
+)
 def test_bad_obstacles_get_one_line_naming_the_field(table: str, message: str) -> None:
     with pytest.raises(SceneError) as info:
         loads(with_obstacles("[[obstacles]]\n" + table + "\n"), SRC)

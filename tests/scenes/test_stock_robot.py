@@ -17,6 +17,7 @@ from dvqp import DvqpError, check_run, load_scene
 from dvqp.cli.main import main
 from dvqp.geometry import proximity
 from dvqp.kinematics.state import KinematicState
+from dvqp.scenes import loads
 from tests.runs import run, scene
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -94,6 +95,11 @@ BASE = ("xyz = [0.0, 0.32, 0.0]", "rpy = [-1.5707963267948966, -1.57079632679489
         ([(BASE[0], "xyz = [0.0, 1e9, 0.0]")], "robot.base.xyz[1]: must be <= 100 m"),
         ([("rpy = [", "rpz = [")], "robot.base.rpz: unknown key (did you mean 'rpy'?)"),
         ([(BASE[0], "xyz = [0, 0, 0]")], "q0: body point 3 (frame 'panda_link5') starts inside"),
+        (
+            [(BASE[0], "xyz = [0.0, 0.25, 0.0]")],
+            "robot.base: the arm's base (frame 'panda_link0') starts inside the pipe: "
+            "h = -0.05 m (50 mm inside the pipe wall)",
+        ),
         ([(BASE[0], ""), (BASE[1], "")], "frame 'panda_link2' lies on the pipe axis (rho = 0 m)"),
     ],
 )
@@ -117,3 +123,30 @@ def test_a_bad_placement_or_q0_is_one_line_naming_the_file_and_field(
     assert err.startswith(f"dvqp: {path}: ") and message in err and err.count("\n") == 1, err
     with pytest.raises(DvqpError, match=re.escape(message)):
         load_scene(path)
+
+
+@pytest.mark.parametrize(
+    ("height", "inside"),
+    [("", "50 mm"), ("height = 0.05", "30 mm"), ("height = 0.01", None)],
+    ids=["a wall", "taller than the base", "lower than the base"],
+)
+def test_an_obstacle_over_the_base_is_refused_unless_the_base_stands_over_it(
+    height: str, inside: str | None
+) -> None:
+    """The base (l, z, h) = (0.4712, 0, 0.02) m never moves: an obstacle's solid round it is
+    refused at load, naming the frame; one lower than the base's foot is not."""
+    text = (ROOT / "scenes" / "panda.toml").read_text(encoding="utf-8")
+    table = f'[[obstacles]]\nname = "clamp"\ncenter = [0.4712, 0.0]\nradius = 0.05\n{height}\n\n'
+    at = text.index("[constraints]")
+    source = str(ROOT / "scenes" / "panda.toml")
+    edited = text[:at] + table + text[at:]
+    if inside is None:
+        s = loads(edited, source)
+        assert s.obstacles[1].height == 0.01
+        return
+    with pytest.raises(DvqpError) as info:
+        loads(edited, source)
+    assert str(info.value) == (
+        f"{source}: obstacles[1]: covers the arm's base (frame 'panda_link0') at [l, z, h] = "
+        f"[0.4712, 0, 0.02] m ({inside} inside the circle), which never moves"
+    )

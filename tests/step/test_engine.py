@@ -150,7 +150,10 @@ def test_every_sample_of_a_run_is_the_state_its_joints_reach(name: str, backend:
             assert traj.min_clearance[k] == math.inf == traj.probe_clearance[k]
         now = verified_values(s.spec().limits, s.robot, traj.q[k], R)
         value, ratio, _ = worst_excess(start_values(name), now)
-        assert traj.limit_excess[k] == pytest.approx(max(value, 0.0), abs=1e-7)
+        # to solids, the oracle's links are the true ones, sampled (dvqp's at most PRECISION
+        # below them where they matter): else the same rule to 1e-7
+        close = PRECISION + 1e-7 if any(o.bounded for o in s.obstacles) else 1e-7
+        assert traj.limit_excess[k] == pytest.approx(max(value, 0.0), abs=close)
         if abs(ratio - 1.0) > 1e-2:
             assert traj.limits_kept[k] == (ratio <= 1.0)
 

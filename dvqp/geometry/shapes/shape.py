@@ -175,7 +175,9 @@ def checked_height(value: Any) -> float:
         ``height``: not a real number, NaN, or not > 0.
     """
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ParameterError("height", f"must be a number > 0 (m), got {type(value).__name__}")
+        raise ParameterError(
+            "height", f"must be a number > 0 (m above the surface), got a {type(value).__name__}"
+        )
     if not float(value) > 0.0:
         raise ParameterError("height", f"must be a number > 0 (m above the surface), got {value!r}")
     return float(value)
