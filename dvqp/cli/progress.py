@@ -101,6 +101,9 @@ def interruptible() -> Iterator[None]:
 
     Forked workers (``compare --jobs``) inherit the handler and exit at once (code 130); a
     signal sent to this process alone (``kill -INT``, ``kill -TERM``) is passed on to them.
+    A signal's exception that a library turns into an error of its own (llvmlite, when the
+    signal lands while numba compiles: ``AttributeError: 'ValueRef' object has no attribute
+    '_as_parameter_'``) leaves as the signal's stop, the error chained to it.
     Outside the main thread (where signals are delivered) nothing changes.
     """
     if threading.current_thread() is not threading.main_thread():
@@ -120,6 +123,12 @@ def interruptible() -> Iterator[None]:
     previous = {signum: signal.signal(signum, handler) for signum in STOPS}
     try:
         yield
+    except KeyboardInterrupt:
+        raise
+    except Exception as exc:
+        if _PENDING:  # the stop, raised inside a library that turned it into its own error
+            raise STOPS[signal.Signals(_PENDING[-1])] from exc  # (numba compiling: llvmlite)
+        raise
     finally:
         for signum, before in previous.items():
             signal.signal(signum, before)

@@ -42,3 +42,25 @@ def test_a_signal_of_an_earlier_command_does_not_stop_the_next() -> None:
     with interruptible():  # the next command in the same process (the console, a test)
         bar.show(2, 10)
         bar.show(10, 10)
+
+
+def swallowing_library() -> None:
+    """A library call that the signal interrupts and that turns it into an error of its own
+    (as llvmlite does when a Ctrl-C lands while numba compiles)."""
+    try:
+        signal.raise_signal(signal.SIGINT)
+    except KeyboardInterrupt as exc:
+        raise AttributeError("'ValueRef' object has no attribute '_as_parameter_'") from exc
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="signals as on Linux")
+def test_a_signal_a_library_turns_into_its_own_error_still_stops_as_the_signal() -> None:
+    with pytest.raises(KeyboardInterrupt) as info, interruptible():
+        swallowing_library()
+    assert not isinstance(info.value, Terminated)
+    assert isinstance(info.value.__cause__, AttributeError)
+
+
+def test_an_error_without_a_signal_stays_that_error() -> None:
+    with pytest.raises(AttributeError), interruptible():
+        raise AttributeError("no signal")
