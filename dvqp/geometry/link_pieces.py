@@ -38,10 +38,11 @@ T0, T1, END0, END1, WIDTH = 0, 1, 2, 7, 12
 """Columns of a piece: its parameters ``t0``, ``t1`` and its ends' ``(l, z, d, n_l, n_z)``
 (the image's point there and its footprint distance to the obstacle, or ``d = nan``: not
 taken)."""
-LB, UB, FINAL, AT, LOW, W2, WH, NL, NZ, BOUNDS = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
+LB, UB, FINAL, AT, LOW, W2, WH, NL, NZ, DROP, BOUNDS = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10
 """Columns of a piece's bounds (:func:`_bounds`): its clearance's lower and upper bounds, whether
 they are close enough (1.0), the link parameters of its footprint's closest point and of its
-lowest point, ``∂d/∂d₂`` and ``∂d/∂d_h`` at the lower bound, and the footprint's normal."""
+lowest point, ``∂d/∂d₂`` and ``∂d/∂d_h`` at the lower bound, the footprint's normal, and a
+lower bound that only decides whether the piece is dropped (:func:`_supported`)."""
 
 
 @njit(inline="always")
@@ -131,7 +132,7 @@ def _bounds(shapes, j, a, b, la, radius, piece, straight, out) -> None:  # type:
     height = shapes.height[j]
     if not height < math.inf:
         out[LB], out[UB], out[FINAL] = d - bend, d + bend, 1.0 if 2.0 * bend <= PRECISION else 0.0
-        out[LOW], out[W2], out[WH] = at, 1.0, 0.0
+        out[LOW], out[W2], out[WH], out[DROP] = at, 1.0, 0.0, d - bend
         return
     low, t_low = _lowest(a, b, t0, t1, radius, straight)
     lower, w2, wh = solid(d - bend, low - height)
@@ -140,7 +141,49 @@ def _bounds(shapes, j, a, b, la, radius, piece, straight, out) -> None:  # type:
         pl, pz = _image(a, b, la, radius, t_low, straight, shapes.period)
         upper = min(upper, solid(shape_point(shapes, j, pl, pz)[0], low - height)[0])
     out[LB], out[UB], out[FINAL] = lower, upper, 1.0 if upper - lower <= PRECISION else 0.0
-    out[LOW], out[W2], out[WH] = t_low, w2, wh
+    out[LOW], out[W2], out[WH], out[DROP] = t_low, w2, wh, lower
+    if upper - lower > PRECISION and shapes.convex[j]:
+        out[DROP] = max(lower, _supported(shapes, j, a, b, la, radius, piece, straight) - bend)
+
+
+@njit
+def _supported(shapes, j, a, b, la, radius, piece, straight):  # type: ignore[no-untyped-def]
+    """A lower bound (m) of ``g(t) = solid(d₂(t), h(t) − H)`` over the piece, ``d₂`` the
+    footprint's distance along its straight DV piece and ``h`` its height: the least of the
+    greater of ``g``'s tangent lines at the piece's ends. For a convex footprint ``g`` is
+    convex (the solid's signed distance is convex and nondecreasing in ``h``, ``(l, z)`` is
+    affine along the piece and ``h`` convex: linear, or a chord's distance from the pipe axis),
+    so its tangents lie below it: the bound is exact at a kink and its gap shrinks as the
+    square of the piece, where :func:`_bounds`' lower bound (the footprint's least distance
+    and the least height, from two points) shrinks only as the piece. The real image is
+    within the piece's bend of the straight piece (the caller subtracts it)."""
+    t0, t1, height = piece[T0], piece[T1], shapes.height[j]
+    span = t1 - t0
+    dl, dz = (piece[END1] - piece[END0]) / span, (piece[END1 + 1] - piece[END0 + 1]) / span
+    g0, s0 = _tangent(shapes, j, a, b, radius, piece, END0, t0, dl, dz, height, straight)
+    g1, s1 = _tangent(shapes, j, a, b, radius, piece, END1, t1, dl, dz, height, straight)
+    if s0 >= 0.0:
+        return g0 if g0 == g0 else -math.inf
+    if s1 <= 0.0:
+        return g1 if g1 == g1 else -math.inf
+    t = (g1 - g0 + s0 * t0 - s1 * t1) / (s0 - s1)  # where the two tangents meet, in [t0, t1]
+    least = g0 + s0 * (min(max(t, t0), t1) - t0)
+    return least if least == least else -math.inf  # NaN (a footprint's h = −∞): no bound
+
+
+@njit(inline="always")
+def _tangent(shapes, j, a, b, radius, piece, col, t, dl, dz, height, straight):  # type: ignore[no-untyped-def]
+    """``(g, g')`` at an end of the piece (:func:`_supported`), ``g'`` per unit of ``t``."""
+    d, nl, nz = shape_point(shapes, j, piece[col], piece[col + 1])
+    if straight:
+        h, dh = _height(a, b, radius, t, True), b[2] - a[2]
+    else:
+        x, y, _ = link_point(a, b, t)
+        rho = math.hypot(x, y)
+        h = rho - radius
+        dh = (x * (b[0] - a[0]) + y * (b[1] - a[1])) / rho if rho > 0.0 else 0.0
+    g, w2, wh = solid(d, h - height)
+    return g, w2 * (nl * dl + nz * dz) + wh * dh
 
 
 @njit
@@ -165,7 +208,7 @@ def _halving(shapes, j, a, b, la, radius, t, bend, straight, best_piece, found):
                 best = _candidate(live[p], out[p], best_piece, found)
         n = 0
         for p in range(count):  # the others, halved where they may hold the minimum
-            if out[p, FINAL] == 0.0 and out[p, LB] < min(upper, best):
+            if out[p, FINAL] == 0.0 and out[p, DROP] < min(upper, best):
                 if n + 2 > MAX_PIECES:
                     if out[p, LB] < best:
                         best = _candidate(live[p], out[p], best_piece, found)

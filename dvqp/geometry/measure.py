@@ -76,6 +76,8 @@ class ShapeArrays:
         (a shape of your own, measured in NumPy; ``rows_at``: its rows a call each).
     boxed, ends : (J,) bool
         Its kind's :attr:`~dvqp.geometry.shapes.shape.ShapeKernels.boxed` and ``ends``.
+    convex : (J,) bool
+        Whether its footprint is convex (:attr:`~dvqp.geometry.shapes.shape.CompiledShape.convex`).
     """
 
     period: float
@@ -94,6 +96,7 @@ class ShapeArrays:
     rows_at: NDArray[np.int64]
     boxed: NDArray[np.bool_]
     ends: NDArray[np.bool_]
+    convex: NDArray[np.bool_]
 
     @classmethod
     def of(cls, shapes: Sequence[Shape], period: float) -> ShapeArrays:
@@ -104,6 +107,7 @@ class ShapeArrays:
         data, box = np.zeros((count, 4)), np.zeros((count, 4))
         start, stop = np.zeros(count, np.int64), np.zeros(count, np.int64)
         boxed, ends = np.zeros(count, np.bool_), np.zeros(count, np.bool_)
+        convex = np.zeros(count, np.bool_)
         vertices: list[Array] = []
         compiled, at = [shape.compiled() for shape in shapes], 0
         for j, packed in enumerate(compiled):
@@ -111,6 +115,7 @@ class ShapeArrays:
                 continue
             data[j], box[j] = packed.data, packed.box
             boxed[j], ends[j] = packed.kernels.boxed, packed.kernels.ends
+            convex[j] = packed.convex
             if packed.samples is not None:
                 start[j], stop[j] = at, at + packed.samples.shape[0]
                 vertices.append(packed.samples)
@@ -133,6 +138,7 @@ class ShapeArrays:
             np.zeros(count, np.int64),
             boxed,
             ends,
+            convex,
         )
         arrays._link([None if packed is None else packed.kernels for packed in compiled])
         return arrays

@@ -54,7 +54,7 @@ def test_its_slopes_are_its_derivatives_away_from_the_edges(d2: float, dh: float
     assume(math.hypot(d2, dh) > 1e-3)
     assume(not (d2 < 1e-3 and dh < 1e-3 and abs(d2 - dh) < 1e-3))
     _, w2, wh = solid(d2, dh)
-    eps = 1e-7
+    eps = 1e-9  # the curvature past the edge is 1/d: a small step
     assert math.isclose(
         w2, (solid(d2 + eps, dh)[0] - solid(d2 - eps, dh)[0]) / (2 * eps), abs_tol=1e-5
     )
@@ -113,3 +113,17 @@ def test_the_normal_is_the_gradient_in_l_z_and_h() -> None:
         far = (np.abs(d) > 1e-3)[..., None] & (smooth[..., None] == 0)
         assert far.sum() <= 0.02 * d.size, far.sum()
     assert checked >= 0.97 * 3 * d.size
+
+
+def test_the_footprints_the_halving_may_take_as_convex_are_the_convex_ones() -> None:
+    """Its supporting-line bound holds only for convex footprints: dvqp's circle, band and
+    inlet, and a polygon only if it is convex (an L-shaped pad is not)."""
+    from dvqp.geometry.measure import ShapeArrays
+
+    square = Polygon(np.array([[0.1, 0.2], [0.2, 0.2], [0.2, 0.3], [0.1, 0.3]]), height=0.01)
+    ell = Polygon(
+        np.array([[0.1, 0.2], [0.3, 0.2], [0.3, 0.25], [0.15, 0.25], [0.15, 0.4], [0.1, 0.4]]),
+        height=0.01,
+    )
+    packed = ShapeArrays.of((*SHAPES[:4], square, ell), PERIOD)
+    assert packed.convex.tolist() == [True, True, True, True, True, False]

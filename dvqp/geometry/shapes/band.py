@@ -84,7 +84,8 @@ class Band(Shape):
         if overrides(self, Band, "point_distance", "segment_distance"):
             return None
         low, high = float(self.z_min), float(self.z_max)
-        return CompiledShape(KERNELS, (low, high, 0.0, 0.0), (-math.inf, math.inf, low, high))
+        box = (-math.inf, math.inf, low, high)
+        return CompiledShape(KERNELS, (low, high, 0.0, 0.0), box, convex=True)
 
     def outline(self) -> Array:
         """``[[nan, z_min], [nan, z_max]]``: a band has edges, not a closed outline."""

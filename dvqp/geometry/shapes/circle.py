@@ -83,7 +83,8 @@ class Circle(Shape):
         if overrides(self, Circle, "point_distance", "segment_distance"):
             return None
         (l, z), r = self.center, self.radius
-        return CompiledShape(KERNELS, (float(l), float(z), float(r), 0.0), (-r, r, z - r, z + r))
+        data, box = (float(l), float(z), float(r), 0.0), (-r, r, z - r, z + r)
+        return CompiledShape(KERNELS, data, box, convex=True)
 
     def outline(self) -> Array:
         """128 points on the circle, closed, m."""

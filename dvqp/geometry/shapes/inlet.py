@@ -126,7 +126,7 @@ class Inlet(Shape):
         low, high = local.min(axis=0), local.max(axis=0)
         box = (float(low[0]), float(high[0]), float(low[1] + z), float(high[1] + z))
         data = (float(l), float(z), float(self.radius), float(self.pipe_radius))
-        return CompiledShape(KERNELS, data, box, local)
+        return CompiledShape(KERNELS, data, box, local, convex=True)  # convex for r < R
 
     def outline(self) -> Array:
         """512 points of the exact outline, closed."""

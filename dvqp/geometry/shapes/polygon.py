@@ -103,11 +103,20 @@ class Polygon(Shape):
         local = self.local_vertices
         low, high = local.min(axis=0), local.max(axis=0)
         box = (float(low[0]), float(high[0]), float(low[1]), float(high[1]))
-        return CompiledShape(KERNELS, (float(self.l_ref), 0.0, 0.0, 0.0), box, local)
+        data = (float(self.l_ref), 0.0, 0.0, 0.0)
+        return CompiledShape(KERNELS, data, box, local, convex=_convex(local))
 
     def outline(self) -> Array:
         """The vertices, closed."""
         return np.vstack([self.vertices, self.vertices[:1]])
+
+
+def _convex(v: Array) -> bool:
+    """Whether the simple polygon ``v`` (V, 2) is convex: every turn the same way round (a
+    straight angle allowed)."""
+    e = np.roll(v, -1, axis=0) - v
+    turns = e[:, 0] * np.roll(e, -1, axis=0)[:, 1] - e[:, 1] * np.roll(e, -1, axis=0)[:, 0]
+    return bool((turns >= 0.0).all() or (turns <= 0.0).all())
 
 
 def _check_simple(v: Array) -> None:

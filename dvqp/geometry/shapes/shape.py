@@ -86,12 +86,17 @@ class CompiledShape:
         ``[l_lo, l_hi, z_lo, z_hi]`` (m), l from ``data[0]``.
     samples : ndarray, shape (V, 2), optional
         Its vertices or outline samples in its local frame (m).
+    convex : bool
+        Whether its footprint is convex: its solid's signed distance is then convex along a
+        straight segment (and along a real link, whose height is convex), which the halving
+        of a link uses to drop pieces (:mod:`dvqp.geometry.link_pieces`).
     """
 
     kernels: ShapeKernels
     data: tuple[float, float, float, float]
     box: tuple[float, float, float, float]
     samples: Array | None = None
+    convex: bool = False
 
 
 class Shape(ABC):
