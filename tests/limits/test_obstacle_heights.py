@@ -42,7 +42,7 @@ def test_damper_rows_are_minus_the_gradient_of_the_clearance_to_each_solid(
     margin = 0.06
     damper = ObstacleDamper(CASE.obstacles, margin=margin, influence=0.1)
     seen_obstacles, seen_sides = set(), set()
-    for q in [CASE.q0, *configurations(robot, CASE.q0, 3, seed=7, spread=0.03)]:
+    for q in [CASE.q0, *configurations(robot, CASE.q0, 2, seed=7, spread=0.03)]:
         rows = stepping.rows(damper, robot, q)
         near = proximity(KinematicState.compute(robot, q, PIPE_RADIUS), CASE.obstacles)
         names = KinematicState.compute(robot, q, PIPE_RADIUS).part_names
@@ -55,6 +55,8 @@ def test_damper_rows_are_minus_the_gradient_of_the_clearance_to_each_solid(
                 link = part not in names.points
                 index = names.links.index(part) if link else names.points.index(part)
                 picked.append((j, index, link))
+            if not CASE.obstacles[j].bounded:  # walls: tests/limits/test_obstacle_damper.py
+                continue
             if clearance_of(robot, q, CASE.obstacles, label) >= margin:
                 continue
             fd = central_difference(
