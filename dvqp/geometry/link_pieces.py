@@ -163,18 +163,22 @@ def _supported(shapes, j, a, b, la, radius, piece, straight):  # type: ignore[no
     g0, s0 = _tangent(shapes, j, a, b, radius, piece, END0, t0, dl, dz, height, straight)
     g1, s1 = _tangent(shapes, j, a, b, radius, piece, END1, t1, dl, dz, height, straight)
     if s0 >= 0.0:
-        return g0 if g0 == g0 else -math.inf
-    if s1 <= 0.0:
-        return g1 if g1 == g1 else -math.inf
-    t = (g1 - g0 + s0 * t0 - s1 * t1) / (s0 - s1)  # where the two tangents meet, in [t0, t1]
-    least = g0 + s0 * (min(max(t, t0), t1) - t0)
+        least = g0
+    elif s1 <= 0.0:
+        least = g1
+    else:  # where the two tangents meet, in [t0, t1]
+        t = (g1 - g0 + s0 * t0 - s1 * t1) / (s0 - s1)
+        least = g0 + s0 * (min(max(t, t0), t1) - t0)
     return least if least == least else -math.inf  # NaN (a footprint's h = −∞): no bound
 
 
 @njit(inline="always")
 def _tangent(shapes, j, a, b, radius, piece, col, t, dl, dz, height, straight):  # type: ignore[no-untyped-def]
-    """``(g, g')`` at an end of the piece (:func:`_supported`), ``g'`` per unit of ``t``."""
-    d, nl, nz = shape_point(shapes, j, piece[col], piece[col + 1])
+    """``(g, g')`` at an end of the piece (:func:`_supported`), ``g'`` per unit of ``t``; the
+    end's footprint distance as :func:`_end` measured it, where it did."""
+    d, nl, nz = piece[col + 2], piece[col + 3], piece[col + 4]
+    if d != d:
+        d, nl, nz = shape_point(shapes, j, piece[col], piece[col + 1])
     if straight:
         h, dh = _height(a, b, radius, t, True), b[2] - a[2]
     else:

@@ -264,8 +264,7 @@ def lowest_link(state: KinematicState) -> tuple[float, str]:
     """The lowest height (m) of the body links' and the carriage link's chords at ``state``
     (:func:`lowest_chords`; not a standing arm's base link) and that link's name
     (``"link2"``, ``"carriage"``; inf and ``""`` without links)."""
-    ends = link_ends(state.k, state.rail)
-    skip = state.k if state.part_names.base else -1
+    ends, skip = link_ends(state.k, state.rail), state.part_names.base_link
     low, which, _ = lowest_chords(
         np.array(state.guarded), np.array(state.origins), ends, state.k, state.radius, skip
     )

@@ -192,11 +192,9 @@ def obstacle_distances(
             nl, nz, nh = normal[0], normal[1], normal[2]
             distance[r], usable[r] = near.point_distance[j, i], nl != 0.0 or nz != 0.0 or nh != 0.0
             if usable[r] and distance[r] < reach[r]:
+                jac = jacobians[i]
                 for c in range(n):
-                    gradient[r, c] = nl * jacobians[i, 0, c] + nz * jacobians[i, 1, c]
-                if nh != 0.0:
-                    for c in range(n):
-                        gradient[r, c] += nh * jacobians[i, 2, c]
+                    gradient[r, c] = nl * jac[0, c] + nz * jac[1, c] + nh * jac[2, c]
             r += 1
     for j in members:
         if near.skipped[j]:  # the bound less each link's bend

@@ -94,8 +94,6 @@ def pull_points(at_points: Array, jacobians: Array, gradient: Array) -> None:
         al, az, ah = at_points[i, 0], at_points[i, 1], at_points[i, 2]
         if al == 0.0 and az == 0.0 and ah == 0.0:
             continue
+        jac = jacobians[i]
         for col in range(gradient.shape[0]):
-            gradient[col] -= al * jacobians[i, 0, col] + az * jacobians[i, 1, col]
-        if ah != 0.0:
-            for col in range(gradient.shape[0]):
-                gradient[col] -= ah * jacobians[i, 2, col]
+            gradient[col] -= al * jac[0, col] + az * jac[1, col] + ah * jac[2, col]

@@ -264,7 +264,7 @@ def lay_out(
         plan.checks,
         layout.joint_values,
         layout.damper_values,
-        k if plan.names.base else -1,
+        plan.names.base_link,
         rows,
         np.zeros(7),
         record,

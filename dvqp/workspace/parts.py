@@ -89,6 +89,12 @@ class PartNames:
         return self.links[self.k - 1]
 
     @property
+    def base_link(self) -> int:
+        """The index of a standing arm's base link (its lead link, k), which keeps the surface,
+        not ``min_height``; −1 for an arm without such a base."""
+        return self.k if self.base else -1
+
+    @property
     def lead(self) -> str:
         """The lead point's name (the rail point or the base; "" if none)."""
         return self.points[self.k + 1] if self.rail else ""
