@@ -69,6 +69,7 @@ WIDE_TABLE = (  # (row key, header, format)
     ("final_joint_speed", "end qd", "{:.3g}"),
     ("braking_time", "brake s", "{:.3f}"),
     ("levels_gave_way", "levels gave way", "{}"),
+    ("levels_least_squares", "least squares", "{}"),
 )
 """Every column (``--wide``)."""
 
@@ -190,12 +191,19 @@ def _heights(row: Row, traj: Trajectory) -> str:
 
 
 def _result(row: Row) -> str:
-    """``safe to send`` (and how much of the task gave way), or ``NOT OK``."""
+    """``safe to send`` (and how much of the task gave way; whether the tool tracked the
+    commanded motion, the verdict ``compare`` gives), or ``NOT OK``."""
     if not row["success"]:
         return "NOT OK"
     gave_way = row["relaxed"] + (row.get("braking") or 0)
     text = "safe to send: every limit kept"
-    return text + (f"; the task gave way on {gave_way} of {row['steps']} steps" if gave_way else "")
+    text += f"; the task gave way on {gave_way} of {row['steps']} steps" if gave_way else ""
+    if row.get("tracked") is False:
+        text += (
+            f"; not tracked: the tool was up to {row['max_tracking_error'] * 1e3:.3g} mm and "
+            f"{row['max_heading_error']:.3g} rad from the commanded motion"
+        )
+    return text
 
 
 def _steps(row: Row) -> str:

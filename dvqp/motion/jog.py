@@ -13,6 +13,11 @@ from dvqp.errors import ParameterError
 
 MAX_STEPS = 10_000_000
 """Most steps a planned motion may take."""
+DEFAULT_GAIN = 5.0
+"""1/s: the feedback a JOG of a scene with tasks at more than one priority closes on its
+reference (the start plus the integrated commands), ``ẋ = ẋ_c + K (x_ref − x)``, as a path's
+does: without it (0, the paper's JOG, the default of a scene of one level) each step meets the
+command in velocity and the integrated probe drifts by the steps' second-order error."""
 DEFAULT_RAMP = 0.2
 """s: a JOG's velocity changes (its start, its end, between segments) are spread over this."""
 

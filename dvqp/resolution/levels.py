@@ -29,6 +29,16 @@ gave way in what they leave free); and a level with more rows than the joints th
 leave (a posture below other tasks), which is never met exactly, relaxed with those above held
 exactly. Refused, the levels are taken one by one.
 
+Levels that cannot all be met together (more rows than joints: a posture below other tasks)
+are first tried without the backends: the nested null-space step (:meth:`Levels.nested`, the
+baseline's :func:`~dvqp.resolution.pinv.pinv_step`: each level met as well as those above let
+it, in least squares where it cannot be met exactly, rows weighed by their weights, then the
+cost) is the optimum of the problem without its inequalities; if it keeps every constraint
+and bound it is the lexicographic optimum, taken as the step (``"optimal"``: a level met in
+least squares did not give way). Else some limit binds and the cascade below solves it on the
+backend. (The ρ-weighted slack of the relaxed problems would trade a least-squares level
+against the cost by about ``1/ρ``; the nested step meets it exactly.)
+
 A level whose relaxed QP has no accepted answer ends the cascade: the step is the answer of
 the level above (which keeps every limit and every level above), the levels from there give
 way. If the first level has none, the step brakes (:class:`~dvqp.resolution.qp.QPSolver`).
@@ -49,10 +59,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 import solvers
+from dvqp.resolution.pinv import pinv_step
 from dvqp.workspace import QPBuffers
 from solvers.jit import njit
 
 Array = NDArray[np.float64]
+
+NESTED_SLACK = 0.0
+"""rad/s (or a constraint's units per s): how far the nested step
+(:meth:`Levels.nested`) may sit past a bound or a constraint's right side and still be taken
+as keeping it (the exact verification of the integrated step judges it then)."""
 
 #: Shows one backend call: ``(kind, problem, solution)``, kind ``"strict"`` or ``"relaxed"``.
 Count = Callable[[str, solvers.Problem, solvers.Solution], None]
@@ -231,6 +247,29 @@ class Levels:
         """The right sides the levels below see: each level above at what it achieved."""
         self._strict: dict[int, tuple[solvers.Problem, solvers.Backend]] = {}
         self._relaxed: dict[int, tuple[solvers.Problem, solvers.Backend]] = {}
+
+    def nested(self) -> Array | None:
+        """The step when no limit is active, if it keeps every limit: the nested null-space
+        step of the levels (:func:`~dvqp.resolution.pinv.pinv_step` over the step's ``A``,
+        ``b``, the rows' weights, the cost and ``P``; a level that cannot be met exactly met in
+        least squares), checked from the problem data against every constraint and bound
+        (within :data:`NESTED_SLACK`). It is then the lexicographic optimum itself: the optimum
+        without the inequalities, and it satisfies them. None: it breaks one (or is not
+        defined), so some limit binds and the levels are solved one by one."""
+        qp = self.qp
+        n = qp.cost.shape[0]
+        out, info = np.empty(n), np.zeros(3)
+        breaks = np.asarray(self.breaks, dtype=np.int64)
+        status = pinv_step(
+            qp.A, qp.b, breaks, self.weights, qp.cost, np.ones(n), qp.P, True, 0.0, info, out
+        )
+        if status != -1 or not np.isfinite(out).all():
+            return None
+        if np.any(out < qp.lb - NESTED_SLACK) or np.any(out > qp.ub + NESTED_SLACK):
+            return None
+        if qp.h.shape[0] and np.any(qp.G @ out > qp.h + NESTED_SLACK):
+            return None
+        return out
 
     def reset(self) -> None:
         """Forget every level backend's warm start."""

@@ -346,6 +346,11 @@ class QPSolver:
             if solution.found and solution.x is not None:
                 x = solution.x[: qp.cost.shape[0]]
                 return Answer(x, "optimal", solution.iterations, solution.solver_time)
+        if levels is not None and not levels.together:
+            started = perf_counter()
+            x = levels.nested()
+            if x is not None:  # no limit binds: the lexicographic optimum, met in closed form
+                return Answer(x, "optimal", 0, perf_counter() - started)
         if levels is not None:
             slow = self._slow_down if not rest and self.feedforward.any() else None
             out = levels.solve(self._count, slow, refused, relaxed_values)

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import solvers
+from dvqp import _validate
 from dvqp._versions import __version__
 from dvqp.errors import BackendError, ParameterError
 from dvqp.resolution.pinv import PseudoinverseResolver
@@ -21,6 +22,10 @@ from solvers.tiers import TIERS, tier_settings
 
 PINV = "pinv"
 """Name of the paper's pseudoinverse baseline (eq. 18)."""
+
+PINV_SETTINGS = ("damping",)
+"""The settings the baseline takes: ``damping`` (μ >= 0 of its damped inverse, 0 its
+default)."""
 
 EXTRA_BACKENDS = ("proxqp", "quadprog", "piqp", "highs")
 """The backends the extra ``dvqp[solvers]`` installs."""
@@ -79,13 +84,22 @@ def check_options(name: str, options: dict[str, Any]) -> dict[str, Any]:
     Raises
     ------
     BackendError
-        Unknown backend; ``pinv`` given settings; a setting the backend does not take (its
-        accepted settings listed where the backend can say them).
+        Unknown backend; a setting the backend does not take (its accepted settings listed
+        where the backend can say them; ``pinv`` takes :data:`PINV_SETTINGS`).
     """
     check_name(name)
     if name == PINV:
-        if options:
-            raise BackendError("pinv: the pseudoinverse has no settings")
+        unknown = sorted(set(options) - set(PINV_SETTINGS))
+        if unknown:
+            raise BackendError(
+                f"pinv: unknown setting {unknown[0]!r}; the pseudoinverse takes: "
+                f"{', '.join(PINV_SETTINGS)}"
+            )
+        for key, value in options.items():
+            try:
+                _validate.positive(key, value, strict=False)
+            except (ParameterError, TypeError, ValueError) as exc:
+                raise BackendError(f"pinv: {key} must be a number >= 0, got {value!r}") from exc
         return options
     make_backend(name, **options)
     return options
@@ -124,6 +138,6 @@ def make_resolver(name: str, spec: StepSpec, options: dict[str, Any] | None = No
     """
     check_name(name)
     if name == PINV:
-        check_options(name, options or {})  # none
-        return PseudoinverseResolver(spec)
+        settings = check_options(name, options or {})
+        return PseudoinverseResolver(spec, **{k: float(v) for k, v in settings.items()})
     return QPResolver(spec, name, options)  # makes its backend once: the settings checked there

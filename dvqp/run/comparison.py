@@ -82,6 +82,7 @@ FIELDS = (
     "final_joint_speed",
     "braking_time",
     "levels_gave_way",
+    "levels_least_squares",
     "level_detail",
     "error",
 )
@@ -132,8 +133,9 @@ def summarize(scene: Scene, traj: Trajectory, settings: str = "default") -> Row:
     ``Q̇``; the final tracking error (m); ``final_joint_speed``, the largest ``|Q̇|`` of the
     last step that succeeded (rad/s; 0: at rest), ``braking_time`` (s; None: not stopped) and
     ``final_tool`` ``[l, z, h, α]``. A run with hard tasks at more than one priority has
-    ``levels_gave_way`` (each level's steps that did not keep it exactly, ``"0/161"``, priority
-    order) and ``level_detail`` (each level kept exactly or given way, and its worst error in
+    ``levels_gave_way`` (each level's relaxed steps that did not meet it exactly, ``"0/161"``,
+    priority order), ``levels_least_squares`` (each level's steps that met it in least squares,
+    not relaxed) and ``level_detail`` (each level kept exactly or given way, and its worst error in
     mm and rad, :func:`dvqp.run.levels.level_figures`); None with one level. Undefined figures
     are None.
     """
@@ -177,9 +179,10 @@ def _levels(traj: Trajectory) -> Row:
     None)."""
     levels = level_figures(traj)
     if len(levels) < 2:
-        return {"levels_gave_way": None, "level_detail": None}
+        return {"levels_gave_way": None, "levels_least_squares": None, "level_detail": None}
     return {
         "levels_gave_way": "/".join(str(level.gave_way) for level in levels),
+        "levels_least_squares": "/".join(str(level.least_squares) for level in levels),
         "level_detail": "; ".join(
             f"level {k} ({level.name}) {level.words()}" for k, level in enumerate(levels, 1)
         ),

@@ -2,7 +2,8 @@
 
 :func:`plan` runs a scene's motion with a named resolver (``"pinv"``, the paper's baseline, or
 a QP backend) on the scene's step plus any tasks and limits of the caller's. In JOG mode the
-tool gets the JOG velocities; in path mode it follows the waypoints with position feedback
+tool gets the JOG velocities with position feedback on their integral (the scene's
+``[motion] gain``); in path mode it follows the waypoints with position feedback
 ``ẋ = ẋ_d + K(x_d − x)``, on the nominal schedule or time-scaled (``timing``,
 :mod:`dvqp.motion.schedule`).
 """
@@ -43,7 +44,8 @@ class Commands:
         ``x_d(t_k)``, l and α unwrapped: the path, or in JOG mode the start plus the
         integrated commands.
     feedback_gain : float
-        ``K``, 1/s (0 in JOG mode: the paper's JOG uses velocities only).
+        ``K``, 1/s: the path's, or in JOG mode the scene's ``[motion] gain`` (0: the paper's
+        JOG, velocities only).
     """
 
     velocity: NDArray[np.float64]
@@ -57,7 +59,7 @@ def scene_commands(scene: Scene) -> Commands:
     if scene.path is None:
         cmd = jog_commands(scene.jog, scene.dt, scene.ramp)
         ref = tool0 + np.vstack([np.zeros(4), np.cumsum(cmd * scene.dt, axis=0)])
-        return Commands(cmd, ref, 0.0)
+        return Commands(cmd, ref, scene.jog_gain)
     ref = ramped(scene.path.reference(tool0, scene.dt, scene.pipe_radius), scene.ramp, scene.dt)
     return Commands(np.diff(ref, axis=0) / scene.dt, ref, scene.path.gain)
 

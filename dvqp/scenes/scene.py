@@ -21,6 +21,7 @@ from dvqp._inputs import read_bounded
 from dvqp.errors import InputFileError, SceneError, one_line
 from dvqp.geometry.obstacle import ObstacleSet
 from dvqp.kinematics.robot import Robot
+from dvqp.kinematics.state import KinematicState
 from dvqp.limits import Limit
 from dvqp.motion.jog import JogSegment
 from dvqp.motion.path import ToolPath
@@ -93,6 +94,10 @@ class Scene:
     tasks : tuple of Task
         ``[[tasks]]``: the hard tasks at their priorities; empty (no ``[[tasks]]``): the tool's
         DV task, all four components, alone (the paper's).
+    jog_gain : float
+        ``[motion] gain``, 1/s: the feedback a JOG closes on its reference (the start plus the
+        integrated commands; default 5 with tasks at more than one priority); 0 (the default
+        of one level): the paper's JOG, velocities only.
     """
 
     name: str
@@ -115,6 +120,7 @@ class Scene:
     solver_options: dict[str, dict[str, Any]] = field(default_factory=dict, repr=False)
     saddle: SaddleWeld | None = field(default=None, repr=False)
     tasks: tuple[Task, ...] = field(default=(), repr=False)
+    jog_gain: float = 0.0
 
     def spec(self) -> StepSpec:
         """The step of this scene: its tasks (the tool's DV task if it names none), the
@@ -167,13 +173,16 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
     with f.guard("constraints"):
         limits = sec.limits(f, doc, robot, obstacles)
     with f.guard("motion"):
-        dt, jog, path, ramp, saddle = sec.motion(f, doc, obstacles)
+        dt, jog, path, ramp, saddle, jog_gain = sec.motion(f, doc, obstacles)
     with f.guard("solvers"):
         options = solver_options(f, doc)
     with f.guard("robot.q0"):
         start.check_start(f, robot, q0, radius, obstacles)
     with f.guard("tasks"):
         tasks = tasks_section.tasks(f, doc, robot, q0, radius)
+    with f.guard("motion"):
+        tool0 = KinematicState.compute(robot, q0, radius).tool
+        tasks_section.check_followed(f, tasks, jog, path, tool0)
     with f.guard("constraints"):
         start.check_floor(f, robot, q0, radius, limits)
     stem = "scene" if source.startswith("<") else Path(source).stem
@@ -198,6 +207,7 @@ def loads(text: str, source: str = "<string>", *, base_dir: str | Path | None = 
         solver_options=options,
         saddle=saddle,
         tasks=tasks,
+        jog_gain=jog_gain,
     )
 
 

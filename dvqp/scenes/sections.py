@@ -19,7 +19,7 @@ from dvqp.kinematics.robot import Robot
 from dvqp.limits import DEFAULT_QDD_MAX, Limit
 from dvqp.limits.limit import SceneLimits
 from dvqp.limits.registry import SCENE_LIMITS, constraint_keys
-from dvqp.motion.jog import DEFAULT_RAMP, MAX_STEPS, JogSegment, jog_step_count
+from dvqp.motion.jog import DEFAULT_GAIN, DEFAULT_RAMP, MAX_STEPS, JogSegment, jog_step_count
 from dvqp.motion.path import ToolPath
 from dvqp.motion.saddle import SaddleWeld
 from dvqp.motion.schedule import TIMINGS
@@ -116,14 +116,21 @@ def _configured(f: Fields, cls: type[Limit], scene: SceneLimits) -> Limit | None
 
 def motion(
     f: Fields, doc: dict[str, Any], obstacles: ObstacleSet
-) -> tuple[float, tuple[JogSegment, ...], ToolPath | None, float, SaddleWeld | None]:
-    """``dt`` (s), the JOG segments or the path, the JOG ramp time (s) and the saddle weld
-    the path was made from (None: none)."""
-    motion = f.table(doc, "motion", "", ("dt", "ramp", "jog", "path", "saddle"))
+) -> tuple[float, tuple[JogSegment, ...], ToolPath | None, float, SaddleWeld | None, float]:
+    """``dt`` (s), the JOG segments or the path, the JOG ramp time (s), the saddle weld the
+    path was made from (None: none) and the JOG's feedback gain (1/s)."""
+    motion = f.table(doc, "motion", "", ("dt", "ramp", "gain", "jog", "path", "saddle"))
     dt = f.number(motion, "dt", "motion", within=DT)
     ramp = f.number(motion, "ramp", "motion", DEFAULT_RAMP, within=RAMP)
     if sum(kind in motion for kind in ("jog", "path", "saddle")) != 1:
         f.fail("motion", ONE_MOTION)
+    if "gain" in motion and "jog" not in motion:
+        kind = "path" if "path" in motion else "saddle"
+        f.fail("motion.gain", f"a JOG's feedback gain; a {kind}'s is motion.{kind}.gain")
+    tasks = doc.get("tasks") if isinstance(doc.get("tasks"), list) else []
+    priorities = {t.get("priority", 1) for t in tasks if isinstance(t, dict)}
+    default = DEFAULT_GAIN if len(priorities) > 1 else 0.0  # one level: the paper's JOG
+    gain = f.number(motion, "gain", "motion", default, within=GAIN)
     saddle = _saddle(f, motion, obstacles) if "saddle" in motion else None
     jog, path = ((), saddle[1]) if saddle else _motion(f, motion)
     steps = sum(s.duration for s in jog) / dt if path is None else path.step_count(dt)
@@ -131,7 +138,7 @@ def motion(
         steps = jog_step_count(jog, dt)
     if steps > MAX_STEPS:
         f.fail("motion", f"about {steps:.3g} steps of dt: too many (at most {MAX_STEPS:.0e})")
-    return dt, jog, path, ramp, saddle[0] if saddle else None
+    return dt, jog, path, ramp, saddle[0] if saddle else None, gain
 
 
 def _motion(f: Fields, motion: dict[str, Any]) -> tuple[tuple[JogSegment, ...], ToolPath | None]:

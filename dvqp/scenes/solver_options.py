@@ -28,15 +28,13 @@ def solver_options(f: Fields, doc: dict[str, Any]) -> Options:
     options: Options = {}
     for name, settings in table.items():
         field = join("solvers", name)
-        if name == PINV:
-            f.fail(field, "the pseudoinverse has no settings")
         for key, value in settings.items():
             if not setting_value(value):
                 f.fail(
                     join(field, key),
                     f"expected a finite number, a boolean or a string, got {kind(value)}",
                 )
-        if name in installed:
+        if name in installed or name == PINV:
             try:
                 check_options(name, settings)
             except BackendError as exc:

@@ -11,7 +11,7 @@ are refused with ``<file>: tasks[i].<key>: <reason>``.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -20,6 +20,8 @@ import pinocchio as pin
 from dvqp.errors import ParameterError
 from dvqp.kinematics.robot import Robot
 from dvqp.kinematics.state import KinematicState
+from dvqp.motion.jog import JogSegment
+from dvqp.motion.path import ToolPath
 from dvqp.resolution.spec import StepSpec, unmeetable
 from dvqp.scenes.fields import Bound, Fields, join
 from dvqp.tasks import FrameTask, PointTask, PostureTask, Task, ToolTask
@@ -65,6 +67,43 @@ def tasks(
     _distinct_tool_components(f, tables)
     _levels_met(f, made, start)
     return tuple(made)
+
+
+def check_followed(
+    f: Fields,
+    tasks: Sequence[Task],
+    jog: Sequence[JogSegment],
+    path: ToolPath | None,
+    tool0: np.ndarray,
+) -> None:
+    """Refuse a motion that commands a tool component no task follows (:attr:`Task.follows`;
+    no ``[[tasks]]``: the tool's task, all four): a JOG segment's non-zero velocity, or a
+    path's waypoints (with the tool's start ``tool0`` (4,)) changing in it."""
+    followed = {c for task in tasks for c in task.follows} if tasks else set(TOOL_COMPONENTS)
+    names = "; ".join(task.label for task in tasks)
+    for i, segment in enumerate(jog):
+        moved = [c for c, v in zip(TOOL_COMPONENTS, segment.velocity, strict=True) if v != 0.0]
+        unused = [c for c in moved if c not in followed]
+        if unused:
+            f.fail(
+                join(join("motion.jog", i), "velocity"),
+                f"commands the tool's {', '.join(unused)} but no task follows "
+                f"{'it' if len(unused) == 1 else 'them'} (tasks: {names}); add a "
+                f'[[tasks]] kind = "tool" with components = {unused!r} or command 0 there',
+            )
+    if path is not None:
+        nodes = np.vstack([tool0, path.waypoints])
+        moved = [
+            c for c, span in zip(TOOL_COMPONENTS, np.ptp(nodes, axis=0), strict=True) if span > 1e-9
+        ]
+        unused = [c for c in moved if c not in followed]
+        if unused:
+            f.fail(
+                "motion.path.waypoints",
+                f"move the tool's {', '.join(unused)} but no task follows "
+                f"{'it' if len(unused) == 1 else 'them'} (tasks: {names}); add a "
+                f'[[tasks]] kind = "tool" with components = {unused!r}',
+            )
 
 
 def _common(f: Fields, t: dict[str, Any], prefix: str) -> dict[str, Any]:

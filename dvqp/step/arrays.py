@@ -101,12 +101,14 @@ class MeasureArrays:
 
 @dataclass(frozen=True)
 class PinvArrays:
-    """The baseline's step (eq. 18), when ``baseline``: ``weights`` (n,) of ``W``, ``dense``
-    (soft tasks make the metric ``P``), ``damping`` μ, ``info`` (3,) the Cholesky pivots'
-    extremes, ``x`` (n,) the step."""
+    """The baseline's step (eq. 18), when ``baseline``: ``weights`` (n,) of ``W``, ``rows``
+    (m,) the task rows' weights within their level (a level met in least squares weighs its
+    rows so), ``dense`` (soft tasks make the metric ``P``), ``damping`` μ, ``info`` (3,) the
+    Cholesky pivots' extremes and the level a failure names, ``x`` (n,) the step."""
 
     baseline: bool
     weights: Array
+    rows: Array
     dense: bool
     damping: float
     info: Array

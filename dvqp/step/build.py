@@ -193,8 +193,11 @@ def _verified(layout: Layout, step: StepWiring, joints: tuple[str, ...]) -> None
         layout.blocks.append(Block(block.limit, first, first + count, named[:count]))
 
 
-def _pinv_arrays(resolver: Resolver, weights: np.ndarray, soft: bool, x: np.ndarray) -> PinvArrays:
-    """The baseline's arrays (for a QP resolver: unused), ``x`` (n,) its step.
+def _pinv_arrays(
+    resolver: Resolver, weights: np.ndarray, rows: np.ndarray, soft: bool, x: np.ndarray
+) -> PinvArrays:
+    """The baseline's arrays (for a QP resolver: unused), ``rows`` (m,) the task rows'
+    weights, ``x`` (n,) its step.
 
     Raises
     ------
@@ -206,7 +209,7 @@ def _pinv_arrays(resolver: Resolver, weights: np.ndarray, soft: bool, x: np.ndar
     damping = 0.0 if damping is None else damping
     if damping > 0.0 and soft:
         raise ParameterError("damping", "the damped inverse takes no soft tasks")
-    return PinvArrays(baseline, weights, soft, damping, np.zeros(3), x)
+    return PinvArrays(baseline, weights, rows, soft, damping, np.zeros(3), x)
 
 
 def lay_out(
@@ -229,7 +232,7 @@ def lay_out(
     weights = spec.diagonal(n)
     plan.qp.P[:] = np.diag(weights)
     x = np.zeros(n)  # the step: the baseline's is written there directly
-    pinv = _pinv_arrays(resolver, weights, layout.hooks.soft, x)
+    pinv = _pinv_arrays(resolver, weights, layout.row_weights, layout.hooks.soft, x)
     shapes = ShapeArrays.of(layout.shapes, plan.period)
     shapes.refine[:] = layout.refine  # links measured to the last precision below a margin
     if not layout.hooks.active:  # parts of your own may read any row: every row exact

@@ -425,18 +425,10 @@ class Stepper(Verification):
     def _pinv_error(self, status: int) -> SingularConfigurationError:
         if status == stages.INDEFINITE_METRIC:
             return SingularConfigurationError("the soft tasks' metric is not positive definite")
-        lo, hi, level = self.arrays.pinv.info
+        level = int(self.arrays.pinv.info[2])
         names = self.resolver.spec.level_names
-        which = (
-            f" of level {int(level) + 1} ({names[int(level)]}) in the null space of the levels "
-            "above"
-            if len(names) > 1
-            else ""
-        )
-        return SingularConfigurationError(
-            f"task Jacobian{which} is (nearly) rank deficient (Cholesky pivots from {lo:.3g} "
-            f"to {hi:.3g}); use a damped inverse"
-        )
+        which = f" of level {level + 1} ({names[level]})" if len(names) > 1 else ""
+        return SingularConfigurationError(f"task Jacobian{which} is not finite")
 
     def record_into(self, samples: Mapping[str, np.ndarray]) -> None:
         """Write the samples of the states concluded from now on into ``samples`` (the

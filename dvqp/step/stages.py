@@ -267,7 +267,7 @@ def prepare_baseline(s, first, last) -> int:  # type: ignore[no-untyped-def]
     if first <= CLOSE <= last:
         levels = s.tasks.levels
         status = pinv_step(
-            qp.A, qp.b, levels, qp.cost, p.weights, qp.P, p.dense, p.damping, p.info, p.x
+            qp.A, qp.b, levels, p.rows, qp.cost, p.weights, qp.P, p.dense, p.damping, p.info, p.x
         )
         if status != -1:
             return INDEFINITE_METRIC if status == NOT_DEFINITE else SINGULAR_TASK

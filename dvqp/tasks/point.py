@@ -43,8 +43,9 @@ class PointTask(Task):
     components
         A non-empty subset of ``("l", "z", "h")``.
     target
-        ``[l, z, h]`` (m, shape (3,); only the chosen components are read). None: where the
-        point is when the run starts (the state the step is laid out at).
+        ``[l, z, h]`` (m, shape (3,); only the chosen components are read), or one number per
+        chosen component (``PointTask(2, ("h",), [0.07])``, as a scene file takes it). None:
+        where the point is when the run starts (the state the step is laid out at).
     gain
         ``K``, 1/s, >= 0.
     priority, weight
@@ -54,8 +55,9 @@ class PointTask(Task):
     ------
     ParameterError
         A negative point index, an empty, unknown or repeated component, a target not of 3
-        finite numbers, a gain < 0, a priority not an integer >= 1, a weight not > 0. A point
-        index beyond the arm's points is refused when the task joins a run.
+        (or one per component) finite numbers, a gain < 0, a priority not an integer >= 1, a
+        weight not > 0. A point index beyond the arm's points is refused when the task joins a
+        run.
     """
 
     name = "point"
@@ -75,12 +77,21 @@ class PointTask(Task):
             raise ParameterError("point", f"must be an integer >= 0, got {point!r}")
         self.point = int(point)
         self.components = check_components("components", components, COMPONENTS)
-        self.target = (
-            None if target is None else _validate.readonly(_validate.vector("target", target, 3))
-        )
+        self.target = None if target is None else _validate.readonly(self._full(target))
         self.gain = _validate.positive("gain", gain, strict=False)
         self.priority = check_priority(priority)
         self.weight = check_weight(weight)
+
+    def _full(self, target: ArrayLike) -> NDArray[np.float64]:
+        """``target`` as ``[l, z, h]`` (3,): given so, or one number per chosen component (the
+        others, never read, 0)."""
+        m = len(self.components)
+        size = np.size(target)
+        if m < 3 and size == m:
+            full = np.zeros(3)
+            full[self.index] = _validate.vector("target", target, m)
+            return full
+        return _validate.vector("target", target, 3)
 
     def __repr__(self) -> str:
         return f"PointTask({self.point}, {self.components!r}, priority={self.priority})"

@@ -135,6 +135,13 @@ class Task:
         return None
 
     @property
+    def follows(self) -> tuple[str, ...]:
+        """The components of the operator's tool command (``"l"``, ``"z"``, ``"h"``,
+        ``"alpha"``) this task makes the tool follow: none by default (a scene whose motion
+        commands a component no task follows is refused at load)."""
+        return ()
+
+    @property
     def measured(self) -> Sequence[Any]:
         """The obstacles whose distances the step must measure for this task (none)."""
         return ()

@@ -73,6 +73,11 @@ class ToolTask(Task):
         return f"tool{parts}"
 
     @property
+    def follows(self) -> tuple[str, ...]:
+        """Its components, as a hard task (a soft one only leans toward them)."""
+        return self.components if self.hard else ()
+
+    @property
     def index(self) -> NDArray[np.int64]:
         """The components' rows of ``J̄`` (0 l, 1 z, 2 h, 3 α), shape (m,)."""
         return np.array([COMPONENTS.index(c) for c in self.components], dtype=np.int64)

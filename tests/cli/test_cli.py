@@ -213,6 +213,8 @@ def test_compare_prints_one_table_and_writes_json_and_csv(
         "levels",
         "gave",
         "way",
+        "least",
+        "squares",
     ]
     assert [line.split()[:5] for line in lines[2:6]] == [
         ["one", "pinv", "yes", "yes", "21"],

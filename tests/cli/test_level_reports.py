@@ -25,7 +25,10 @@ def test_the_summary_says_per_level_whether_it_was_kept(
     assert main(["plan", PRIORITIES, "--backend", "daqp", "-o", str(tmp_path / "r.npz")]) == 0
     out = capsys.readouterr().out
     level1 = re.search(
-        r"^level 1 +tool h, alpha: kept exactly; worst error (\S+) mm, (\S+) rad$", out, re.M
+        r"^level 1 +tool h, alpha: kept exactly \(within 0.05 mm, 0.1 mrad\); worst error (\S+) mm,"
+        r"\s+(\S+) rad$",
+        out,
+        re.M,
     )
     level2 = re.search(
         r"^level 2 +tool l, z: gave way in (\d+) of (\d+) steps; worst error (\S+) mm$", out, re.M
@@ -49,14 +52,15 @@ def test_compare_tells_each_levels_fate_in_its_footer_and_wide_table(
     assert max(len(line) for line in table.splitlines()) <= 100
     footer = " ".join(out.split())  # the footer wrapped to 100 columns, read as one text
     assert re.search(
-        r"reach-priorities / daqp: level 1 \(tool h, alpha\) kept exactly; worst error \S+ mm, "
+        r"reach-priorities / daqp: level 1 \(tool h, alpha\) kept exactly \(within 0.05 mm, 0.1 "
+        r"mrad\); worst error \S+ mm, "
         r"\S+ rad; level 2 \(tool l, z\) gave way in \d+ of \d+ steps; worst error \S+ mm",
         footer,
     ), footer
     assert main(["compare", PRIORITIES, "--backends", "daqp", "--wide"]) == 0
     wide = capsys.readouterr().out.splitlines()
-    assert wide[0].split()[-3:] == ["levels", "gave", "way"]
-    assert re.fullmatch(r"0/\d+", wide[2].split()[-1])
+    assert wide[0].split()[-5:] == ["levels", "gave", "way", "least", "squares"]
+    assert re.fullmatch(r"0/\d+", wide[2].split()[-2])
 
 
 def test_the_limits_page_draws_each_levels_error_over_time(tmp_path: Path) -> None:

@@ -69,16 +69,25 @@ def kkt(jac: Array, xdot: Array, g: Array, metric: Array) -> Array:
     return np.linalg.solve(system, np.concatenate([g, xdot]))[:n]  # type: ignore[no-any-return]
 
 
-def nested(levels: Sequence[tuple[Array, Array]], g: Array, weights: Array) -> Array:
+def nested(
+    levels: Sequence[tuple[Array, Array]],
+    g: Array,
+    weights: Array,
+    row_weights: Sequence[Array] | None = None,
+) -> Array:
     """Strict priorities without inequalities, by null-space bases (SVD), not by dvqp's
     recursion: in ``y = W^½ Q̇`` each level ``(J_k, v_k)`` is solved in least squares within the
-    basis ``Z`` of what the levels above leave free, ``Z`` then shrinks to the part of it that
-    ``J_k`` does not move, and ``W^-½ g`` is added projected on the last ``Z``: the
-    lexicographic minimiser of the levels' residuals, then of ``½ Q̇ᵀWQ̇ − gᵀQ̇``."""
+    basis ``Z`` of what the levels above leave free (its rows weighed by ``row_weights[k]``,
+    ``Σ w_i r_i²``), ``Z`` then shrinks to the part of it that ``J_k`` does not move, and
+    ``W^-½ g`` is added projected on the last ``Z``: the lexicographic minimiser of the levels'
+    residuals, then of ``½ Q̇ᵀWQ̇ − gᵀQ̇``."""
     root = np.sqrt(np.asarray(weights, dtype=float))
     n = root.shape[0]
     y, basis = np.zeros(n), np.eye(n)
-    for jac, v in levels:
+    for k, (jac, v) in enumerate(levels):
+        if row_weights is not None:
+            scale = np.sqrt(np.asarray(row_weights[k], dtype=float))
+            jac, v = jac * scale[:, None], v * scale
         moved = (jac / root) @ basis  # J W^-½ Z
         z = np.linalg.lstsq(moved, v - (jac / root) @ y, rcond=1e-12)[0]
         y = y + basis @ z

@@ -27,13 +27,12 @@ from dvqp import (
     jog_commands,
     simulate,
 )
-from dvqp.errors import SingularConfigurationError
 from dvqp.limits import JointPositionLimit, JointVelocityLimit, SurfaceHeight
 from dvqp.resolution.pinv import pinv_step
 from dvqp.resolution.spec import DEFAULT_TASK_WEIGHT
 from dvqp.step import advance
 from tests.common import LINK_LENGTHS, PIPE_RADIUS, Q0, objective_with, random_configurations
-from tests.oracles.resolution import frames, kkt, kkt_residual, nested
+from tests.oracles.resolution import frames, kkt_residual, nested
 from tests.resolution.test_qp_resolver import CorruptingBackend
 
 DT = 0.005
@@ -171,22 +170,25 @@ def test_a_level_the_limits_forbid_gives_way_and_the_level_above_is_kept(backend
             assert residual < 1e-6
 
 
-def test_a_level_beyond_the_joints_left_gives_way_in_weighted_least_squares(robot: Robot) -> None:
-    """A posture below two tool levels (4 + 13 rows for 13 joints) is never met: its relaxed
-    QP is the minimiser of the cost plus ``½ ρ Σ w‖A₃Q̇ − b₃‖²`` on the levels above."""
+def test_a_level_beyond_the_joints_left_is_met_in_least_squares_without_giving_way(
+    robot: Robot,
+) -> None:
+    """A posture below two tool levels (4 + 13 rows for 13 joints) is never met exactly, and
+    no limit binds: the step is the lexicographic minimiser (the SVD oracle's: each level in
+    least squares in what those above leave free), ``optimal``, not relaxed."""
     posture = PostureTask(np.array(Q0) + 0.05, gain=1.0, priority=3, weight=0.5)
     spec = StepSpec((*FOUR[:2], posture), objective_with([]), loose(robot))
     s = Stepper(robot, PIPE_RADIUS, QPResolver(spec, "daqp"), np.array(Q0), DT)
     s.start(np.array(Q0))
     command = np.array([0.01, -0.01, 0.0, 0.05])
     found = s.resolve(command, DT)
-    assert found.status == "relaxed"  # the lowest level: as a single level's would be
+    assert found.status == "optimal"  # met in least squares: nothing gave way
     p = s.problem()
-    A3, b3, rho = p.A[4:], p.b[4:], 0.5 * DEFAULT_TASK_WEIGHT
     g = objective_gradient(s)
-    expected = kkt(p.A[:4], p.b[:4], g + rho * A3.T @ b3, np.eye(13) + rho * A3.T @ A3)
-    np.testing.assert_allclose(s.x, expected, atol=1e-8)
+    levels = [(p.A[:2], p.b[:2]), (p.A[2:4], p.b[2:4]), (p.A[4:], p.b[4:])]
+    np.testing.assert_allclose(s.x, nested(levels, g, np.ones(13)), atol=1e-9)
     assert s.move() and s.level_error[0] < 1e-9 and s.level_error[1] < 1e-9
+    assert s.level_error[2] > 1e-3  # the posture: in least squares
 
 
 class CorruptRelaxed(CorruptingBackend):
@@ -217,15 +219,19 @@ def test_a_level_answer_that_fails_its_check_is_not_used(robot: Robot) -> None:
     assert s.solver is not None and sum(s.solver.refusals.values()) >= 2  # strict and relaxed
 
 
-def test_the_baseline_refuses_a_level_it_cannot_meet_naming_it(robot: Robot) -> None:
+def test_the_baseline_meets_a_level_it_cannot_meet_exactly_in_least_squares(robot: Robot) -> None:
+    """The tool's h twice, at two priorities: level 2 has nothing left to move, so it keeps
+    the error level 1 left it (here none), undamped as damped."""
     spec = StepSpec((ToolTask(), ToolTask(("h",), priority=2)), objective_with([]))
     s = Stepper(robot, PIPE_RADIUS, PseudoinverseResolver(spec), np.array(Q0), DT)
     s.start(np.array(Q0))
-    with pytest.raises(SingularConfigurationError, match=r"level 2 \(tool h\) in the null space"):
-        s.resolve(np.array([0.01, 0.0, 0.0, 0.0]), DT)
+    command = np.array([0.01, 0.0, 0.0, 0.0])
+    assert s.resolve(command, DT).success
+    tool = np.array(s.state.tool_jacobian)
+    np.testing.assert_allclose(tool @ s.x, command, atol=1e-10)
     damped = Stepper(robot, PIPE_RADIUS, PseudoinverseResolver(spec, 0.01), np.array(Q0), DT)
     damped.start(np.array(Q0))
-    assert damped.resolve(np.array([0.01, 0.0, 0.0, 0.0]), DT).success
+    assert damped.resolve(command, DT).success
 
 
 @pytest.mark.parametrize(
@@ -265,12 +271,12 @@ def test_the_compiled_nested_step_is_the_null_space_oracle(
     A, b = np.vstack(rows), np.concatenate(v)
     breaks = np.cumsum([0, *sizes]).astype(np.int64)
     out, info = np.zeros(n), np.zeros(3)
-    status = pinv_step(A, b, breaks, -g, w, np.eye(n), False, 0.0, info, out)
+    status = pinv_step(A, b, breaks, np.ones(b.shape[0]), -g, w, np.eye(n), False, 0.0, info, out)
     assert status == -1
     np.testing.assert_allclose(out, nested(list(zip(rows, v, strict=True)), g, w), atol=1e-9)
     np.testing.assert_allclose(A @ out, b, atol=1e-9)  # every level met
     dense = np.diag(w)  # the same metric, written out: the dense path
-    status = pinv_step(A, b, breaks, -g, w, dense, True, 0.0, info, out)
+    status = pinv_step(A, b, breaks, np.ones(b.shape[0]), -g, w, dense, True, 0.0, info, out)
     np.testing.assert_allclose(out, nested(list(zip(rows, v, strict=True)), g, w), atol=1e-9)
 
 

@@ -22,9 +22,9 @@ from dvqp import (
     simulate,
 )
 from dvqp.errors import ParameterError, ShapeError, SingularConfigurationError
-from dvqp.resolution.pinv import SINGULAR, pinv_step
+from dvqp.resolution.pinv import SINGULAR, pinv_step, symmetric_eigen
 from tests.common import PIPE_RADIUS, Q0, random_configurations, spec_with
-from tests.oracles.resolution import eq18, frames, kkt
+from tests.oracles.resolution import eq18, frames, kkt, nested
 
 DT = 0.005
 COMMAND = np.array([0.02, 0.01, 0.0, 0.1])
@@ -47,6 +47,7 @@ def compiled(
         np.ascontiguousarray(jac),
         xdot,
         levels,
+        np.ones(jac.shape[0]),
         -g,
         weights,
         P,
@@ -140,28 +141,36 @@ class Zero(Task):
         return TaskRows(np.zeros((1, state.n)), np.zeros(1))
 
 
-def test_rank_deficient_task_raises_unless_damped(robot: Robot) -> None:
+def test_a_dependent_row_is_met_in_least_squares_undamped_and_damped_as_eq18(
+    robot: Robot,
+) -> None:
     spec = spec_with(np.linspace(-1, 1, 13)).with_extra(tasks=[Zero()])
-    with pytest.raises(SingularConfigurationError, match=r"rank deficient.*damped inverse"):
-        baseline(robot, spec).resolve(COMMAND, DT)
+    s = baseline(robot, spec)
+    assert s.resolve(COMMAND, DT).success  # the zero row: rank deficient, met (0 = 0)
+    tool = np.array(s.state.tool_jacobian)
+    np.testing.assert_allclose(s.x, eq18(tool, COMMAND, np.linspace(-1, 1, 13)), atol=1e-10)
     s = baseline(robot, spec, damping=1e-2)
     assert s.resolve(COMMAND, DT).success
     jac = np.vstack([s.state.tool_jacobian, np.zeros((1, 13))])
     expected = eq18(jac, np.r_[COMMAND, 0.0], np.linspace(-1, 1, 13), damping=1e-2)
     np.testing.assert_allclose(s.x, expected, atol=1e-10)
-    status, _ = compiled(jac, np.r_[COMMAND, 0.0], np.zeros(13), np.ones(13))
-    assert status == SINGULAR
+    status, _ = compiled(jac, np.r_[COMMAND, 1.0], np.zeros(13), np.ones(13))
+    assert status == -1  # inconsistent (0 = 1): least squares all the same
 
 
-def test_a_nearly_singular_task_is_refused_by_the_pivot_ratio() -> None:
+def test_a_nearly_singular_row_below_the_rank_tolerance_is_dropped() -> None:
     jac = np.eye(4, 13)
-    jac[3, 3] = 1e-6  # the Gram matrix's pivots: 1 and 1e-12 < 1e-10 · 1
-    status, _ = compiled(jac, np.ones(4), np.zeros(13), np.ones(13))
-    assert status == SINGULAR
+    jac[3, 3] = 1e-6  # the Gram matrix's eigenvalues: 1 and 1e-12 < 1e-10 · 1: rank 3
+    status, qdot = compiled(jac, np.ones(4), np.zeros(13), np.ones(13))
+    assert status == -1
+    np.testing.assert_allclose(qdot, eq18(jac[:3], np.ones(3), np.zeros(13)), atol=1e-12)
     jac[3, 3] = 1e-4  # 1e-8: still resolved, and exactly
     status, qdot = compiled(jac, np.ones(4), np.zeros(13), np.ones(13))
     assert status == -1
     np.testing.assert_allclose(qdot, eq18(jac, np.ones(4), np.zeros(13)), rtol=1e-9)
+    jac[3, 3] = np.nan
+    status, _ = compiled(jac, np.ones(4), np.zeros(13), np.ones(13))
+    assert status == SINGULAR
 
 
 def test_bad_inputs_raise_typed_errors(robot: Robot, q0: np.ndarray) -> None:
@@ -274,3 +283,59 @@ def test_a_spec_needs_a_hard_task_and_parts_derived_from_dvqps() -> None:
         StepSpec((ToolTask(), object()))  # type: ignore[arg-type]
     with pytest.raises(ParameterError, match=r"terms\[0\].*ObjectiveTerm"):
         Objective((object(),))  # type: ignore[arg-type]
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 10_000), st.integers(2, 13))
+def test_jacobi_rotations_give_the_eigen_decomposition_of_a_symmetric_matrix(
+    seed: int, m: int
+) -> None:
+    rng = np.random.default_rng(seed)
+    half = rng.normal(size=(m, m))
+    a = half @ half.T if seed % 2 else half + half.T  # definite, or not
+    vectors, decomposed = np.empty((m, m)), a.copy()
+    assert symmetric_eigen(decomposed, vectors)
+    values = np.diag(decomposed)
+    np.testing.assert_allclose(np.sort(values), np.linalg.eigvalsh(a), atol=1e-10 * np.abs(a).max())
+    np.testing.assert_allclose(
+        vectors @ np.diag(values) @ vectors.T, a, atol=1e-10 * np.abs(a).max()
+    )
+    np.testing.assert_allclose(vectors.T @ vectors, np.eye(m), atol=1e-12)
+    nan = a.copy()
+    nan[0, 0] = np.nan
+    assert not symmetric_eigen(nan, vectors)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.integers(0, 10_000),
+    st.lists(st.tuples(st.integers(1, 4), st.integers(0, 2)), min_size=1, max_size=4),
+    st.booleans(),
+)
+def test_a_level_that_cannot_be_met_is_met_in_weighted_least_squares_as_the_oracle_says(
+    seed: int, shapes: list[tuple[int, int]], posture: bool
+) -> None:
+    """Levels of independent rows plus ``copies`` rows that repeat (scaled) or mix rows above
+    or within them — dependent, and inconsistent where their right sides differ — and maybe a
+    posture (the identity, 13 rows) last: each met in least squares, rows weighed, exactly as
+    the SVD oracle's lexicographic minimiser."""
+    rng = np.random.default_rng(seed)
+    n = 13
+    rows: list[np.ndarray] = []
+    for fresh, copies in shapes:
+        level = rng.normal(size=(fresh, n))
+        earlier = np.vstack([*rows, level])
+        mixes = rng.normal(size=(copies, earlier.shape[0])) @ earlier
+        rows.append(np.vstack([level, mixes]))
+    if posture:
+        rows.append(np.eye(n))
+    v = [rng.normal(size=r.shape[0]) for r in rows]
+    weights = [rng.uniform(0.2, 5.0, r.shape[0]) for r in rows]
+    g, w = rng.normal(size=n), rng.uniform(0.3, 3.0, n)
+    A, b, row_w = np.vstack(rows), np.concatenate(v), np.concatenate(weights)
+    breaks = np.cumsum([0, *(r.shape[0] for r in rows)]).astype(np.int64)
+    out, info = np.zeros(n), np.zeros(3)
+    status = pinv_step(A, b, breaks, row_w, -g, w, np.eye(n), False, 0.0, info, out)
+    assert status == -1
+    expected = nested(list(zip(rows, v, strict=True)), g, w, weights)
+    np.testing.assert_allclose(out, expected, atol=1e-7 * max(1.0, np.abs(expected).max()))

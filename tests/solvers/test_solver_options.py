@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import solvers
@@ -56,7 +57,11 @@ def test_the_scene_s_settings_reach_the_backend(tmp_path: Path) -> None:
         ("[solvers.osqp]\neps_abss = 1e-6\n", "solvers.osqp: osqp: unknown setting 'eps_abss'"),
         ("[solvers.osqp]\neps_abs = [1e-6]\n", "solvers.osqp.eps_abs: expected a finite number"),
         ("[solvers.osqp]\neps_abs = nan\n", "solvers.osqp.eps_abs: expected a finite number"),
-        ("[solvers.pinv]\ngain = 1\n", "solvers.pinv: the pseudoinverse has no settings"),
+        (
+            "[solvers.pinv]\ngain = 1\n",
+            "solvers.pinv: pinv: unknown setting 'gain'; the pseudoinverse takes: damping",
+        ),
+        ("[solvers.pinv]\ndamping = -1\n", "solvers.pinv: pinv: damping must be a number >= 0"),
         ("solvers = 3\n", "solvers: expected tables of settings"),
     ],
 )
@@ -156,4 +161,15 @@ def test_a_setting_out_of_its_range_says_osqps_own_reason_on_stderr(
         "dvqp: osqp: settings eps_abs refused: ERROR in validate_settings: eps_abs must be "
         "nonnegative; ERROR in osqp_setup: Solver settings validation. (osqp raised "
         "OSQPException: 2)"
+    )
+
+
+def test_the_baseline_takes_its_damping_from_the_options_and_the_command_line() -> None:
+    scene = load_scene(SCENES / "joint-limit.toml")
+    plain, damped = plan(scene, "pinv"), plan(scene, "pinv", options={"damping": 0.05})
+    assert plain.success.all() and damped.success.all()
+    assert np.abs(plain.q - damped.q).max() > 1e-6  # the damped inverse, not eq. 18's
+    scene_file = str(SCENES / "joint-limit.toml")
+    assert (
+        main(["plan", scene_file, "--backend", "pinv", "--solver-option", "pinv.damping=0.05"]) == 1
     )

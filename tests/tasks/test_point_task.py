@@ -99,6 +99,7 @@ def test_without_a_target_the_point_is_held_where_the_run_starts(
         (lambda: PointTask(1, priority=1.5), "priority", "must be an integer >= 1"),  # type: ignore[arg-type]
         (lambda: PointTask(1, weight=0.0), "weight", "must be finite and > 0"),
         (lambda: PointTask(1, target=[0.1, 0.2]), "target", "expected shape"),
+        (lambda: PointTask(1, ("h",), target=[0.1, 0.2]), "target", "expected shape"),
     ],
 )
 def test_bad_arguments_are_refused_naming_them(make, field: str, words: str) -> None:  # type: ignore[no-untyped-def]
@@ -113,3 +114,10 @@ def test_a_point_the_arm_does_not_have_is_refused_when_it_joins(
     spec = StepSpec((ToolTask(), PointTask(5, priority=2)), Objective())
     with pytest.raises(ParameterError, match=r"point: index 5 is out of range: .* 0 \.\. 4"):
         Stepper(robot, PIPE_RADIUS, QPResolver(spec, "daqp"), q0, DT)
+
+
+def test_a_target_of_the_chosen_components_alone_is_taken_as_a_scene_file_takes_it() -> None:
+    task = PointTask(2, ("h",), [0.07])
+    assert task.target is not None and task.target[2] == 0.07
+    both = PointTask(2, ("l", "h"), [0.3, 0.07])
+    assert both.target is not None and (both.target[0], both.target[2]) == (0.3, 0.07)
