@@ -197,7 +197,12 @@ def _result(row: Row) -> str:
         return "NOT OK"
     gave_way = row["relaxed"] + (row.get("braking") or 0)
     text = "safe to send: every limit kept"
-    text += f"; the task gave way on {gave_way} of {row['steps']} steps" if gave_way else ""
+    counts = [int(c) for c in (row.get("levels_gave_way") or "").split("/") if c]
+    if gave_way and any(counts):  # which levels: "level 3 on 1886"
+        which = ", ".join(f"level {k} on {c}" for k, c in enumerate(counts, 1) if c)
+        text += f"; a level gave way on {gave_way} of {row['steps']} steps ({which})"
+    elif gave_way:
+        text += f"; the task gave way on {gave_way} of {row['steps']} steps"
     if row.get("tracked") is False:
         text += (
             f"; not tracked: the tool was up to {row['max_tracking_error'] * 1e3:.3g} mm and "

@@ -27,6 +27,7 @@ from dvqp.scenes.fields import Bound, Fields, join
 from dvqp.tasks import FrameTask, PointTask, PostureTask, Task, ToolTask
 from dvqp.tasks.frame import COMPONENTS as FRAME_COMPONENTS
 from dvqp.tasks.point import COMPONENTS as POINT_COMPONENTS
+from dvqp.tasks.point import point_index
 from dvqp.tasks.task import check_priority
 from dvqp.tasks.tool_dv import COMPONENTS as TOOL_COMPONENTS
 
@@ -130,9 +131,17 @@ def _tool(
 def _point(
     f: Fields, t: dict[str, Any], prefix: str, robot: Robot, q0: np.ndarray, start: KinematicState
 ) -> Task:
-    raw = f.get(t, "point", prefix)
-    if isinstance(raw, bool) or not isinstance(raw, int):
-        f.fail(join(prefix, "point"), f"expected an integer (0-based body point), got {raw!r}")
+    given = f.get(t, "point", prefix)
+    names = robot.part_names.points[: robot.n_points]
+    if isinstance(given, bool) or not isinstance(given, (int, str)):
+        f.fail(
+            join(prefix, "point"),
+            f"expected an index (0-based) or a name ({names[0]!r}, as reports say), got {given!r}",
+        )
+    try:
+        raw = point_index(given, names)
+    except ParameterError as exc:
+        f.fail(join(prefix, "point"), exc.reason)
     if not 0 <= raw < robot.n_points:
         f.fail(
             join(prefix, "point"),

@@ -39,7 +39,8 @@ class PointTask(Task):
     Parameters
     ----------
     point
-        The body point, 0-based (0 .. k − 1).
+        The body point: its index, 0-based (0 .. k − 1), or its name as reports and plots
+        give it, ``"point3"`` (1-based: index 2).
     components
         A non-empty subset of ``("l", "z", "h")``.
     target
@@ -54,10 +55,10 @@ class PointTask(Task):
     Raises
     ------
     ParameterError
-        A negative point index, an empty, unknown or repeated component, a target not of 3
-        (or one per component) finite numbers, a gain < 0, a priority not an integer >= 1, a
-        weight not > 0. A point index beyond the arm's points is refused when the task joins a
-        run.
+        A negative point index or a name not ``"point<k>"``, an empty, unknown or repeated
+        component, a target not of 3 (or one per component) finite numbers, a gain < 0, a
+        priority not an integer >= 1, a weight not > 0. A point index beyond the arm's points
+        is refused when the task joins a run.
     """
 
     name = "point"
@@ -73,9 +74,7 @@ class PointTask(Task):
         priority: int = 1,
         weight: float = 1.0,
     ) -> None:
-        if isinstance(point, bool) or not isinstance(point, (int, np.integer)) or point < 0:
-            raise ParameterError("point", f"must be an integer >= 0, got {point!r}")
-        self.point = int(point)
+        self.point = point_index(point)
         self.components = check_components("components", components, COMPONENTS)
         self.target = None if target is None else _validate.readonly(self._full(target))
         self.gain = _validate.positive("gain", gain, strict=False)
@@ -162,6 +161,33 @@ class PointTask(Task):
         padded[: index.shape[0]] = index
         step.tasks["point"].append(((start, index.shape[0], self.point, *padded), goal, self.gain))
         return None
+
+
+def point_index(point: object, names: Sequence[str] = ()) -> int:
+    """A body point's 0-based index from ``point``: an integer >= 0, or a name, ``"point3"``
+    (dvqp's numbering, 1-based, as reports name body points) or one of ``names`` (the arm's
+    body points as its reports name them: a URDF arm's frames).
+
+    Raises
+    ------
+    ParameterError
+        Anything else.
+    """
+    if isinstance(point, str):
+        if point in names:
+            return list(names).index(point)
+        number = point.removeprefix("point")
+        if point.startswith("point") and number.isdigit() and int(number) >= 1:
+            return int(number) - 1
+        known = f" or one of {', '.join(names)}" if names else ""
+        raise ParameterError(
+            "point", f"unknown body point {point!r} (names: point1, point2, …{known})"
+        )
+    if isinstance(point, bool) or not isinstance(point, (int, np.integer)) or point < 0:
+        raise ParameterError(
+            "point", f'must be an integer >= 0 or a name ("point3"), got {point!r}'
+        )
+    return int(point)
 
 
 @njit(separate=True)

@@ -38,8 +38,8 @@ def assert_sane_png(path: Path) -> None:
     with Image.open(path) as im:
         rgb = np.asarray(im.convert("RGB"), dtype=float)
     assert rgb.shape[0] > 600 and rgb.shape[1] > 1000
-    white = (rgb > 245).all(axis=2).mean()
-    assert 0.4 < white < 0.97, f"{white:.0%} of the page is white"
+    white = (rgb > 245).all(axis=2).mean()  # a run relaxed throughout is shaded throughout
+    assert 0.25 < white < 0.97, f"{white:.0%} of the page is white"
     red = (rgb[..., 0] > 180) & (rgb[..., 1] < 90) & (rgb[..., 2] < 90)
     assert red.sum() > 200, "no bound line drawn"
 

@@ -196,3 +196,17 @@ def test_a_jog_gain_belongs_to_a_jog(tmp_path) -> None:  # type: ignore[no-untyp
     assert main(["plan", str(bad)]) == 2
     with pytest.raises(dvqp.SceneError, match=r"motion\.gain: a JOG's feedback gain; a path's"):
         dvqp.load_scene(bad)
+
+
+def test_a_scene_names_a_body_point_as_its_reports_do() -> None:
+    named = dvqp.scenes.loads(FOUR_LEVELS.replace("point = 2", 'point = "point3"'), "named.toml")
+    point = next(t for t in named.tasks if isinstance(t, dvqp.PointTask))
+    assert point.point == 2 and point.label == "point3 h"
+    with pytest.raises(dvqp.SceneError, match=r"tasks\[2\]\.point: unknown body point 'knee'"):
+        dvqp.scenes.loads(FOUR_LEVELS.replace("point = 2", 'point = "knee"'), "bad.toml")
+    text = panda_text(
+        '[[tasks]]\nkind = "tool"\n\n[[tasks]]\nkind = "point"\npoint = "panda_link4"\n'
+        'components = ["h"]\npriority = 2\n'
+    )
+    panda = dvqp.scenes.loads(text, str(SCENES / "panda-point.toml"))
+    assert next(t for t in panda.tasks if isinstance(t, dvqp.PointTask)).point == 1

@@ -121,3 +121,12 @@ def test_a_target_of_the_chosen_components_alone_is_taken_as_a_scene_file_takes_
     assert task.target is not None and task.target[2] == 0.07
     both = PointTask(2, ("l", "h"), [0.3, 0.07])
     assert both.target is not None and (both.target[0], both.target[2]) == (0.3, 0.07)
+
+
+def test_a_body_point_is_named_as_reports_name_it() -> None:
+    assert PointTask("point3").point == PointTask(2).point == 2
+    assert PointTask("point3", ("h",)).label == "point3 h"
+    with pytest.raises(DvqpError, match=r"point: unknown body point 'point0'"):
+        PointTask("point0")
+    with pytest.raises(DvqpError, match=r"point: unknown body point 'elbow'"):
+        PointTask("elbow")
