@@ -18,6 +18,11 @@ DEFAULT_TASK_WEIGHT = 1e4
 """``ρ`` of the hard tasks' slack (dimensionless relative to W): large, so a task is given
 up last."""
 
+MAX_LEVELS = 16
+"""Most levels (distinct priorities of the hard tasks) a step takes: a step whose levels cannot
+all be met together solves up to one QP per level, each with a backend of its own (150 levels
+took 37 s to plan a bundled scene, 1 000 over 2 minutes), so more are refused when the step is
+made, at load for a scene file."""
 RANK_RCOND = 1e-6
 """A level's Jacobian whose smallest singular value is below this fraction of its largest
 cannot be met even alone (its rows are dependent there)."""
@@ -60,6 +65,14 @@ class StepSpec:
             if task.hard:
                 check_priority(task.priority, f"tasks[{i}].priority")
                 check_weight(task.weight, f"tasks[{i}].weight")
+        priorities = {t.priority for t in tasks if t.hard}
+        if len(priorities) > MAX_LEVELS:
+            raise ParameterError(
+                "tasks",
+                f"{len(priorities)} priorities: at most {MAX_LEVELS} levels (each level is a QP "
+                "of its own where the levels cannot be met together; merge tasks into fewer "
+                "priorities)",
+            )
         ordered = sorted(tasks, key=lambda t: t.priority if t.hard else 0)
         object.__setattr__(self, "tasks", tuple(ordered))
         if sum(isinstance(limit, AccelerationLimit) for limit in self.limits) > 1:

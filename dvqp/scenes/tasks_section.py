@@ -212,7 +212,10 @@ def _distinct_tool_components(f: Fields, tables: list[dict[str, Any]]) -> None:
 
 def _levels_met(f: Fields, made: list[Task], start: KinematicState) -> None:
     """Each level can be met alone at the start (:func:`~dvqp.resolution.spec.unmeetable`)."""
-    spec_levels = StepSpec(tuple(made)).levels
+    try:
+        spec_levels = StepSpec(tuple(made)).levels
+    except ParameterError as exc:  # too many levels
+        f.fail("tasks", exc.reason)
     for number, level in enumerate(spec_levels, start=1):
         rows = [task.compute(start, np.zeros(4), 0.0).jacobian for task in level]
         reason = unmeetable(np.vstack(rows))

@@ -210,3 +210,17 @@ def test_a_scene_names_a_body_point_as_its_reports_do() -> None:
     )
     panda = dvqp.scenes.loads(text, str(SCENES / "panda-point.toml"))
     assert next(t for t in panda.tasks if isinstance(t, dvqp.PointTask)).point == 1
+
+
+def test_more_levels_than_the_cap_are_refused_at_load_and_in_the_api() -> None:
+    from dvqp.resolution.spec import MAX_LEVELS
+
+    many = "".join(
+        f'[[tasks]]\nkind = "posture"\npriority = {p}\n' for p in range(2, MAX_LEVELS + 2)
+    )
+    text = FOUR_LEVELS.replace('[[tasks]]\nkind = "posture"\npriority = 4\n', many)
+    with pytest.raises(dvqp.SceneError, match=rf"tasks: {MAX_LEVELS + 1} priorities: at most"):
+        dvqp.scenes.loads(text, "many.toml")
+    tasks = [dvqp.ToolTask(), *(dvqp.PostureTask(priority=p) for p in range(2, MAX_LEVELS + 2))]
+    with pytest.raises(dvqp.ParameterError, match=f"at most {MAX_LEVELS} levels"):
+        dvqp.StepSpec(tuple(tasks))
