@@ -36,6 +36,7 @@ from numpy.typing import NDArray
 from dvqp.motion.recorder import TrajectoryRecorder
 from dvqp.motion.schedule import Schedule, ScheduleArrays, command_into
 from dvqp.resolution.levels import load_columns
+from dvqp.resolution.pinv import pinv_step
 from dvqp.resolution.qp import load_scaled
 from dvqp.resolution.ray import ray_constants
 from dvqp.step import JOINT_STRIDE, Stepper
@@ -626,6 +627,8 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing, e, proving):  # type: igno
         add_kernel_metrics(f.log_sums, answer[4:12])
         return (OPTIMAL, int(answer[2]), solver_time, 1.0)
     f.flags[k] = answer[1]
+    if f.held.shape[0] > 0 and nested_keeps(s):  # levels met in least squares: Python's
+        return (-1, 0, 0.0, 0.0)
     if _paced(f):  # slowed along the path
         if not pacing:
             return (-1, 0, 0.0, 0.0)
@@ -657,6 +660,30 @@ def _refused(s, w, r, p, f, k, out, relaxing, pacing, e, proving):  # type: igno
     add_kernel_metrics(f.log_sums, again[4:12])
     iterations = int(again[2]) + (int(answer[2]) if levels else 0)  # as the cascade counts
     return (RELAXED, iterations, solver_time + again[3], 1.0)
+
+
+@njit
+def nested_keeps(s) -> bool:  # type: ignore[no-untyped-def]
+    """Whether the nested step of the step's levels (:func:`~dvqp.resolution.pinv.pinv_step`,
+    as :meth:`~dvqp.resolution.levels.Levels.nested` makes it) keeps every bound and
+    constraint: then no limit binds and Python takes it, without relaxing a level."""
+    qp, p = s.qp, s.pinv
+    x, info = np.empty(qp.cost.shape[0]), np.zeros(3)
+    status = pinv_step(
+        qp.A, qp.b, s.tasks.levels, p.rows, qp.cost, p.weights, qp.P, True, 0.0, info, x
+    )
+    if status != -1:
+        return False
+    for i in range(x.shape[0]):
+        if not (qp.lb[i] <= x[i] <= qp.ub[i]):
+            return False
+    for r in range(qp.h.shape[0]):
+        v = 0.0
+        for c in range(x.shape[0]):
+            v += qp.G[r, c] * x[c]
+        if not v <= qp.h[r]:
+            return False
+    return True
 
 
 @njit(inline="always")

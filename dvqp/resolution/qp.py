@@ -228,7 +228,8 @@ class QPSolver:
         step (:meth:`count_refused`); None when it cannot (as :meth:`fused_attempt`). With
         levels that may all be met together, the last level's relaxed problem, the levels above
         held (:attr:`loop_relaxed`): the first QP of their cascade after that strict refusal
-        (:meth:`~dvqp.resolution.levels.Levels.solve`)."""
+        (:meth:`~dvqp.resolution.levels.Levels.solve`), made only where the nested step breaks
+        a limit (else the loop hands the step to :meth:`solve`, which takes it)."""
         if self.watchers:
             return None
         if self.levels is not None:
@@ -346,11 +347,12 @@ class QPSolver:
             if solution.found and solution.x is not None:
                 x = solution.x[: qp.cost.shape[0]]
                 return Answer(x, "optimal", solution.iterations, solution.solver_time)
-        if levels is not None and not levels.together:
+        if levels is not None:  # not all met together, or together refused
             started = perf_counter()
             x = levels.nested()
             if x is not None:  # no limit binds: the lexicographic optimum, met in closed form
-                return Answer(x, "optimal", 0, perf_counter() - started)
+                spent = perf_counter() - started + (0.0 if refused is None else refused.solver_time)
+                return Answer(x, "optimal", 0, spent)
         if levels is not None:
             slow = self._slow_down if not rest and self.feedforward.any() else None
             out = levels.solve(self._count, slow, refused, relaxed_values)
