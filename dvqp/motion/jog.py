@@ -13,11 +13,23 @@ from dvqp.errors import ParameterError
 
 MAX_STEPS = 10_000_000
 """Most steps a planned motion may take."""
-DEFAULT_GAIN = 5.0
-"""1/s: the feedback a JOG of a scene with tasks at more than one priority closes on its
-reference (the start plus the integrated commands), ``ẋ = ẋ_c + K (x_ref − x)``, as a path's
-does: without it (0, the paper's JOG, the default of a scene of one level) each step meets the
-command in velocity and the integrated probe drifts by the steps' second-order error."""
+DEFAULT_GAIN_STEP = 0.5
+"""The share of its reference error a JOG of a scene with tasks at more than one priority
+closes each step by default: its feedback ``ẋ = ẋ_c + K (x_ref − x)`` (the reference the start
+plus the integrated commands, as a path's) has ``K = 0.5 / dt`` (100/s at dt = 5 ms; at most
+1000/s). Each step meets the command in velocity; the feedback removes what the steps'
+second-order error adds up to, to about twice one step's. 0 is the paper's JOG (velocities
+only, the default of a scene of one level): the integrated probe then drifts by those errors."""
+MAX_GAIN = 1000.0
+"""1/s: the largest feedback gain a scene takes."""
+
+
+def default_gain(dt: float) -> float:
+    """``K`` of a JOG with levels by default, 1/s: :data:`DEFAULT_GAIN_STEP` ``/ dt``, at most
+    :data:`MAX_GAIN`."""
+    return min(DEFAULT_GAIN_STEP / dt, MAX_GAIN)
+
+
 DEFAULT_RAMP = 0.2
 """s: a JOG's velocity changes (its start, its end, between segments) are spread over this."""
 

@@ -96,8 +96,8 @@ class Scene:
         DV task, all four components, alone (the paper's).
     jog_gain : float
         ``[motion] gain``, 1/s: the feedback a JOG closes on its reference (the start plus the
-        integrated commands; default 5 with tasks at more than one priority); 0 (the default
-        of one level): the paper's JOG, velocities only.
+        integrated commands; default ``0.5 / dt`` with tasks at more than one priority); 0 (the
+        default of one level): the paper's JOG, velocities only.
     """
 
     name: str

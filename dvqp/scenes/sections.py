@@ -19,7 +19,7 @@ from dvqp.kinematics.robot import Robot
 from dvqp.limits import DEFAULT_QDD_MAX, Limit
 from dvqp.limits.limit import SceneLimits
 from dvqp.limits.registry import SCENE_LIMITS, constraint_keys
-from dvqp.motion.jog import DEFAULT_GAIN, DEFAULT_RAMP, MAX_STEPS, JogSegment, jog_step_count
+from dvqp.motion.jog import DEFAULT_RAMP, MAX_STEPS, JogSegment, default_gain, jog_step_count
 from dvqp.motion.path import ToolPath
 from dvqp.motion.saddle import SaddleWeld
 from dvqp.motion.schedule import TIMINGS
@@ -129,7 +129,7 @@ def motion(
         f.fail("motion.gain", f"a JOG's feedback gain; a {kind}'s is motion.{kind}.gain")
     tasks = doc.get("tasks") if isinstance(doc.get("tasks"), list) else []
     priorities = {t.get("priority", 1) for t in tasks if isinstance(t, dict)}
-    default = DEFAULT_GAIN if len(priorities) > 1 else 0.0  # one level: the paper's JOG
+    default = default_gain(dt) if len(priorities) > 1 else 0.0  # one level: the paper's JOG
     gain = f.number(motion, "gain", "motion", default, within=GAIN)
     saddle = _saddle(f, motion, obstacles) if "saddle" in motion else None
     jog, path = ((), saddle[1]) if saddle else _motion(f, motion)

@@ -25,7 +25,7 @@ from dvqp.motion.stop import MARGIN, braking_steps, room
 from dvqp.run.comparison import summarize
 from dvqp.run.planning import check_run, scene_commands, scene_timing
 from dvqp.scenes.scene import loads
-from tests.runs import BUNDLED, LOOSE_ACCELERATION, QP, run, scene
+from tests.runs import BUNDLED, LOOSE, LOOSE_ACCELERATION, QP, run, scene
 
 
 def qdd_max(s: Scene) -> np.ndarray:
@@ -65,7 +65,7 @@ def test_every_bundled_scene_ends_at_rest_within_its_acceleration_limit(
     s, traj = scene(name), run(name, backend)
     check_run(s, traj)  # safe to send, the stop included
     if (name, backend) in LOOSE_ACCELERATION:
-        assert_ends_at_rest(s, traj, tol=1e-6 * float(qdd_max(s).max()))
+        assert_ends_at_rest(s, traj, tol=LOOSE * float(qdd_max(s).max()))
         pytest.xfail(LOOSE_ACCELERATION[name, backend])
     assert_ends_at_rest(s, traj)
 

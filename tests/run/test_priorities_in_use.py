@@ -106,7 +106,7 @@ def test_a_jog_holds_its_first_level_to_the_reference_while_the_second_lags() ->
 
 def test_an_open_loop_jog_drifts_off_its_first_level_and_says_so() -> None:
     text = (SCENES / "jog-priorities.toml").read_text(encoding="utf-8")
-    opened = text.replace("gain = 20.0 ", "gain = 0.0 ")
+    opened = text.replace("[motion]\n", "[motion]\ngain = 0.0\n", 1)
     assert opened != text
     traj = dvqp.plan(dvqp.scenes.loads(opened, "open-loop.toml"), "daqp")
     level = level_figures(traj)[0]
